@@ -1,0 +1,105 @@
+//! Speed of the EEG side: synthesis, preprocessing, features, decoding.
+//!
+//! Run with `cargo bench -p errp_bci`. Figures are per call on one core.
+
+use std::sync::LazyLock;
+
+use divan::{Bencher, black_box};
+use errp_bci::{
+    Assessment, AssessmentKind, CalibrationParams, CalibrationSetup, EegGenerator, EpochWindow,
+    ErrorModel, GeneratorParams, LdaDecoder, LdaModel, Montage, Preprocessor, SessionOptions,
+    calibrate,
+};
+
+fn main() {
+    divan::main();
+}
+
+const FS: usize = 256;
+
+struct Trained {
+    setup: CalibrationSetup,
+    pre: Preprocessor,
+    model: LdaModel,
+}
+
+static TRAINED: LazyLock<Trained> = LazyLock::new(|| {
+    let setup = CalibrationSetup {
+        generator: GeneratorParams {
+            errp_to_noise: 0.8,
+            ..GeneratorParams::default()
+        },
+        calibration: CalibrationParams {
+            n_actions: 120,
+            ..CalibrationParams::default()
+        },
+        ..CalibrationSetup::default()
+    };
+    let c = calibrate(&LdaDecoder::default(), &setup, 1, SessionOptions::default()).unwrap();
+    Trained {
+        pre: c.session.preprocessor.clone(),
+        model: c.model,
+        setup,
+    }
+});
+
+/// One second of all 40 channels (34 EEG + 6 EOG) at 256 Hz.
+#[divan::bench]
+fn generate_one_second(bencher: Bencher) {
+    let mut g = EegGenerator::new(GeneratorParams::default(), &Montage::standard(), 1).unwrap();
+    bencher.bench_local(|| black_box(g.generate(FS)));
+}
+
+/// Preprocess (CAR + EOG regression + notch + band-pass, 8 output channels),
+/// extract the 312 features and classify one epoch, from raw samples.
+#[divan::bench]
+fn decode_epoch(bencher: Bencher) {
+    let t = &*TRAINED;
+    let window = EpochWindow::paper(FS as f64);
+    let mut g = EegGenerator::new(t.setup.generator.clone(), &t.setup.montage, 2).unwrap();
+    let raw = g.generate(window.span());
+    let mut pre = t.pre.clone();
+    bencher.bench_local(|| {
+        let clean = pre.process(black_box(&raw));
+        let x = window.extract(&clean, 0);
+        black_box(t.model.p_error(&x))
+    });
+}
+
+/// One action of the discrete task with the EEG decoder, net time only: the
+/// 0.8 s epoch after the action synthesised (with its ErrP) and decoded.
+#[divan::bench]
+fn synthesize_and_decode_epoch(bencher: Bencher) {
+    action(bencher, 0.8);
+}
+
+/// One action including the 3.25 s mean inter-action interval: all EEG
+/// between actions is synthesised and filtered, as in a continuous session.
+#[divan::bench]
+fn synthesize_and_decode_action_with_interval(bencher: Bencher) {
+    action(bencher, 3.25);
+}
+
+fn action(bencher: Bencher, secs: f64) {
+    let t = &*TRAINED;
+    let window = EpochWindow::paper(FS as f64);
+    let n = ((secs * FS as f64) as usize).max(window.span());
+    let mut g = EegGenerator::new(t.setup.generator.clone(), &t.setup.montage, 3).unwrap();
+    let mut pre = t.pre.clone();
+    let mut k = 0u64;
+    bencher.bench_local(|| {
+        let onset = g.now_secs();
+        g.schedule(Assessment {
+            onset_secs: onset,
+            kind: if k.is_multiple_of(5) {
+                AssessmentKind::Error
+            } else {
+                AssessmentKind::Correct
+            },
+        });
+        k += 1;
+        let raw = g.generate(n);
+        let clean = pre.process(&raw);
+        black_box(t.model.p_error(&window.extract(&clean, 0)))
+    });
+}

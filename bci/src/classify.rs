@@ -1,0 +1,66 @@
+//! The classifier interface shared by every ErrP decoder.
+
+use nalgebra::DMatrix;
+
+use crate::error::Result;
+
+/// Feature matrix, one trial per row: shape `(n_trials, n_features)`.
+pub type Features = DMatrix<f64>;
+
+/// Something that learns p(error | features) from labelled trials
+/// (scikit-learn / linfa `Fit` shape). Labels: `true` = error (class 1).
+pub trait Classifier: Send + Sync {
+    /// The trained model.
+    type Model: ErrorModel;
+
+    /// Fits on `x` `(n_trials, n_features)` and `labels` (`n_trials`).
+    /// `seed` drives any randomness; the same seed gives the same model.
+    fn fit(&self, x: &Features, labels: &[bool], seed: u64) -> Result<Self::Model>;
+}
+
+/// A trained decoder.
+pub trait ErrorModel: Send + Sync + Clone + std::fmt::Debug {
+    /// Raw decision value; `>= 0` means "error".
+    fn decision(&self, x: &[f64]) -> f64;
+
+    /// Probability that the trial is an error, in [0, 1].
+    fn p_error(&self, x: &[f64]) -> f64;
+
+    /// Number of features expected.
+    fn n_features(&self) -> usize;
+}
+
+/// Logistic function, 1 / (1 + e^-y), without overflow.
+pub fn sigmoid(y: f64) -> f64 {
+    if y >= 0.0 {
+        1.0 / (1.0 + (-y).exp())
+    } else {
+        let e = y.exp();
+        e / (1.0 + e)
+    }
+}
+
+/// Checks the shapes and that both classes are present.
+pub(crate) fn check_training_set(x: &Features, labels: &[bool]) -> Result<(usize, usize)> {
+    use crate::error::BciError;
+    if x.nrows() != labels.len() {
+        return Err(BciError::Training(format!(
+            "{} trials but {} labels",
+            x.nrows(),
+            labels.len()
+        )));
+    }
+    let n_err = labels.iter().filter(|&&l| l).count();
+    let n_cor = labels.len() - n_err;
+    if n_err < 2 || n_cor < 2 {
+        return Err(BciError::Training(format!(
+            "need at least 2 trials of each class, got {n_cor} correct and {n_err} error"
+        )));
+    }
+    if x.iter().any(|v| !v.is_finite()) {
+        return Err(BciError::Training(
+            "features contain NaN or infinity".into(),
+        ));
+    }
+    Ok((n_cor, n_err))
+}

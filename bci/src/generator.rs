@@ -1,0 +1,744 @@
+//! The synthetic EEG generator: assessment events in, multichannel samples out.
+
+use std::f64::consts::PI;
+
+use nalgebra::DMatrix;
+use rand::Rng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Exp, StandardNormal};
+use serde::{Deserialize, Serialize};
+
+use crate::erp::{AssessmentKind, ErpTemplates, waveform};
+use crate::error::{Result, check};
+use crate::montage::{Montage, angle_between};
+use crate::noise::{PinkNoise, Resonator};
+use crate::rng::stream;
+
+/// Parameters of the synthetic EEG. Amplitudes are in uV; every default is
+/// documented next to its field.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct GeneratorParams {
+    /// Sampling rate (Hz); the paper records at 256 Hz.
+    pub sfreq_hz: f64,
+    /// SD of the 1/f background on every EEG channel (uV). 10 uV is typical
+    /// of resting scalp EEG below 40 Hz.
+    pub background_uv: f64,
+    /// Spatial correlation length of the background on the unit head sphere:
+    /// correlation exp(-d / length) for chord distance d (1.0: ~0.75 between
+    /// neighbours 3 cm apart, ~0.2 across the head).
+    pub spatial_length: f64,
+    /// SD of the alpha rhythm at Oz (uV); it falls off towards the front.
+    pub alpha_uv: f64,
+    /// Alpha centre frequency (Hz).
+    pub alpha_hz: f64,
+    /// Alpha bandwidth (Hz).
+    pub alpha_bandwidth_hz: f64,
+    /// White sensor noise SD on every channel (uV).
+    pub sensor_noise_uv: f64,
+    /// Mains interference amplitude (uV), mostly common-mode.
+    pub line_noise_uv: f64,
+    /// Mains frequency (Hz); the paper's lab is on 50 Hz.
+    pub line_hz: f64,
+    /// Mean blink rate (per second).
+    pub blink_rate_hz: f64,
+    /// Mean blink amplitude on the electrodes above the eyes (uV).
+    pub blink_uv: f64,
+    /// Mean saccade rate (per second).
+    pub saccade_rate_hz: f64,
+    /// SD of the horizontal gaze potential at the outer canthi (uV).
+    pub saccade_uv: f64,
+    /// Peak of the error-minus-correct difference at FCz divided by the SD
+    /// of the background EEG there: the knob accuracy targeting searches.
+    pub errp_to_noise: f64,
+    /// SD of the single-trial latency jitter of the ERPs (ms).
+    pub latency_jitter_ms: f64,
+    /// SD of the single-trial amplitude factor (mean 1, clipped at 0).
+    pub amplitude_variability: f64,
+}
+
+impl Default for GeneratorParams {
+    fn default() -> Self {
+        Self {
+            sfreq_hz: 256.0,
+            background_uv: 10.0,
+            spatial_length: 1.0,
+            alpha_uv: 6.0,
+            alpha_hz: 10.0,
+            alpha_bandwidth_hz: 2.0,
+            sensor_noise_uv: 1.0,
+            line_noise_uv: 10.0,
+            line_hz: 50.0,
+            blink_rate_hz: 0.2,
+            blink_uv: 150.0,
+            saccade_rate_hz: 0.5,
+            saccade_uv: 30.0,
+            errp_to_noise: 0.5,
+            latency_jitter_ms: 25.0,
+            amplitude_variability: 0.3,
+        }
+    }
+}
+
+impl GeneratorParams {
+    /// Checks every field; the error names the field and the accepted range.
+    pub fn validate(&self) -> Result<()> {
+        let finite_nonneg = |v: f64| v.is_finite() && v >= 0.0;
+        check(
+            self.sfreq_hz.is_finite() && self.sfreq_hz >= 64.0,
+            "sfreq_hz",
+            self.sfreq_hz,
+            "a sampling rate of at least 64 Hz",
+        )?;
+        for (name, v) in [
+            ("background_uv", self.background_uv),
+            ("alpha_uv", self.alpha_uv),
+            ("sensor_noise_uv", self.sensor_noise_uv),
+            ("line_noise_uv", self.line_noise_uv),
+            ("blink_rate_hz", self.blink_rate_hz),
+            ("blink_uv", self.blink_uv),
+            ("saccade_rate_hz", self.saccade_rate_hz),
+            ("saccade_uv", self.saccade_uv),
+            ("errp_to_noise", self.errp_to_noise),
+            ("latency_jitter_ms", self.latency_jitter_ms),
+            ("amplitude_variability", self.amplitude_variability),
+        ] {
+            check(finite_nonneg(v), name, v, "a finite number >= 0")?;
+        }
+        check(
+            self.background_uv > 0.0,
+            "background_uv",
+            self.background_uv,
+            "a number > 0 (the ErrP-to-noise ratio is relative to it)",
+        )?;
+        check(
+            self.spatial_length.is_finite() && self.spatial_length > 0.0,
+            "spatial_length",
+            self.spatial_length,
+            "a finite number > 0",
+        )?;
+        let nyquist = self.sfreq_hz / 2.0;
+        for (name, v) in [("alpha_hz", self.alpha_hz), ("line_hz", self.line_hz)] {
+            check(
+                v.is_finite() && v > 0.0 && v < nyquist,
+                name,
+                v,
+                &format!("a frequency in (0, {nyquist}) Hz"),
+            )?;
+        }
+        check(
+            self.alpha_bandwidth_hz.is_finite() && self.alpha_bandwidth_hz > 0.0,
+            "alpha_bandwidth_hz",
+            self.alpha_bandwidth_hz,
+            "a finite number > 0",
+        )
+    }
+}
+
+/// A user's judgement of one action, at a time on the generator's clock.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Assessment {
+    /// Action onset (s since the generator started).
+    pub onset_secs: f64,
+    /// Correct or erroneous.
+    pub kind: AssessmentKind,
+}
+
+/// Multichannel samples, channel-major: shape `(n_channels, n_samples)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EegBlock {
+    /// Number of channels (rows).
+    pub n_channels: usize,
+    /// Number of samples per channel (columns).
+    pub n_samples: usize,
+    /// `data[ch * n_samples + t]`.
+    pub data: Vec<f64>,
+}
+
+impl EegBlock {
+    /// A block of zeros.
+    pub fn zeros(n_channels: usize, n_samples: usize) -> Self {
+        Self {
+            n_channels,
+            n_samples,
+            data: vec![0.0; n_channels * n_samples],
+        }
+    }
+
+    /// Samples of one channel.
+    pub fn channel(&self, ch: usize) -> &[f64] {
+        &self.data[ch * self.n_samples..(ch + 1) * self.n_samples]
+    }
+
+    /// Mutable samples of one channel.
+    pub fn channel_mut(&mut self, ch: usize) -> &mut [f64] {
+        &mut self.data[ch * self.n_samples..(ch + 1) * self.n_samples]
+    }
+
+    /// Appends `other` (same channel count) after this block's samples.
+    pub fn append(&mut self, other: &EegBlock) {
+        assert_eq!(self.n_channels, other.n_channels, "channel counts differ");
+        let n = self.n_samples + other.n_samples;
+        let mut data = Vec::with_capacity(self.n_channels * n);
+        for ch in 0..self.n_channels {
+            data.extend_from_slice(self.channel(ch));
+            data.extend_from_slice(other.channel(ch));
+        }
+        self.data = data;
+        self.n_samples = n;
+    }
+}
+
+/// Which parts of the signal are switched on. The random streams advance
+/// identically whatever is switched off, so the parts of one seed add up to the
+/// whole signal exactly (accuracy targeting relies on this).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Components {
+    /// Background EEG (1/f, alpha) and sensor noise.
+    pub background: bool,
+    /// Line noise, blinks and saccades.
+    pub artifacts: bool,
+    /// Event-related potentials.
+    pub erp: bool,
+}
+
+impl Default for Components {
+    fn default() -> Self {
+        Self {
+            background: true,
+            artifacts: true,
+            erp: true,
+        }
+    }
+}
+
+#[derive(Debug, Clone)]
+struct ActiveErp {
+    onset_sample: f64,
+    kind: AssessmentKind,
+    jitter_ms: f64,
+    gain: f64,
+}
+
+/// How long an ERP lasts after its onset (s).
+const ERP_LENGTH_SECS: f64 = 1.2;
+/// Duration of a blink (s).
+const BLINK_SECS: f64 = 0.35;
+/// Duration of a saccade (s).
+const SACCADE_SECS: f64 = 0.04;
+
+/// Streams synthetic EEG + EOG for a [`Montage`]. Schedule assessments with
+/// [`EegGenerator::schedule`], pull samples with [`EegGenerator::generate`];
+/// blocks carry all state, so ten 1 s blocks equal one 10 s block.
+///
+/// Model per EEG channel: spatially correlated 1/f background + alpha
+/// (posterior) + white sensor noise + mains + blink and saccade potentials
+/// leaking from the eyes (falling off with distance) + ERPs with the FCz-centred
+/// topography of the templates. EOG channels carry the eye potentials, their
+/// own 1/f noise and sensor noise.
+#[derive(Debug, Clone)]
+pub struct EegGenerator {
+    params: GeneratorParams,
+    components: Components,
+    montage: Montage,
+    templates: ErpTemplates,
+    topography: Vec<f64>,
+    erp_scale: f64,
+    /// Lower-triangular mixing of the background sources, `(n_eeg, n_eeg)`,
+    /// stored column-major (`mixing[k * n_eeg + ch]`), in uV.
+    mixing: Vec<f64>,
+    mixed: Vec<f64>,
+    pink: Vec<PinkNoise>,
+    alpha: Resonator,
+    alpha_weight: Vec<f64>,
+    line_cos: Vec<f64>,
+    line_sin: Vec<f64>,
+    blink_coeff: Vec<f64>,
+    gaze_coeff: Vec<f64>,
+    blinks: Vec<(u64, f64)>,
+    next_blink: u64,
+    gaze_from: f64,
+    gaze_to: f64,
+    saccade_start: u64,
+    next_saccade: u64,
+    erps: Vec<ActiveErp>,
+    sample: u64,
+    white: Vec<f64>,
+    rng_background: ChaCha8Rng,
+    rng_artifacts: ChaCha8Rng,
+    rng_erp: ChaCha8Rng,
+}
+
+impl EegGenerator {
+    /// A generator for `montage` with the shipped ERP templates.
+    pub fn new(params: GeneratorParams, montage: &Montage, seed: u64) -> Result<Self> {
+        Self::with_templates(params, montage, ErpTemplates::default(), seed)
+    }
+
+    /// A generator with custom ERP templates.
+    pub fn with_templates(
+        params: GeneratorParams,
+        montage: &Montage,
+        templates: ErpTemplates,
+        seed: u64,
+    ) -> Result<Self> {
+        params.validate()?;
+        let mut rng_background = stream(seed, "eeg/background");
+        let mut rng_artifacts = stream(seed, "eeg/artifacts");
+        let rng_erp = stream(seed, "eeg/erp");
+        let n_eeg = montage.n_eeg();
+        let n_ch = montage.len();
+        let fs = params.sfreq_hz;
+
+        // Background: correlation exp(-chord / length) between EEG sites.
+        let pos = |i: usize| montage.channels()[i].position;
+        let corr = DMatrix::from_fn(n_eeg, n_eeg, |i, j| {
+            let (a, b) = (pos(i), pos(j));
+            let d = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
+            (-d / params.spatial_length).exp()
+        });
+        let l = corr
+            .cholesky()
+            .expect("an exponential kernel on distinct points is positive definite")
+            .l();
+        let mut mixing = vec![0.0; n_eeg * n_eeg];
+        for i in 0..n_eeg {
+            for j in 0..=i {
+                mixing[j * n_eeg + i] = l[(i, j)] * params.background_uv;
+            }
+        }
+        let pink = (0..n_ch)
+            .map(|_| PinkNoise::new(fs, &mut rng_background))
+            .collect();
+        let alpha = Resonator::new(
+            params.alpha_hz,
+            params.alpha_bandwidth_hz,
+            fs,
+            &mut rng_background,
+        );
+        let oz = pos(montage.index("Oz")?);
+        let alpha_weight = (0..n_ch)
+            .map(|ch| {
+                if ch < n_eeg {
+                    let d = angle_between(pos(ch), oz);
+                    params.alpha_uv * (-0.5 * (d / 0.9).powi(2)).exp()
+                } else {
+                    0.0
+                }
+            })
+            .collect::<Vec<_>>();
+
+        // Mains: mostly common-mode, with a small per-channel spread.
+        let common_phase = rng_artifacts.random::<f64>() * 2.0 * PI;
+        let mut line_cos = Vec::with_capacity(n_ch);
+        let mut line_sin = Vec::with_capacity(n_ch);
+        for _ in 0..n_ch {
+            let amp = params.line_noise_uv * rng_artifacts.random_range(0.5..1.5);
+            let phase = common_phase + 0.3 * rng_artifacts.sample::<f64, _>(StandardNormal);
+            line_cos.push(amp * phase.cos());
+            line_sin.push(amp * phase.sin());
+        }
+
+        // Eye potentials: blinks (vertical) and gaze (horizontal).
+        let (blink_coeff, gaze_coeff) = eye_coefficients(montage)?;
+
+        let centre = montage.index(&templates.centre)?;
+        let bg_sd_at_centre = (params.background_uv.powi(2)
+            + alpha_weight[centre].powi(2)
+            + params.sensor_noise_uv.powi(2))
+        .sqrt();
+        let erp_scale = params.errp_to_noise * bg_sd_at_centre / templates.difference_peak_uv();
+        let topography = templates.topography(montage)?;
+
+        let mut generator = Self {
+            components: Components::default(),
+            montage: montage.clone(),
+            templates,
+            topography,
+            erp_scale,
+            mixing,
+            mixed: vec![0.0; n_eeg],
+            pink,
+            alpha,
+            alpha_weight,
+            line_cos,
+            line_sin,
+            blink_coeff,
+            gaze_coeff,
+            blinks: Vec::new(),
+            next_blink: 0,
+            gaze_from: 0.0,
+            gaze_to: 0.0,
+            saccade_start: 0,
+            next_saccade: 0,
+            erps: Vec::new(),
+            sample: 0,
+            white: vec![0.0; n_ch],
+            rng_background,
+            rng_artifacts,
+            rng_erp,
+            params,
+        };
+        generator.next_blink = generator.draw_interval(generator.params.blink_rate_hz);
+        generator.next_saccade = generator.draw_interval(generator.params.saccade_rate_hz);
+        Ok(generator)
+    }
+
+    /// Switches parts of the signal on or off (see [`Components`]).
+    pub fn with_components(mut self, components: Components) -> Self {
+        self.components = components;
+        self
+    }
+
+    /// The parameters in force.
+    pub fn params(&self) -> &GeneratorParams {
+        &self.params
+    }
+
+    /// The montage generated for.
+    pub fn montage(&self) -> &Montage {
+        &self.montage
+    }
+
+    /// ERP amplitude at the centre electrode per template uV (the rescaling
+    /// that `errp_to_noise` implies).
+    pub fn erp_scale(&self) -> f64 {
+        self.erp_scale
+    }
+
+    /// Time of the next sample to be generated (s).
+    pub fn now_secs(&self) -> f64 {
+        self.sample as f64 / self.params.sfreq_hz
+    }
+
+    /// Index of the next sample to be generated.
+    pub fn sample_index(&self) -> u64 {
+        self.sample
+    }
+
+    /// Schedules the ERP of an assessment. Its single-trial latency jitter and
+    /// amplitude are drawn now, from the ERP stream, in scheduling order.
+    pub fn schedule(&mut self, assessment: Assessment) {
+        let jitter_ms =
+            self.params.latency_jitter_ms * self.rng_erp.sample::<f64, _>(StandardNormal);
+        let gain = (1.0
+            + self.params.amplitude_variability * self.rng_erp.sample::<f64, _>(StandardNormal))
+        .max(0.0);
+        let erp = ActiveErp {
+            onset_sample: assessment.onset_secs * self.params.sfreq_hz,
+            kind: assessment.kind,
+            jitter_ms,
+            gain,
+        };
+        // Kept sorted by onset so that rendering stops at the first future ERP.
+        let at = self
+            .erps
+            .partition_point(|e| e.onset_sample <= erp.onset_sample);
+        self.erps.insert(at, erp);
+    }
+
+    fn draw_interval(&mut self, rate_hz: f64) -> u64 {
+        if rate_hz <= 0.0 {
+            return u64::MAX;
+        }
+        let secs: f64 = self
+            .rng_artifacts
+            .sample(Exp::new(rate_hz).expect("rate > 0"));
+        self.sample + (secs * self.params.sfreq_hz).ceil().max(1.0) as u64
+    }
+
+    /// Generates the next `n_samples` samples of every channel, shape
+    /// `(n_channels, n_samples)`, in uV.
+    pub fn generate(&mut self, n_samples: usize) -> EegBlock {
+        let mut block = EegBlock::zeros(self.montage.len(), n_samples);
+        self.generate_into(&mut block);
+        block
+    }
+
+    /// Fills `block` (any channel count equal to the montage's) with the next
+    /// `block.n_samples` samples.
+    pub fn generate_into(&mut self, block: &mut EegBlock) {
+        assert_eq!(block.n_channels, self.montage.len(), "channel count");
+        let n = block.n_samples;
+        let n_ch = self.montage.len();
+        let n_eeg = self.montage.n_eeg();
+        let fs = self.params.sfreq_hz;
+        let c = self.components;
+        let bg = if c.background { 1.0 } else { 0.0 };
+        let art = if c.artifacts { 1.0 } else { 0.0 };
+        let erp_on = if c.erp { 1.0 } else { 0.0 };
+        let eog_bg = 0.5 * self.params.background_uv;
+        let sensor = self.params.sensor_noise_uv;
+        let blink_len = (BLINK_SECS * fs) as u64;
+        let saccade_len = ((SACCADE_SECS * fs) as u64).max(1);
+        let erp_len = ERP_LENGTH_SECS * fs;
+        let line_step = self.params.line_hz / fs;
+
+        for t in 0..n {
+            let s = self.sample;
+            // Background sources.
+            for ch in 0..n_ch {
+                let w: f64 = self.rng_background.sample(StandardNormal);
+                self.white[ch] = self.pink[ch].step(w);
+            }
+            let alpha = self.alpha.step(self.rng_background.sample(StandardNormal));
+
+            // Eye potentials.
+            while s >= self.next_blink {
+                let amp = self.params.blink_uv
+                    * (1.0 + 0.2 * self.rng_artifacts.sample::<f64, _>(StandardNormal)).max(0.2);
+                self.blinks.push((self.next_blink, amp));
+                self.next_blink = self.draw_interval(self.params.blink_rate_hz);
+            }
+            while s >= self.next_saccade {
+                self.gaze_from = self.gaze_at(s, saccade_len);
+                self.gaze_to =
+                    self.params.saccade_uv * self.rng_artifacts.sample::<f64, _>(StandardNormal);
+                self.saccade_start = self.next_saccade;
+                self.next_saccade = self.draw_interval(self.params.saccade_rate_hz);
+            }
+            self.blinks.retain(|&(start, _)| s < start + blink_len);
+            let blink: f64 = self
+                .blinks
+                .iter()
+                .map(|&(start, amp)| {
+                    let x = (s - start) as f64 / blink_len as f64;
+                    amp * (PI * x).sin().powi(2)
+                })
+                .sum();
+            let gaze = self.gaze_at(s, saccade_len);
+            let phase = 2.0 * PI * (line_step * s as f64).fract();
+            let (line_s, line_c) = phase.sin_cos();
+
+            // ERPs at the centre electrode.
+            let mut erp_centre = 0.0;
+            for e in &self.erps {
+                let dt = s as f64 - e.onset_sample;
+                if dt < 0.0 {
+                    break;
+                }
+                if dt < erp_len {
+                    let t_ms = dt / fs * 1000.0 - e.jitter_ms;
+                    erp_centre += e.gain * waveform(self.templates.components(e.kind), t_ms);
+                }
+            }
+            erp_centre *= self.erp_scale * erp_on;
+
+            // Spatial mixing, column by column (vectorises; no long add chain).
+            self.mixed.fill(0.0);
+            for k in 0..n_eeg {
+                let zk = self.white[k];
+                let col = &self.mixing[k * n_eeg..(k + 1) * n_eeg];
+                for (m, &l) in self.mixed[k..].iter_mut().zip(&col[k..]) {
+                    *m += l * zk;
+                }
+            }
+            for ch in 0..n_ch {
+                let mut v = if ch < n_eeg {
+                    bg * (self.mixed[ch] + self.alpha_weight[ch] * alpha)
+                } else {
+                    bg * eog_bg * self.white[ch]
+                };
+                v += bg * sensor * self.rng_background.sample::<f64, _>(StandardNormal);
+                v += art
+                    * (self.line_cos[ch] * line_c - self.line_sin[ch] * line_s
+                        + self.blink_coeff[ch] * blink
+                        + self.gaze_coeff[ch] * gaze);
+                v += self.topography[ch] * erp_centre;
+                block.data[ch * n + t] = v;
+            }
+            self.sample += 1;
+        }
+        let now = self.sample as f64;
+        self.erps.retain(|e| now < e.onset_sample + erp_len);
+    }
+
+    fn gaze_at(&self, s: u64, saccade_len: u64) -> f64 {
+        if s < self.saccade_start {
+            return self.gaze_from;
+        }
+        let x = ((s - self.saccade_start) as f64 / saccade_len as f64).min(1.0);
+        let smooth = x * x * (3.0 - 2.0 * x);
+        self.gaze_from + (self.gaze_to - self.gaze_from) * smooth
+    }
+}
+
+/// Blink and gaze coefficients per channel. EOG: blinks are positive above
+/// the eyes and smaller, negative below; gaze is opposite at the two canthi.
+/// EEG: both leak with distance from the eyes (a blink reaches Fp1/Fp2 at
+/// ~40 % of its supra-orbital size and Fz at ~10 %, as propagation factors
+/// reported for EOG correction).
+fn eye_coefficients(montage: &Montage) -> Result<(Vec<f64>, Vec<f64>)> {
+    let pos =
+        |name: &str| -> Result<[f64; 3]> { Ok(montage.channels()[montage.index(name)?].position) };
+    let (la, ra, lo, ro) = (
+        pos("EOG-LA")?,
+        pos("EOG-RA")?,
+        pos("EOG-LO")?,
+        pos("EOG-RO")?,
+    );
+    let mut blink = Vec::with_capacity(montage.len());
+    let mut gaze = Vec::with_capacity(montage.len());
+    for c in montage.channels() {
+        let (b, g) = match c.name.as_str() {
+            "EOG-LA" => (1.0, 0.1),
+            "EOG-RA" => (1.0, -0.1),
+            "EOG-LB" => (-0.35, 0.1),
+            "EOG-RB" => (-0.35, -0.1),
+            "EOG-LO" => (0.15, 0.5),
+            "EOG-RO" => (0.15, -0.5),
+            _ => {
+                let d_eye = angle_between(c.position, la).min(angle_between(c.position, ra));
+                let b = 0.6 * (-d_eye / 0.6).exp();
+                let g = 0.4
+                    * ((-angle_between(c.position, lo) / 0.5).exp()
+                        - (-angle_between(c.position, ro) / 0.5).exp());
+                (b, g)
+            }
+        };
+        blink.push(b);
+        gaze.push(g);
+    }
+    Ok((blink, gaze))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn generator(seed: u64) -> EegGenerator {
+        EegGenerator::new(GeneratorParams::default(), &Montage::standard(), seed).unwrap()
+    }
+
+    #[test]
+    fn ten_one_second_blocks_equal_one_ten_second_block() {
+        let mut a = generator(5);
+        let mut b = generator(5);
+        for g in [&mut a, &mut b] {
+            for k in 0..6 {
+                let kind = if k % 2 == 0 {
+                    AssessmentKind::Error
+                } else {
+                    AssessmentKind::Correct
+                };
+                g.schedule(Assessment {
+                    onset_secs: 0.7 + 1.5 * k as f64,
+                    kind,
+                });
+            }
+        }
+        let whole = a.generate(2560);
+        let mut parts = b.generate(256);
+        for _ in 1..10 {
+            parts.append(&b.generate(256));
+        }
+        assert_eq!(whole, parts);
+    }
+
+    #[test]
+    fn components_add_up_to_the_whole_signal() {
+        let sched = |g: &mut EegGenerator| {
+            g.schedule(Assessment {
+                onset_secs: 0.5,
+                kind: AssessmentKind::Error,
+            })
+        };
+        let mut whole = generator(9);
+        sched(&mut whole);
+        let whole = whole.generate(600);
+        let mut parts = Vec::new();
+        for comp in [
+            Components {
+                background: true,
+                artifacts: false,
+                erp: false,
+            },
+            Components {
+                background: false,
+                artifacts: true,
+                erp: false,
+            },
+            Components {
+                background: false,
+                artifacts: false,
+                erp: true,
+            },
+        ] {
+            let mut g = generator(9).with_components(comp);
+            sched(&mut g);
+            parts.push(g.generate(600));
+        }
+        for i in 0..whole.data.len() {
+            let sum: f64 = parts.iter().map(|p| p.data[i]).sum();
+            assert!((sum - whole.data[i]).abs() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn same_seed_same_samples_other_seed_other_samples() {
+        assert_eq!(generator(1).generate(300), generator(1).generate(300));
+        assert_ne!(generator(1).generate(300), generator(2).generate(300));
+    }
+
+    #[test]
+    fn background_has_the_requested_sd_and_is_spatially_correlated() {
+        let m = Montage::standard();
+        let mut g = generator(11).with_components(Components {
+            background: true,
+            artifacts: false,
+            erp: false,
+        });
+        let block = g.generate(256 * 120);
+        let fcz = block.channel(m.index("FCz").unwrap());
+        let sd = (fcz.iter().map(|x| x * x).sum::<f64>() / fcz.len() as f64).sqrt();
+        assert!((sd - 10.0).abs() < 2.5, "FCz background sd {sd}");
+        let corr = |a: &[f64], b: &[f64]| {
+            let ab: f64 = a.iter().zip(b).map(|(x, y)| x * y).sum();
+            let aa: f64 = a.iter().map(|x| x * x).sum();
+            let bb: f64 = b.iter().map(|x| x * x).sum();
+            ab / (aa * bb).sqrt()
+        };
+        let cz = block.channel(m.index("Cz").unwrap());
+        let t8 = block.channel(m.index("T8").unwrap());
+        assert!(corr(fcz, cz) > 0.6, "neighbours correlate");
+        assert!(
+            corr(fcz, cz) > corr(fcz, t8) + 0.2,
+            "far sites correlate less"
+        );
+    }
+
+    #[test]
+    fn blinks_dominate_eog_and_leak_into_frontal_eeg() {
+        let m = Montage::standard();
+        let params = GeneratorParams {
+            blink_rate_hz: 1.0,
+            ..GeneratorParams::default()
+        };
+        let mut g = EegGenerator::new(params, &m, 4)
+            .unwrap()
+            .with_components(Components {
+                background: false,
+                artifacts: true,
+                erp: false,
+            });
+        let block = g.generate(256 * 30);
+        let peak = |n: &str| {
+            block
+                .channel(m.index(n).unwrap())
+                .iter()
+                .fold(0.0f64, |a, &x| a.max(x.abs()))
+        };
+        assert!(peak("EOG-LA") > 100.0);
+        assert!(peak("Fp1") > peak("Fz") && peak("Fz") > peak("Pz"));
+    }
+
+    #[test]
+    fn invalid_parameters_are_rejected_by_name() {
+        let params = GeneratorParams {
+            errp_to_noise: f64::NAN,
+            ..GeneratorParams::default()
+        };
+        let err = EegGenerator::new(params, &Montage::standard(), 0).unwrap_err();
+        assert!(err.to_string().contains("errp_to_noise"), "{err}");
+    }
+}

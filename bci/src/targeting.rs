@@ -1,0 +1,251 @@
+//! Accuracy targeting: find the ErrP-to-noise ratio at which the real
+//! decoder's cross-validated mean accuracy equals a requested value.
+
+use serde::{Deserialize, Serialize};
+
+use crate::calibration::{
+    Accuracy, CalibrationSetup, SessionOptions, cross_validate, cv_seed, simulate_session,
+};
+use crate::classify::{Classifier, Features};
+use crate::error::{BciError, Result, check};
+use crate::generator::{Components, GeneratorParams};
+
+/// How closely and how hard to search.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct TargetingParams {
+    /// Stop once the cross-validated mean accuracy is this close (fraction).
+    pub tolerance: f64,
+    /// Most decoder evaluations (each a full cross-validation).
+    pub max_evaluations: usize,
+    /// Largest ratio tried.
+    pub max_ratio: f64,
+}
+
+impl Default for TargetingParams {
+    fn default() -> Self {
+        Self {
+            tolerance: 0.005,
+            max_evaluations: 16,
+            max_ratio: 8.0,
+        }
+    }
+}
+
+/// One evaluation of the search.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TargetingStep {
+    /// ErrP-to-noise ratio tried.
+    pub ratio: f64,
+    /// Cross-validated accuracy there.
+    pub accuracy: Accuracy,
+}
+
+/// Outcome of a search.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TargetingResult {
+    /// Requested mean accuracy.
+    pub requested: f64,
+    /// The ratio found.
+    pub ratio: f64,
+    /// Cross-validated accuracy at that ratio.
+    pub accuracy: Accuracy,
+    /// Every evaluation, in order.
+    pub steps: Vec<TargetingStep>,
+}
+
+/// Checks a requested accuracy: the mean of two per-class rates, strictly
+/// between chance (0.5) and perfect (1).
+pub fn check_requested_accuracy(requested: f64) -> Result<()> {
+    check(
+        requested.is_finite() && requested > 0.5 && requested < 1.0,
+        "accuracy",
+        requested,
+        "a mean accuracy strictly between 0.5 (chance) and 1, e.g. 0.7438",
+    )
+}
+
+/// Searches the ErrP-to-noise ratio of `params` so that `classifier`,
+/// trained on a calibration session simulated from `seed`, scores `requested`
+/// (mean of the per-class rates) in cross-validation.
+///
+/// The preprocessing and the features are linear in the signal and the
+/// generator's parts add up exactly, so the session is simulated once as
+/// background + artifacts and once as ERPs at ratio 1; the features at ratio r
+/// are then `background + r * erp` and each step costs one cross-validation.
+/// The search brackets the target, then interpolates on the probit scale
+/// (accuracy ~ Phi(c r) for an ideal observer), bisecting when that stalls.
+pub fn target_accuracy<C: Classifier>(
+    requested: f64,
+    classifier: &C,
+    setup: &CalibrationSetup,
+    search: &TargetingParams,
+    seed: u64,
+    mut progress: impl FnMut(&TargetingStep),
+) -> Result<TargetingResult> {
+    check_requested_accuracy(requested)?;
+    let unit = CalibrationSetup {
+        generator: GeneratorParams {
+            errp_to_noise: 1.0,
+            ..setup.generator.clone()
+        },
+        ..setup.clone()
+    };
+    let part = |components| {
+        simulate_session(
+            &unit,
+            seed,
+            SessionOptions {
+                components,
+                ..SessionOptions::default()
+            },
+        )
+    };
+    let noise = part(Components {
+        background: true,
+        artifacts: true,
+        erp: false,
+    })?;
+    let erp = part(Components {
+        background: false,
+        artifacts: false,
+        erp: true,
+    })?;
+    let labels = noise.labels.clone();
+    let cv_seed = cv_seed(seed);
+    let mut steps: Vec<TargetingStep> = Vec::new();
+    let mut evaluate = |ratio: f64, steps: &mut Vec<TargetingStep>| -> Result<f64> {
+        let x: Features = &noise.features + &erp.features * ratio;
+        let accuracy = cross_validate(classifier, &x, &labels, setup.calibration.folds, cv_seed)?;
+        let step = TargetingStep { ratio, accuracy };
+        progress(&step);
+        steps.push(step);
+        Ok(accuracy.mean())
+    };
+    let close = |acc: f64| (acc - requested).abs() <= search.tolerance;
+
+    // Bracket: lo scores below the target (ratio 0 is chance), hi above.
+    let (mut lo, mut lo_acc) = (0.0, 0.5);
+    let mut hi = 0.25;
+    let mut hi_acc = evaluate(hi, &mut steps)?;
+    while hi_acc < requested && !close(hi_acc) {
+        if hi >= search.max_ratio || steps.len() >= search.max_evaluations {
+            return Err(BciError::InvalidParameter {
+                name: "accuracy",
+                value: requested.to_string(),
+                expected: format!(
+                    "an accuracy the decoder can reach: it scores {:.2} % at the largest \
+                     ErrP-to-noise ratio tried ({hi})",
+                    100.0 * hi_acc
+                ),
+            });
+        }
+        (lo, lo_acc) = (hi, hi_acc);
+        hi = (hi * 2.0).min(search.max_ratio);
+        hi_acc = evaluate(hi, &mut steps)?;
+    }
+    let mut bisect_next = false;
+    let mut last = hi_acc;
+    while !close(last) && steps.len() < search.max_evaluations {
+        let probit = |a: f64| inverse_normal_cdf(a.clamp(0.5 + 1e-6, 1.0 - 1e-6));
+        let (zl, zh, zt) = (probit(lo_acc), probit(hi_acc), probit(requested));
+        let mut r = if bisect_next || zh <= zl {
+            0.5 * (lo + hi)
+        } else {
+            lo + (hi - lo) * (zt - zl) / (zh - zl)
+        };
+        // Stay well inside the bracket so that it always shrinks.
+        let margin = 0.05 * (hi - lo);
+        r = r.clamp(lo + margin, hi - margin);
+        last = evaluate(r, &mut steps)?;
+        let width = hi - lo;
+        if last < requested {
+            (lo, lo_acc) = (r, last);
+        } else {
+            (hi, hi_acc) = (r, last);
+        }
+        bisect_next = (hi - lo) > 0.6 * width;
+    }
+    let best = *steps
+        .iter()
+        .min_by(|a, b| {
+            (a.accuracy.mean() - requested)
+                .abs()
+                .total_cmp(&(b.accuracy.mean() - requested).abs())
+        })
+        .expect("at least one evaluation");
+    Ok(TargetingResult {
+        requested,
+        ratio: best.ratio,
+        accuracy: best.accuracy,
+        steps,
+    })
+}
+
+/// Inverse of the standard normal CDF (Acklam's rational approximation,
+/// relative error below 1.2e-9).
+pub fn inverse_normal_cdf(p: f64) -> f64 {
+    const A: [f64; 6] = [
+        -3.969_683_028_665_376e1,
+        2.209_460_984_245_205e2,
+        -2.759_285_104_469_687e2,
+        1.383_577_518_672_69e2,
+        -3.066_479_806_614_716e1,
+        2.506_628_277_459_239,
+    ];
+    const B: [f64; 5] = [
+        -5.447_609_879_822_406e1,
+        1.615_858_368_580_409e2,
+        -1.556_989_798_598_866e2,
+        6.680_131_188_771_972e1,
+        -1.328_068_155_288_572e1,
+    ];
+    const C: [f64; 6] = [
+        -7.784_894_002_430_293e-3,
+        -3.223_964_580_411_365e-1,
+        -2.400_758_277_161_838,
+        -2.549_732_539_343_734,
+        4.374_664_141_464_968,
+        2.938_163_982_698_783,
+    ];
+    const D: [f64; 4] = [
+        7.784_695_709_041_462e-3,
+        3.224_671_290_700_398e-1,
+        2.445_134_137_142_996,
+        3.754_408_661_907_416,
+    ];
+    let p_low = 0.024_25;
+    if p < p_low {
+        let q = (-2.0 * p.ln()).sqrt();
+        (((((C[0] * q + C[1]) * q + C[2]) * q + C[3]) * q + C[4]) * q + C[5])
+            / ((((D[0] * q + D[1]) * q + D[2]) * q + D[3]) * q + 1.0)
+    } else if p <= 1.0 - p_low {
+        let q = p - 0.5;
+        let r = q * q;
+        (((((A[0] * r + A[1]) * r + A[2]) * r + A[3]) * r + A[4]) * r + A[5]) * q
+            / (((((B[0] * r + B[1]) * r + B[2]) * r + B[3]) * r + B[4]) * r + 1.0)
+    } else {
+        -inverse_normal_cdf(1.0 - p)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn inverse_normal_cdf_known_values() {
+        assert!(inverse_normal_cdf(0.5).abs() < 1e-9);
+        assert!((inverse_normal_cdf(0.975) - 1.959_963_985).abs() < 1e-6);
+        assert!((inverse_normal_cdf(0.01) + 2.326_347_874).abs() < 1e-6);
+    }
+
+    #[test]
+    fn requested_accuracy_must_be_above_chance_and_below_one() {
+        for bad in [0.5, 1.0, 1.7, -0.2, f64::NAN] {
+            let err = check_requested_accuracy(bad).unwrap_err().to_string();
+            assert!(err.contains("accuracy"), "{err}");
+        }
+        assert!(check_requested_accuracy(0.7438).is_ok());
+    }
+}

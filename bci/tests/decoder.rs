@@ -1,0 +1,264 @@
+//! Contract and statistical tests of the EEG generator and the discrete
+//! decoder: every classifier obeys the same contract, accuracy targeting lands
+//! where asked, the ErrP has the shape of Fig. 1, and shuffled labels give
+//! chance.
+
+use errp_bci::{
+    AssessmentKind, CalibrationParams, CalibrationSetup, Classifier, Components, ErrorModel,
+    Features, GeneratorParams, LdaDecoder, SessionOptions, Shrinkage, TargetingParams, calibrate,
+    cross_validate, rng::stream, simulate_session, target_accuracy,
+};
+use rand::seq::SliceRandom;
+
+fn setup_at(ratio: f64) -> CalibrationSetup {
+    CalibrationSetup {
+        generator: GeneratorParams {
+            errp_to_noise: ratio,
+            ..GeneratorParams::default()
+        },
+        ..CalibrationSetup::default()
+    }
+}
+
+fn small_session(seed: u64) -> (Features, Vec<bool>) {
+    let setup = CalibrationSetup {
+        calibration: CalibrationParams {
+            n_actions: 150,
+            ..CalibrationParams::default()
+        },
+        ..setup_at(1.0)
+    };
+    let s = simulate_session(&setup, seed, SessionOptions::default()).unwrap();
+    (s.features, s.labels)
+}
+
+fn assert_send_sync<T: Send + Sync>() {}
+
+/// The contract every classifier must meet (pyRiemann-style common tests).
+fn classifier_contract<C: Classifier>(classifier: C) {
+    assert_send_sync::<C>();
+    assert_send_sync::<C::Model>();
+    let (x, y) = small_session(21);
+    let a = classifier.fit(&x, &y, 7).unwrap();
+    let b = classifier.fit(&x, &y, 7).unwrap();
+    assert_eq!(a.n_features(), 312);
+    for i in 0..x.nrows() {
+        let row: Vec<f64> = x.row(i).iter().copied().collect();
+        let p = a.p_error(&row);
+        assert!((0.0..=1.0).contains(&p), "p = {p}");
+        assert_eq!(p, b.p_error(&row), "same seed, same model");
+        assert_eq!(a.decision(&row) >= 0.0, p >= 0.5, "decision and p agree");
+    }
+    // One class only, or mismatched shapes: a clear error, not a panic.
+    assert!(classifier.fit(&x, &vec![false; y.len()], 7).is_err());
+    assert!(classifier.fit(&x, &y[1..], 7).is_err());
+}
+
+#[test]
+fn every_classifier_meets_the_contract() {
+    classifier_contract(LdaDecoder::default());
+    classifier_contract(LdaDecoder {
+        pca_variance: 0.99,
+        shrinkage: Shrinkage::Fixed(0.2),
+    });
+}
+
+#[test]
+fn features_are_linear_in_the_errp_to_noise_ratio() {
+    // Targeting relies on: features(r) = features(noise) + r * features(ERP at 1).
+    let setup = CalibrationSetup {
+        calibration: CalibrationParams {
+            n_actions: 30,
+            ..CalibrationParams::default()
+        },
+        ..setup_at(1.0)
+    };
+    let part = |c: Components, ratio: f64| {
+        let s = CalibrationSetup {
+            generator: GeneratorParams {
+                errp_to_noise: ratio,
+                ..setup.generator.clone()
+            },
+            ..setup.clone()
+        };
+        simulate_session(
+            &s,
+            4,
+            SessionOptions {
+                components: c,
+                ..SessionOptions::default()
+            },
+        )
+        .unwrap()
+        .features
+    };
+    let noise = part(
+        Components {
+            erp: false,
+            ..Components::default()
+        },
+        1.0,
+    );
+    let erp = part(
+        Components {
+            background: false,
+            artifacts: false,
+            erp: true,
+        },
+        1.0,
+    );
+    let whole = part(Components::default(), 0.7);
+    let combined = &noise + &erp * 0.7;
+    let worst = (&whole - &combined).abs().max();
+    assert!(worst < 1e-6, "largest difference {worst}");
+}
+
+fn lands_within_1_5_points(requested: f64, seed: u64) {
+    let decoder = LdaDecoder::default();
+    let setup = CalibrationSetup::default();
+    let found = target_accuracy(
+        requested,
+        &decoder,
+        &setup,
+        &TargetingParams::default(),
+        seed,
+        |_| {},
+    )
+    .unwrap();
+    // The session at the ratio found, simulated from scratch.
+    let c = calibrate(
+        &decoder,
+        &setup_at(found.ratio),
+        seed,
+        SessionOptions::default(),
+    )
+    .unwrap();
+    let got = c.accuracy.mean();
+    assert!(
+        (got - requested).abs() <= 0.015,
+        "requested {requested}, got {got} at ratio {}",
+        found.ratio
+    );
+    assert!(
+        (got - found.accuracy.mean()).abs() < 0.005,
+        "search and rerun agree"
+    );
+    assert!(c.accuracy.n_correct + c.accuracy.n_error == 400);
+}
+
+#[test]
+fn targeting_lands_at_65_percent() {
+    lands_within_1_5_points(0.65, 11);
+}
+
+#[test]
+fn targeting_lands_at_the_papers_74_38_percent() {
+    lands_within_1_5_points(0.7438, 1);
+}
+
+#[test]
+fn targeting_lands_at_80_percent() {
+    lands_within_1_5_points(0.80, 12);
+}
+
+#[test]
+fn targeting_lands_at_90_percent() {
+    lands_within_1_5_points(0.90, 13);
+}
+
+#[test]
+fn unreachable_accuracy_is_a_clear_error() {
+    let setup = CalibrationSetup {
+        calibration: CalibrationParams {
+            n_actions: 60,
+            ..CalibrationParams::default()
+        },
+        ..CalibrationSetup::default()
+    };
+    let search = TargetingParams {
+        max_ratio: 0.3,
+        ..TargetingParams::default()
+    };
+    let err = target_accuracy(0.99, &LdaDecoder::default(), &setup, &search, 1, |_| {})
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("accuracy") && err.contains("largest"), "{err}");
+}
+
+#[test]
+fn grand_average_difference_at_fcz_has_the_three_components_of_fig1() {
+    let s = simulate_session(
+        &setup_at(1.0),
+        3,
+        SessionOptions {
+            grand_average: true,
+            ..SessionOptions::default()
+        },
+    )
+    .unwrap();
+    let ga = s.grand_average.unwrap();
+    let diff = ga.difference();
+    let row = |n: &str| ga.channels.iter().position(|c| c == n).unwrap();
+    let fcz = row("FCz");
+    let extreme = |lo: f64, hi: f64, sign: f64| {
+        (0..ga.times_ms.len())
+            .filter(|&t| ga.times_ms[t] >= lo && ga.times_ms[t] <= hi)
+            .max_by(|&a, &b| (sign * diff[(fcz, a)]).total_cmp(&(sign * diff[(fcz, b)])))
+            .map(|t| (ga.times_ms[t], diff[(fcz, t)]))
+            .unwrap()
+    };
+    let (t_n1, v_n1) = extreme(150.0, 300.0, -1.0);
+    let (t_p, v_p) = extreme(280.0, 420.0, 1.0);
+    let (t_n2, v_n2) = extreme(400.0, 560.0, -1.0);
+    // Documented latencies (assets/errp_waveforms.toml): 250, 350, 455 ms.
+    assert!(
+        (t_n1 - 250.0).abs() <= 30.0 && v_n1 < -1.0,
+        "N ~250: {t_n1} ms {v_n1} uV"
+    );
+    assert!(
+        (t_p - 350.0).abs() <= 30.0 && v_p > 2.0,
+        "P ~350: {t_p} ms {v_p} uV"
+    );
+    assert!(
+        (t_n2 - 455.0).abs() <= 35.0 && v_n2 < -1.0,
+        "N ~455: {t_n2} ms {v_n2} uV"
+    );
+    // Fronto-central: the positivity is larger at FCz than at Pz and Oz.
+    let peak_t = ga.times_ms.iter().position(|&t| t == t_p).unwrap();
+    assert!(diff[(fcz, peak_t)] > 2.0 * diff[(row("Oz"), peak_t)].abs());
+    assert!(diff[(fcz, peak_t)] > diff[(row("Pz"), peak_t)]);
+    // Before the action there is nothing to see.
+    let pre = (0..ga.times_ms.len())
+        .filter(|&t| ga.times_ms[t] < 0.0)
+        .map(|t| diff[(fcz, t)].abs())
+        .fold(0.0, f64::max);
+    assert!(pre < 0.5 * v_p, "pre-onset {pre} uV");
+}
+
+#[test]
+fn decoder_trained_on_shuffled_labels_scores_chance() {
+    let s = simulate_session(&setup_at(1.0), 5, SessionOptions::default()).unwrap();
+    let decoder = LdaDecoder::default();
+    let real = cross_validate(&decoder, &s.features, &s.labels, 10, 1).unwrap();
+    let mut shuffled = s.labels.clone();
+    shuffled.shuffle(&mut stream(5, "test/shuffle"));
+    let chance = cross_validate(&decoder, &s.features, &shuffled, 10, 1).unwrap();
+    assert!(real.mean() > 0.7, "real labels: {}", real.mean());
+    assert!(
+        (chance.mean() - 0.5).abs() < 0.06,
+        "shuffled labels: {}",
+        chance.mean()
+    );
+}
+
+#[test]
+fn sessions_are_deterministic() {
+    let (a, la) = small_session(9);
+    let (b, lb) = small_session(9);
+    assert_eq!(a, b);
+    assert_eq!(la, lb);
+    let (c, _) = small_session(10);
+    assert_ne!(a, c);
+    assert!(la.iter().any(|&l| l) && la.iter().any(|&l| !l));
+    let _ = AssessmentKind::Error;
+}

@@ -1,0 +1,92 @@
+//! A calibration run: accuracy targeting, then the calibration session at the
+//! ratio found, scored and trained like the paper's.
+
+use errp_bci::{
+    Calibrated, CalibrationSetup, GeneratorParams, LdaDecoder, LdaModel, RawSink, SessionOptions,
+    TargetingParams, TargetingResult, TargetingStep, calibrate, target_accuracy,
+};
+
+use crate::error::Result;
+
+/// What to calibrate.
+#[derive(Debug, Clone)]
+pub struct CalibrationRequest {
+    /// Requested mean accuracy, in (0.5, 1).
+    pub accuracy: f64,
+    /// Seed of the synthetic user and session.
+    pub seed: u64,
+    /// EEG model, protocol, preprocessing, montage.
+    pub setup: CalibrationSetup,
+    /// Search settings.
+    pub search: TargetingParams,
+    /// Compute grand averages of every EEG channel (for recording).
+    pub grand_average: bool,
+}
+
+impl CalibrationRequest {
+    /// A request with the paper's protocol and the default EEG model.
+    pub fn new(accuracy: f64, seed: u64) -> Self {
+        Self {
+            accuracy,
+            seed,
+            setup: CalibrationSetup::default(),
+            search: TargetingParams::default(),
+            grand_average: false,
+        }
+    }
+}
+
+/// The outcome of [`run_calibration`].
+#[derive(Debug, Clone)]
+pub struct CalibrationReport {
+    /// The search for the ErrP-to-noise ratio.
+    pub targeting: TargetingResult,
+    /// The EEG model at the ratio found.
+    pub generator: GeneratorParams,
+    /// The calibration session at that ratio, its cross-validated accuracy
+    /// and the decoder trained on all of it.
+    pub calibrated: Calibrated<LdaModel>,
+}
+
+/// Targets the requested accuracy, then simulates the calibration session at
+/// the ratio found from scratch (raw EEG through the whole pipeline), scores
+/// it by k-fold cross-validation and trains the decoder on every trial.
+/// `progress` sees each targeting step; `raw_sink` sees the raw session.
+pub fn run_calibration(
+    request: &CalibrationRequest,
+    progress: impl FnMut(&TargetingStep),
+    raw_sink: Option<RawSink<'_>>,
+) -> Result<CalibrationReport> {
+    let decoder = LdaDecoder::default();
+    let targeting = target_accuracy(
+        request.accuracy,
+        &decoder,
+        &request.setup,
+        &request.search,
+        request.seed,
+        progress,
+    )?;
+    let generator = GeneratorParams {
+        errp_to_noise: targeting.ratio,
+        ..request.setup.generator.clone()
+    };
+    let setup = CalibrationSetup {
+        generator: generator.clone(),
+        ..request.setup.clone()
+    };
+    let calibrated = calibrate(
+        &decoder,
+        &setup,
+        request.seed,
+        SessionOptions {
+            grand_average: request.grand_average,
+            raw_sink,
+            ..SessionOptions::default()
+        },
+    )?;
+    Ok(CalibrationReport {
+        targeting,
+        generator,
+        calibrated,
+    })
+}

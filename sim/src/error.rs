@@ -1,0 +1,32 @@
+//! The crate's error type.
+
+use std::path::PathBuf;
+
+use thiserror::Error;
+
+/// Everything that can go wrong in `errp_sim`.
+#[derive(Debug, Error)]
+pub enum SimError {
+    /// The EEG side failed (bad parameters, untrainable data, ...).
+    #[error(transparent)]
+    Bci(#[from] errp_bci::BciError),
+    /// An output file cannot be created or written.
+    #[error("cannot write {path}: {source}")]
+    Output {
+        /// The file the user asked for.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// The Rerun SDK refused to record.
+    #[error("recording to {path} failed: {message}")]
+    Record {
+        /// The `.rrd` file.
+        path: PathBuf,
+        /// The SDK's message.
+        message: String,
+    },
+}
+
+/// Shorthand for results in this crate.
+pub type Result<T, E = SimError> = std::result::Result<T, E>;

@@ -1,0 +1,67 @@
+//! Rerun recordings: an `.rrd` file with a default layout, written whole or
+//! not at all.
+
+use std::path::Path;
+
+use rerun::{RecordingStream, RecordingStreamBuilder, blueprint::Blueprint};
+
+use crate::error::{Result, SimError};
+use crate::output::PendingFile;
+
+/// An `.rrd` file being recorded. Log to [`RrdFile::stream`]; call
+/// [`RrdFile::finish`] to flush it and move it into place.
+pub struct RrdFile {
+    stream: RecordingStream,
+    pending: PendingFile,
+}
+
+impl RrdFile {
+    /// Starts a recording of application `app_id` at `path` with `blueprint`
+    /// as its default layout. An unwritable path fails here, before any work.
+    pub fn create(
+        app_id: &'static str,
+        path: impl AsRef<Path>,
+        blueprint: Blueprint,
+    ) -> Result<Self> {
+        let (pending, file) = PendingFile::create(path)?;
+        drop(file);
+        let stream = RecordingStreamBuilder::new(app_id)
+            .with_default_blueprint(blueprint)
+            .save(pending.temp_path())
+            .map_err(|e| SimError::Record {
+                path: pending.path().to_path_buf(),
+                message: e.to_string(),
+            })?;
+        Ok(Self { stream, pending })
+    }
+
+    /// The stream to log to.
+    pub fn stream(&self) -> &RecordingStream {
+        &self.stream
+    }
+
+    /// The final path of the recording.
+    pub fn path(&self) -> &Path {
+        self.pending.path()
+    }
+
+    /// Flushes everything to disk and renames the file into place.
+    pub fn finish(self) -> Result<std::path::PathBuf> {
+        let path = self.pending.path().to_path_buf();
+        self.stream.flush_blocking().map_err(|e| SimError::Record {
+            path: path.clone(),
+            message: e.to_string(),
+        })?;
+        self.stream.disconnect();
+        drop(self.stream);
+        self.pending.commit()
+    }
+}
+
+/// Maps a Rerun SDK error to a [`SimError`] about `path`.
+pub(crate) fn record_error(path: &Path) -> impl Fn(rerun::RecordingStreamError) -> SimError + '_ {
+    move |e| SimError::Record {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    }
+}

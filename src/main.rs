@@ -1,0 +1,240 @@
+//! `errp`: the command-line program of errp-testbed.
+//!
+//! Thin glue: parse arguments, call the libraries, print, write files.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{Context, Result, bail};
+use clap::{Parser, Subcommand, ValueEnum};
+use errp_bci::{EdfWriter, GoalSet, subject, subjects};
+use errp_sim::{
+    CalibrationRequest, PendingFile, calibration_recording, record_calibration, run_calibration,
+};
+
+/// Simulated shared control of a robot from EEG error potentials.
+#[derive(Parser)]
+#[command(name = "errp", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Calibrate the ErrP decoder of a synthetic user at a requested accuracy.
+    ///
+    /// Searches the ErrP-to-noise ratio of the synthetic EEG so that the
+    /// paper's decoder (z-score, PCA 95 %, shrinkage LDA), cross-validated on a
+    /// 400-action calibration session with 20 % errors, reaches the requested
+    /// mean accuracy; then runs that session and reports per-class rates.
+    Calibrate(CalibrateArgs),
+    /// List the subjects of Table 1 of the paper and their accuracies.
+    Subjects,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Goals {
+    /// The five goals shared by all subjects.
+    Fixed,
+    /// The goals each subject chose.
+    Free,
+}
+
+#[derive(clap::Args)]
+struct CalibrateArgs {
+    /// Requested mean accuracy (mean of the correct- and error-class rates),
+    /// strictly between 0.5 and 1. Default: 0.7438, the paper's mean over
+    /// subjects with the fixed goals.
+    #[arg(long, value_parser = parse_accuracy, conflicts_with = "subject")]
+    accuracy: Option<f64>,
+    /// Take the accuracy of a subject of Table 1 (S1..S4) instead.
+    #[arg(long)]
+    subject: Option<String>,
+    /// Which of the subject's accuracies: fixed or free goals.
+    #[arg(long, value_enum, default_value = "fixed", requires = "subject")]
+    goals: Goals,
+    /// Seed of the synthetic user and session.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Record grand averages, a topography and the summary to this `.rrd`.
+    #[arg(long, value_name = "FILE.rrd")]
+    save: Option<PathBuf>,
+    /// Write the raw synthetic EEG + EOG of the session, with `error` /
+    /// `correct` annotations, to this EDF+ file.
+    #[arg(long, value_name = "FILE.edf")]
+    export: Option<PathBuf>,
+    /// Print only the results, not the search.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+fn parse_accuracy(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("{s:?} is not a number; give a fraction such as 0.7438"))?;
+    errp_bci::check_requested_accuracy(v).map_err(|_| {
+        format!(
+            "{s} is out of range: give a mean accuracy strictly between 0.5 (chance) and 1 \
+             as a fraction, e.g. 0.7438 for 74.38 %"
+        )
+    })?;
+    Ok(v)
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Calibrate(args) => calibrate(&args),
+        Command::Subjects => {
+            print_subjects();
+            Ok(())
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn print_subjects() {
+    println!("subject  fixed goals  free goals   (mean accuracy, Table 1)");
+    for s in subjects() {
+        println!(
+            "{:<8} {:>9.2} %  {:>8.2} %",
+            s.name, s.fixed_goals_pct, s.free_goals_pct
+        );
+    }
+}
+
+fn check_extension(path: &Path, ext: &str, flag: &str) -> Result<()> {
+    if path.extension().and_then(|e| e.to_str()) != Some(ext) {
+        bail!(
+            "{flag} {}: the file name must end in .{ext}",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
+fn calibrate(args: &CalibrateArgs) -> Result<()> {
+    let (accuracy, who) = match &args.subject {
+        Some(name) => {
+            let s = subject(name).context("--subject")?;
+            let goals = match args.goals {
+                Goals::Fixed => GoalSet::Fixed,
+                Goals::Free => GoalSet::Free,
+            };
+            let a = s.accuracy(goals);
+            (
+                a,
+                format!("subject {} ({:?} goals)", s.name, goals).to_lowercase(),
+            )
+        }
+        None => (args.accuracy.unwrap_or(0.7438), "requested".to_string()),
+    };
+    if let Some(p) = &args.save {
+        check_extension(p, "rrd", "--save")?;
+    }
+    if let Some(p) = &args.export {
+        check_extension(p, "edf", "--export")?;
+    }
+    // Reserve the outputs first: an unwritable path fails before the work.
+    let mut edf = match &args.export {
+        Some(p) => {
+            let (pending, file) = PendingFile::create(p)?;
+            let montage = errp_bci::Montage::standard();
+            let writer = EdfWriter::new(std::io::BufWriter::new(file), &montage, 256.0)?;
+            Some((pending, writer))
+        }
+        None => None,
+    };
+    let rrd = match &args.save {
+        Some(p) => Some(calibration_recording(p)?),
+        None => None,
+    };
+
+    let mut request = CalibrationRequest::new(accuracy, args.seed);
+    request.grand_average = args.save.is_some();
+    if !args.quiet {
+        eprintln!(
+            "Targeting a mean accuracy of {:.2} % ({who}), seed {}:",
+            100.0 * accuracy,
+            args.seed
+        );
+    }
+    let quiet = args.quiet;
+    let progress = |s: &errp_bci::TargetingStep| {
+        if !quiet {
+            eprintln!(
+                "  ErrP-to-noise {:.4}: correct {:.2} %, error {:.2} %, mean {:.2} %",
+                s.ratio,
+                100.0 * s.accuracy.correct,
+                100.0 * s.accuracy.error,
+                100.0 * s.accuracy.mean()
+            );
+        }
+    };
+    let mut sink = |block: &errp_bci::EegBlock, events: &[errp_bci::Assessment]| match edf.as_mut()
+    {
+        Some((_, w)) => w.write(block, events),
+        None => Ok(()),
+    };
+    let report = run_calibration(
+        &request,
+        progress,
+        if args.export.is_some() {
+            Some(&mut sink)
+        } else {
+            None
+        },
+    )
+    .context("calibration failed")?;
+
+    let a = &report.calibrated.accuracy;
+    let m = &report.calibrated.model;
+    println!(
+        "Calibration session: {} actions ({} error, {} correct), {}-fold cross-validation",
+        a.n_correct + a.n_error,
+        a.n_error,
+        a.n_correct,
+        request.setup.calibration.folds
+    );
+    println!("  correct class  {:6.2} %", 100.0 * a.correct);
+    println!("  error class    {:6.2} %", 100.0 * a.error);
+    println!(
+        "  mean           {:6.2} %   ({who} {:.2} %, off by {:+.2} points)",
+        100.0 * a.mean(),
+        100.0 * accuracy,
+        100.0 * (a.mean() - accuracy)
+    );
+    println!(
+        "  ErrP-to-noise ratio {:.4}; decoder: {} PCA components, Ledoit-Wolf shrinkage {:.3}",
+        report.generator.errp_to_noise,
+        m.n_components(),
+        m.shrinkage()
+    );
+
+    if let Some((pending, writer)) = edf {
+        writer.finish()?;
+        let path = pending.commit()?;
+        println!(
+            "Wrote {} (EDF+, raw EEG + EOG, 256 Hz, annotated)",
+            path.display()
+        );
+    }
+    if let Some(file) = rrd {
+        let montage = errp_bci::Montage::standard();
+        let path = record_calibration(file, &report, &montage)?;
+        println!(
+            "Wrote {} (open with: rerun {})",
+            path.display(),
+            path.display()
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,115 @@
+//! End-to-end tests of the `errp` program, run as a user would.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn errp(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_errp"))
+        .args(args)
+        .output()
+        .expect("errp runs")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("errp-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn files_in(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn calibrate_records_and_exports_at_the_requested_accuracy() {
+    let dir = temp_dir("ok");
+    let rrd = dir.join("calib.rrd");
+    let edf = dir.join("calib.edf");
+    let o = errp(&[
+        "calibrate",
+        "--accuracy",
+        "0.7438",
+        "--seed",
+        "1",
+        "--save",
+        rrd.to_str().unwrap(),
+        "--export",
+        edf.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let mean: f64 = out
+        .lines()
+        .find(|l| l.trim_start().starts_with("mean"))
+        .and_then(|l| l.split_whitespace().nth(1))
+        .and_then(|v| v.parse().ok())
+        .expect("a mean line");
+    assert!((mean - 74.38).abs() <= 1.5, "{out}");
+    assert!(out.contains("correct class") && out.contains("error class"), "{out}");
+    assert!(stderr(&o).contains("ErrP-to-noise"), "progress is shown");
+    assert_eq!(files_in(&dir), ["calib.edf", "calib.rrd"], "no temporary files left");
+    let bytes = std::fs::read(&edf).unwrap();
+    assert_eq!(&bytes[192..197], b"EDF+C");
+    assert!(std::fs::metadata(&rrd).unwrap().len() > 10_000);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn accuracy_out_of_range_is_exit_2_naming_the_flag() {
+    for bad in ["1.7", "0.5", "-3", "NaN", "abc"] {
+        let o = errp(&["calibrate", "--accuracy", bad]);
+        assert_eq!(o.status.code(), Some(2), "{bad}");
+        let e = stderr(&o);
+        assert!(e.contains("--accuracy") && e.contains("0.5"), "{bad}: {e}");
+    }
+}
+
+#[test]
+fn unknown_subject_is_exit_2_listing_the_known_ones() {
+    let o = errp(&["calibrate", "--subject", "S9"]);
+    assert_eq!(o.status.code(), Some(2));
+    let e = stderr(&o);
+    assert!(e.contains("S9") && e.contains("S1, S2, S3, S4"), "{e}");
+}
+
+#[test]
+fn unwritable_output_fails_before_work_and_leaves_nothing() {
+    let dir = temp_dir("bad");
+    let missing = dir.join("no-such-dir").join("x.rrd");
+    let edf = dir.join("x.edf");
+    let o = errp(&[
+        "calibrate",
+        "--export",
+        edf.to_str().unwrap(),
+        "--save",
+        missing.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let e = stderr(&o);
+    assert!(e.contains("no-such-dir"), "{e}");
+    assert!(!e.contains("ErrP-to-noise"), "no work was done: {e}");
+    assert!(files_in(&dir).is_empty(), "{:?}", files_in(&dir));
+
+    let o = errp(&["calibrate", "--save", dir.join("x.txt").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains(".rrd"), "{}", stderr(&o));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn subjects_lists_table1() {
+    let o = errp(&["subjects"]);
+    assert!(o.status.success());
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("S2") && out.contains("69.49") && out.contains("88.18"), "{out}");
+}
