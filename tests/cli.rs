@@ -55,9 +55,16 @@ fn calibrate_records_and_exports_at_the_requested_accuracy() {
         .and_then(|v| v.parse().ok())
         .expect("a mean line");
     assert!((mean - 74.38).abs() <= 1.5, "{out}");
-    assert!(out.contains("correct class") && out.contains("error class"), "{out}");
+    assert!(
+        out.contains("correct class") && out.contains("error class"),
+        "{out}"
+    );
     assert!(stderr(&o).contains("ErrP-to-noise"), "progress is shown");
-    assert_eq!(files_in(&dir), ["calib.edf", "calib.rrd"], "no temporary files left");
+    assert_eq!(
+        files_in(&dir),
+        ["calib.edf", "calib.rrd"],
+        "no temporary files left"
+    );
     let bytes = std::fs::read(&edf).unwrap();
     assert_eq!(&bytes[192..197], b"EDF+C");
     assert!(std::fs::metadata(&rrd).unwrap().len() > 10_000);
@@ -111,5 +118,8 @@ fn subjects_lists_table1() {
     let o = errp(&["subjects"]);
     assert!(o.status.success());
     let out = String::from_utf8_lossy(&o.stdout);
-    assert!(out.contains("S2") && out.contains("69.49") && out.contains("88.18"), "{out}");
+    assert!(
+        out.contains("S2") && out.contains("69.49") && out.contains("88.18"),
+        "{out}"
+    );
 }

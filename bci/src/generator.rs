@@ -220,6 +220,8 @@ struct ActiveErp {
     gain: f64,
 }
 
+/// sqrt(12) / 65536: a centred 16-bit uniform scaled to unit variance.
+const UNIFORM_TO_UNIT_SD: f64 = 3.464_101_615_137_754_6 / 65536.0;
 /// How long an ERP lasts after its onset (s).
 const ERP_LENGTH_SECS: f64 = 1.2;
 /// Duration of a blink (s).
@@ -247,7 +249,6 @@ pub struct EegGenerator {
     /// Lower-triangular mixing of the background sources, `(n_eeg, n_eeg)`,
     /// stored column-major (`mixing[k * n_eeg + ch]`), in uV.
     mixing: Vec<f64>,
-    mixed: Vec<f64>,
     pink: Vec<PinkNoise>,
     alpha: Resonator,
     alpha_weight: Vec<f64>,
@@ -263,8 +264,16 @@ pub struct EegGenerator {
     next_saccade: u64,
     erps: Vec<ActiveErp>,
     sample: u64,
-    white: Vec<f64>,
+    uniforms: Vec<u16>,
+    scratch: Vec<f64>,
+    alpha_buf: Vec<f64>,
+    blink_buf: Vec<f64>,
+    gaze_buf: Vec<f64>,
+    line_c_buf: Vec<f64>,
+    line_s_buf: Vec<f64>,
+    erp_buf: Vec<f64>,
     rng_background: ChaCha8Rng,
+    rng_alpha: ChaCha8Rng,
     rng_artifacts: ChaCha8Rng,
     rng_erp: ChaCha8Rng,
 }
@@ -286,6 +295,7 @@ impl EegGenerator {
         let mut rng_background = stream(seed, "eeg/background");
         let mut rng_artifacts = stream(seed, "eeg/artifacts");
         let rng_erp = stream(seed, "eeg/erp");
+        let mut rng_alpha = stream(seed, "eeg/alpha");
         let n_eeg = montage.n_eeg();
         let n_ch = montage.len();
         let fs = params.sfreq_hz;
@@ -314,7 +324,7 @@ impl EegGenerator {
             params.alpha_hz,
             params.alpha_bandwidth_hz,
             fs,
-            &mut rng_background,
+            &mut rng_alpha,
         );
         let oz = pos(montage.index("Oz")?);
         let alpha_weight = (0..n_ch)
@@ -357,7 +367,6 @@ impl EegGenerator {
             topography,
             erp_scale,
             mixing,
-            mixed: vec![0.0; n_eeg],
             pink,
             alpha,
             alpha_weight,
@@ -373,8 +382,16 @@ impl EegGenerator {
             next_saccade: 0,
             erps: Vec::new(),
             sample: 0,
-            white: vec![0.0; n_ch],
+            uniforms: Vec::new(),
+            scratch: Vec::new(),
+            alpha_buf: Vec::new(),
+            blink_buf: Vec::new(),
+            gaze_buf: Vec::new(),
+            line_c_buf: Vec::new(),
+            line_s_buf: Vec::new(),
+            erp_buf: Vec::new(),
             rng_background,
+            rng_alpha,
             rng_artifacts,
             rng_erp,
             params,
@@ -455,8 +472,13 @@ impl EegGenerator {
         block
     }
 
-    /// Fills `block` (any channel count equal to the montage's) with the next
+    /// Fills `block` (its channel count must be the montage's) with the next
     /// `block.n_samples` samples.
+    ///
+    /// Works in stages over the whole block (draws, 1/f filters, spatial
+    /// mixing, per-sample sources, then one pass per channel), so that the
+    /// inner loops vectorise. Every random stream is consumed sample by sample
+    /// in a fixed order, so block boundaries never change the samples.
     pub fn generate_into(&mut self, block: &mut EegBlock) {
         assert_eq!(block.n_channels, self.montage.len(), "channel count");
         let n = block.n_samples;
@@ -467,23 +489,84 @@ impl EegGenerator {
         let bg = if c.background { 1.0 } else { 0.0 };
         let art = if c.artifacts { 1.0 } else { 0.0 };
         let erp_on = if c.erp { 1.0 } else { 0.0 };
-        let eog_bg = 0.5 * self.params.background_uv;
-        let sensor = self.params.sensor_noise_uv;
+
+        // 1. White noise: per sample, n_ch drivers of the 1/f sources and
+        //    n_ch sensor-noise values, as 16-bit uniforms scaled to unit
+        //    variance. Only their second-order statistics reach the decoder:
+        //    after the 1/f shaping and the 10 Hz low-pass every sample is a
+        //    sum of many of them, Gaussian by the central limit theorem.
+        self.uniforms.resize(n * 2 * n_ch, 0);
+        self.rng_background.fill(&mut self.uniforms[..]);
+        let unit = |u: u16| (f64::from(u) + 0.5 - 32768.0) * UNIFORM_TO_UNIT_SD;
+
+        // 2. The 1/f sources and the sensor noise, channel-major scratch:
+        //    rows 0..n_ch sources, rows n_ch..2 n_ch sensor noise.
+        self.scratch.resize(2 * n_ch * n, 0.0);
+        let (sources, sensor_noise) = self.scratch.split_at_mut(n_ch * n);
+        let stride = 2 * n_ch;
+        for ch in 0..n_ch {
+            let uniforms = &self.uniforms;
+            self.pink[ch].run(
+                |t| unit(uniforms[t * stride + ch]),
+                &mut sources[ch * n..(ch + 1) * n],
+            );
+            for (t, v) in sensor_noise[ch * n..(ch + 1) * n].iter_mut().enumerate() {
+                *v = unit(uniforms[t * stride + n_ch + ch]);
+            }
+        }
+
+        // 3. Spatial mixing of the EEG sources (lower-triangular), four
+        //    sources per pass over the output row; EOG channels keep their own
+        //    source.
+        block.data.fill(0.0);
+        for ch in 0..n_eeg {
+            let out = &mut block.data[ch * n..(ch + 1) * n];
+            let l = |k: usize| bg * self.mixing[k * n_eeg + ch];
+            let src = |k: usize| &sources[k * n..(k + 1) * n];
+            let mut k = 0;
+            while k + 4 <= ch + 1 {
+                let (l0, l1, l2, l3) = (l(k), l(k + 1), l(k + 2), l(k + 3));
+                let (s0, s1, s2, s3) = (src(k), src(k + 1), src(k + 2), src(k + 3));
+                for t in 0..n {
+                    out[t] += l0 * s0[t] + l1 * s1[t] + l2 * s2[t] + l3 * s3[t];
+                }
+                k += 4;
+            }
+            for k in k..=ch {
+                let (lk, sk) = (l(k), src(k));
+                for (o, s) in out.iter_mut().zip(sk) {
+                    *o += lk * s;
+                }
+            }
+        }
+        let eog_bg = bg * 0.5 * self.params.background_uv;
+        for ch in n_eeg..n_ch {
+            let src = &self.scratch[ch * n..(ch + 1) * n];
+            for (o, s) in block.data[ch * n..(ch + 1) * n].iter_mut().zip(src) {
+                *o = eog_bg * s;
+            }
+        }
+
+        // 4. Sources shared by all channels, one value per sample.
+        for buf in [
+            &mut self.alpha_buf,
+            &mut self.blink_buf,
+            &mut self.gaze_buf,
+            &mut self.line_c_buf,
+            &mut self.line_s_buf,
+            &mut self.erp_buf,
+        ] {
+            buf.clear();
+        }
         let blink_len = (BLINK_SECS * fs) as u64;
         let saccade_len = ((SACCADE_SECS * fs) as u64).max(1);
         let erp_len = ERP_LENGTH_SECS * fs;
         let line_step = self.params.line_hz / fs;
-
-        for t in 0..n {
+        for _ in 0..n {
             let s = self.sample;
-            // Background sources.
-            for ch in 0..n_ch {
-                let w: f64 = self.rng_background.sample(StandardNormal);
-                self.white[ch] = self.pink[ch].step(w);
-            }
-            let alpha = self.alpha.step(self.rng_background.sample(StandardNormal));
-
-            // Eye potentials.
+            let alpha = self
+                .alpha
+                .step(self.rng_alpha.sample::<f64, _>(StandardNormal));
             while s >= self.next_blink {
                 let amp = self.params.blink_uv
                     * (1.0 + 0.2 * self.rng_artifacts.sample::<f64, _>(StandardNormal)).max(0.2);
@@ -506,12 +589,9 @@ impl EegGenerator {
                     amp * (PI * x).sin().powi(2)
                 })
                 .sum();
-            let gaze = self.gaze_at(s, saccade_len);
             let phase = 2.0 * PI * (line_step * s as f64).fract();
             let (line_s, line_c) = phase.sin_cos();
-
-            // ERPs at the centre electrode.
-            let mut erp_centre = 0.0;
+            let mut erp = 0.0;
             for e in &self.erps {
                 let dt = s as f64 - e.onset_sample;
                 if dt < 0.0 {
@@ -519,35 +599,44 @@ impl EegGenerator {
                 }
                 if dt < erp_len {
                     let t_ms = dt / fs * 1000.0 - e.jitter_ms;
-                    erp_centre += e.gain * waveform(self.templates.components(e.kind), t_ms);
+                    erp += e.gain * waveform(self.templates.components(e.kind), t_ms);
                 }
             }
-            erp_centre *= self.erp_scale * erp_on;
-
-            // Spatial mixing, column by column (vectorises; no long add chain).
-            self.mixed.fill(0.0);
-            for k in 0..n_eeg {
-                let zk = self.white[k];
-                let col = &self.mixing[k * n_eeg..(k + 1) * n_eeg];
-                for (m, &l) in self.mixed[k..].iter_mut().zip(&col[k..]) {
-                    *m += l * zk;
-                }
-            }
-            for ch in 0..n_ch {
-                let mut v = if ch < n_eeg {
-                    bg * (self.mixed[ch] + self.alpha_weight[ch] * alpha)
-                } else {
-                    bg * eog_bg * self.white[ch]
-                };
-                v += bg * sensor * self.rng_background.sample::<f64, _>(StandardNormal);
-                v += art
-                    * (self.line_cos[ch] * line_c - self.line_sin[ch] * line_s
-                        + self.blink_coeff[ch] * blink
-                        + self.gaze_coeff[ch] * gaze);
-                v += self.topography[ch] * erp_centre;
-                block.data[ch * n + t] = v;
-            }
+            self.alpha_buf.push(bg * alpha);
+            self.blink_buf.push(art * blink);
+            self.gaze_buf.push(art * self.gaze_at(s, saccade_len));
+            self.line_c_buf.push(art * line_c);
+            self.line_s_buf.push(art * line_s);
+            self.erp_buf.push(erp_on * self.erp_scale * erp);
             self.sample += 1;
+        }
+
+        // 5. Per channel: add everything with that channel's weights.
+        let sensor = bg * self.params.sensor_noise_uv;
+        let alpha = &self.alpha_buf[..n];
+        let blink = &self.blink_buf[..n];
+        let gaze = &self.gaze_buf[..n];
+        let line_c = &self.line_c_buf[..n];
+        let line_s = &self.line_s_buf[..n];
+        let erp = &self.erp_buf[..n];
+        for ch in 0..n_ch {
+            let row = &mut block.data[ch * n..(ch + 1) * n];
+            let noise = &self.scratch[(n_ch + ch) * n..(n_ch + ch + 1) * n];
+            let (aw, lc, ls) = (self.alpha_weight[ch], self.line_cos[ch], -self.line_sin[ch]);
+            let (bw, gw, tw) = (
+                self.blink_coeff[ch],
+                self.gaze_coeff[ch],
+                self.topography[ch],
+            );
+            for t in 0..n {
+                row[t] += aw * alpha[t]
+                    + sensor * noise[t]
+                    + lc * line_c[t]
+                    + ls * line_s[t]
+                    + bw * blink[t]
+                    + gw * gaze[t]
+                    + tw * erp[t];
+            }
         }
         let now = self.sample as f64;
         self.erps.retain(|e| now < e.onset_sample + erp_len);

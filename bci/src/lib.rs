@@ -41,7 +41,7 @@ pub use edf::EdfWriter;
 pub use erp::{AssessmentKind, Component, ErpTemplates};
 pub use error::{BciError, Result};
 pub use features::EpochWindow;
-pub use filter::{Biquad, FilterChain};
+pub use filter::{Biquad, FilterBank, FilterChain};
 pub use generator::{Assessment, Components, EegBlock, EegGenerator, GeneratorParams};
 pub use lda::{LdaDecoder, LdaModel, Shrinkage, ledoit_wolf_shrinkage, pca_basis};
 pub use montage::{Channel, ChannelKind, DECODING_CHANNELS, Montage};

@@ -62,6 +62,26 @@ impl PinkNoise {
     }
 }
 
+impl PinkNoise {
+    /// Advances `out.len()` samples, driven by `drive(t)`, writing the output
+    /// to `out` (state kept in registers for the whole run).
+    #[inline]
+    pub fn run(&mut self, mut drive: impl FnMut(usize) -> f64, out: &mut [f64]) {
+        let (p, g) = (self.poles, self.gains);
+        let mut st = self.state;
+        for (t, o) in out.iter_mut().enumerate() {
+            let w = drive(t);
+            let mut sum = 0.0;
+            for k in 0..6 {
+                st[k] = p[k] * st[k] + g[k] * w;
+                sum += st[k];
+            }
+            *o = sum;
+        }
+        self.state = st;
+    }
+}
+
 /// Unit-variance narrow-band noise: a second-order autoregressive resonator
 /// (used for the alpha rhythm).
 #[derive(Debug, Clone)]

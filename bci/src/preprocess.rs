@@ -4,7 +4,7 @@ use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{BciError, Result, check};
-use crate::filter::FilterChain;
+use crate::filter::{FilterBank, FilterChain};
 use crate::generator::EegBlock;
 use crate::montage::Montage;
 
@@ -72,7 +72,8 @@ pub struct Preprocessor {
     outputs: Vec<usize>,
     n_in: usize,
     spatial: Vec<f64>,
-    filters: Vec<FilterChain>,
+    chain: FilterChain,
+    filters: FilterBank,
     eog_weights: DMatrix<f64>,
 }
 
@@ -137,14 +138,13 @@ impl Preprocessor {
         for &o in outputs {
             spatial.extend(full.row(o).iter());
         }
-        let filters = outputs
-            .iter()
-            .map(|_| FilterChain::paper(params.line_hz, params.low_hz, params.high_hz, sfreq_hz))
-            .collect();
+        let chain = FilterChain::paper(params.line_hz, params.low_hz, params.high_hz, sfreq_hz);
+        let filters = FilterBank::new(&chain, outputs.len());
         Ok(Self {
             outputs: outputs.to_vec(),
             n_in: n_ch,
             spatial,
+            chain,
             filters,
             eog_weights,
         })
@@ -172,9 +172,7 @@ impl Preprocessor {
 
     /// A fresh copy of the temporal filter (notch + band-pass).
     pub fn filter(&self) -> FilterChain {
-        let mut f = self.filters[0].clone();
-        f.reset();
-        f
+        self.chain.clone()
     }
 
     /// Output channel indices (into the montage).
@@ -190,19 +188,14 @@ impl Preprocessor {
 
     /// Clears filter state (a new recording starts).
     pub fn reset(&mut self) {
-        for f in &mut self.filters {
-            f.reset();
-        }
+        self.filters.reset();
     }
 
     /// Preprocesses the next block of raw samples; shape in
     /// `(n_channels, n)`, out `(n_outputs, n)`. State carries across calls.
     pub fn process(&mut self, raw: &EegBlock) -> EegBlock {
         let mut out = self.apply_spatial(raw);
-        let n = out.n_samples;
-        for (o, filter) in self.filters.iter_mut().enumerate() {
-            filter.process(&mut out.data[o * n..(o + 1) * n]);
-        }
+        self.filters.process(&mut out.data, out.n_samples);
         out
     }
 }
