@@ -46,7 +46,7 @@ struct CalibrateArgs {
     /// Requested mean accuracy (mean of the correct- and error-class rates),
     /// strictly between 0.5 and 1. Default: 0.7438, the paper's mean over
     /// subjects with the fixed goals.
-    #[arg(long, value_parser = parse_accuracy, conflicts_with = "subject")]
+    #[arg(long, value_parser = parse_accuracy, conflicts_with = "subject", allow_negative_numbers = true)]
     accuracy: Option<f64>,
     /// Take the accuracy of a subject of Table 1 (S1..S4) instead.
     #[arg(long)]
@@ -70,10 +70,12 @@ struct CalibrateArgs {
 }
 
 fn parse_accuracy(s: &str) -> Result<f64, String> {
-    let v: f64 = s
-        .trim()
-        .parse()
-        .map_err(|_| format!("{s:?} is not a number; give a fraction such as 0.7438"))?;
+    let v: f64 = s.trim().parse().map_err(|_| {
+        format!(
+            "{s:?} is not a number: give a mean accuracy strictly between 0.5 and 1 as a \
+                 fraction, e.g. 0.7438"
+        )
+    })?;
     errp_bci::check_requested_accuracy(v).map_err(|_| {
         format!(
             "{s} is out of range: give a mean accuracy strictly between 0.5 (chance) and 1 \
