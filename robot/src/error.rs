@@ -5,6 +5,9 @@ use thiserror::Error;
 /// Everything that can go wrong in `errp_robot`.
 #[derive(Debug, Error)]
 pub enum RobotError {
+    /// A parameter is outside its accepted range.
+    #[error("invalid parameter: {0}")]
+    Parameter(String),
     /// A likelihood vector cannot update a belief.
     #[error("invalid likelihood: {0}")]
     Likelihood(String),
