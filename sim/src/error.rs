@@ -10,6 +10,12 @@ pub enum SimError {
     /// The EEG side failed (bad parameters, untrainable data, ...).
     #[error(transparent)]
     Bci(#[from] errp_bci::BciError),
+    /// The shared-control side failed.
+    #[error(transparent)]
+    Robot(#[from] errp_robot::RobotError),
+    /// A scenario is invalid.
+    #[error("{0}")]
+    Scenario(String),
     /// An output file cannot be created or written.
     #[error("cannot write {path}: {source}")]
     Output {

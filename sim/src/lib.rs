@@ -7,11 +7,15 @@
 mod calibration;
 mod calibration_view;
 mod error;
+mod grid_task;
 mod output;
 mod record;
 
 pub use calibration::{CalibrationReport, CalibrationRequest, run_calibration};
 pub use calibration_view::{LATENCY_TIMELINE, calibration_recording, record_calibration};
 pub use error::{Result, SimError};
+pub use grid_task::{
+    AssessmentDecoder, EegDecoder, GridEpisodeResult, GridStep, GridTaskParams, run_grid_episode,
+};
 pub use output::PendingFile;
 pub use record::RrdFile;

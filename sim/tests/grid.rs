@@ -1,0 +1,107 @@
+//! The grid task with the EEG decoder in the loop: statistical and
+//! determinism checks with fixed seeds.
+
+use errp_bci::{Accuracy, Montage};
+use errp_robot::{Cell, Grid, QTable};
+use errp_sim::{
+    AssessmentDecoder, CalibrationRequest, EegDecoder, GridTaskParams, run_calibration,
+    run_grid_episode,
+};
+
+const PAIRS: [((usize, usize), (usize, usize)); 5] = [
+    ((0, 0), (4, 4)),
+    ((4, 0), (0, 4)),
+    ((0, 2), (4, 2)),
+    ((2, 0), (2, 4)),
+    ((1, 3), (3, 1)),
+];
+
+fn eeg_decoder(accuracy: f64, seed: u64) -> AssessmentDecoder {
+    let report = run_calibration(&CalibrationRequest::new(accuracy, seed), |_| {}, None).unwrap();
+    AssessmentDecoder::Eeg(Box::new(EegDecoder {
+        generator: report.generator,
+        montage: Montage::standard(),
+        preprocessor: report.calibrated.session.preprocessor,
+        model: report.calibrated.model,
+    }))
+}
+
+fn table(params: &GridTaskParams) -> QTable {
+    QTable::compute(Grid::paper(), &params.control.q).unwrap()
+}
+
+fn episodes(decoder: &AssessmentDecoder, n: usize, seed: u64) -> Vec<errp_sim::GridEpisodeResult> {
+    let params = GridTaskParams::default();
+    let t = table(&params);
+    (0..n)
+        .map(|k| {
+            let (s, g) = PAIRS[k % PAIRS.len()];
+            run_grid_episode(
+                Cell::new(s.0, s.1),
+                Cell::new(g.0, g.1),
+                &t,
+                &params,
+                decoder,
+                seed * 1000 + k as u64,
+                false,
+            )
+            .unwrap()
+        })
+        .collect()
+}
+
+fn pooled(results: &[errp_sim::GridEpisodeResult]) -> Accuracy {
+    let mut correct = (0.0, 0usize);
+    let mut error = (0.0, 0usize);
+    for r in results {
+        if r.online.n_correct > 0 {
+            correct.0 += r.online.correct * r.online.n_correct as f64;
+            correct.1 += r.online.n_correct;
+        }
+        if r.online.n_error > 0 {
+            error.0 += r.online.error * r.online.n_error as f64;
+            error.1 += r.online.n_error;
+        }
+    }
+    Accuracy {
+        correct: correct.0 / correct.1 as f64,
+        error: error.0 / error.1 as f64,
+        n_correct: correct.1,
+        n_error: error.1,
+    }
+}
+
+#[test]
+fn online_accuracy_matches_the_calibrated_accuracy() {
+    let requested = 0.7438;
+    let decoder = eeg_decoder(requested, 3);
+    let results = episodes(&decoder, 40, 3);
+    let acc = pooled(&results);
+    assert!(
+        (acc.mean() - requested).abs() <= 0.03,
+        "online mean accuracy {} over {} actions",
+        acc.mean(),
+        acc.n_correct + acc.n_error
+    );
+}
+
+#[test]
+fn same_seed_same_episode() {
+    let params = GridTaskParams::default();
+    let t = table(&params);
+    let decoder = AssessmentDecoder::Oracle { accuracy: 0.75 };
+    let run = |seed| {
+        run_grid_episode(
+            Cell::new(0, 0),
+            Cell::new(3, 4),
+            &t,
+            &params,
+            &decoder,
+            seed,
+            true,
+        )
+        .unwrap()
+    };
+    assert_eq!(run(5), run(5));
+    assert_ne!(run(5), run(6));
+}
