@@ -9,7 +9,9 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
 use errp_bci::{EdfWriter, GoalSet, subject, subjects};
 use errp_sim::{
-    CalibrationRequest, PendingFile, calibration_recording, record_calibration, run_calibration,
+    CalibrationRequest, DecoderChoice, GridRunReport, PendingFile, Scenario, calibration_recording,
+    grid_recording, mean_sd, prepare_decoder, record_calibration, record_grid_run, run_calibration,
+    run_grid_scenario,
 };
 
 /// Simulated shared control of a robot from EEG error potentials.
@@ -29,6 +31,9 @@ enum Command {
     /// 400-action calibration session with 20 % errors, reaches the requested
     /// mean accuracy; then runs that session and reports per-class rates.
     Calibrate(CalibrateArgs),
+    /// Run a scenario: episodes of the grid task with the EEG decoder (or an
+    /// oracle) in the loop, printed per episode and summarised like Table 1.
+    Run(RunArgs),
     /// List the subjects of Table 1 of the paper and their accuracies.
     Subjects,
 }
@@ -69,6 +74,33 @@ struct CalibrateArgs {
     quiet: bool,
 }
 
+#[derive(Clone, Copy, ValueEnum)]
+enum DecoderArg {
+    /// Synthetic EEG through the real preprocessing and decoder.
+    Eeg,
+    /// Assessments flipped with probability 1 - accuracy, no EEG.
+    Oracle,
+}
+
+#[derive(clap::Args)]
+struct RunArgs {
+    /// The scenario file (TOML), e.g. scenarios/grid_fixed_goals.toml.
+    scenario: PathBuf,
+    /// Override the scenario's seed.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Override the scenario's decoder.
+    #[arg(long, value_enum)]
+    decoder: Option<DecoderArg>,
+    /// Record every episode to this `.rrd` (grid, cursor, goal, posterior,
+    /// visited states, p(error), EEG at FCz, event log).
+    #[arg(long, value_name = "FILE.rrd")]
+    save: Option<PathBuf>,
+    /// Print only the results.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
 fn parse_accuracy(s: &str) -> Result<f64, String> {
     let v: f64 = s.trim().parse().map_err(|_| {
         format!(
@@ -89,6 +121,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Calibrate(args) => calibrate(&args),
+        Command::Run(args) => run(&args),
         Command::Subjects => {
             print_subjects();
             Ok(())
@@ -232,6 +265,137 @@ fn calibrate(args: &CalibrateArgs) -> Result<()> {
     if let Some(file) = rrd {
         let montage = errp_bci::Montage::standard();
         let path = record_calibration(file, &report, &montage)?;
+        println!(
+            "Wrote {} (open with: rerun {})",
+            path.display(),
+            path.display()
+        );
+    }
+    Ok(())
+}
+
+fn run(args: &RunArgs) -> Result<()> {
+    let mut scenario = Scenario::load(&args.scenario)?;
+    if let Some(seed) = args.seed {
+        scenario.seed = seed;
+    }
+    if let Some(d) = args.decoder {
+        scenario.decoder = match d {
+            DecoderArg::Eeg => DecoderChoice::Eeg,
+            DecoderArg::Oracle => DecoderChoice::Oracle,
+        };
+        if scenario.decoder == DecoderChoice::Eeg && scenario.accuracy >= 1.0 {
+            bail!("--decoder eeg needs an accuracy below 1; the scenario asks for 1");
+        }
+    }
+    if let Some(p) = &args.save {
+        check_extension(p, "rrd", "--save")?;
+    }
+    let rrd = match &args.save {
+        Some(p) => Some(grid_recording(p)?),
+        None => None,
+    };
+    let quiet = args.quiet;
+    if !quiet {
+        eprintln!(
+            "{}: {} episodes, {} decoder at {:.2} % ({}), seed {}",
+            scenario.name,
+            scenario.episodes.len(),
+            match scenario.decoder {
+                DecoderChoice::Eeg => "EEG",
+                DecoderChoice::Oracle => "oracle",
+            },
+            100.0 * scenario.accuracy,
+            scenario.user,
+            scenario.seed
+        );
+    }
+    let (decoder, calibration) = prepare_decoder(&scenario, |s| {
+        if !quiet {
+            eprintln!(
+                "  calibrating: ErrP-to-noise {:.4} -> mean {:.2} %",
+                s.ratio,
+                100.0 * s.accuracy.mean()
+            );
+        }
+    })
+    .context("calibrating the decoder")?;
+    if let Some(c) = &calibration {
+        println!(
+            "Decoder calibrated on 400 actions: correct {:.2} %, error {:.2} %, mean {:.2} % (cross-validated)",
+            100.0 * c.calibrated.accuracy.correct,
+            100.0 * c.calibrated.accuracy.error,
+            100.0 * c.calibrated.accuracy.mean()
+        );
+    }
+    println!(
+        "{:>3}  {:>6} {:>6}  {:>13}  {:>7}  {:>8}  {:>9}  {:>8} {:>8} {:>8}",
+        "#",
+        "start",
+        "goal",
+        "committed",
+        "actions",
+        "net (s)",
+        "total (s)",
+        "acc corr",
+        "acc err",
+        "acc mean"
+    );
+    let episodes = run_grid_scenario(&scenario, &decoder, args.save.is_some(), |k, r| {
+        let committed = match r.committed {
+            Some(c) if c == r.goal => format!("{c} ok"),
+            Some(c) => format!("{c} WRONG"),
+            None => "none".to_string(),
+        };
+        let pct = |v: f64| {
+            if v.is_nan() {
+                "-".to_string()
+            } else {
+                format!("{:.1}", 100.0 * v)
+            }
+        };
+        println!(
+            "{:>3}  {:>6} {:>6}  {:>13}  {:>7}  {:>8.2}  {:>9.2}  {:>8} {:>8} {:>8}",
+            k + 1,
+            r.start.to_string(),
+            r.goal.to_string(),
+            committed,
+            r.actions,
+            r.net_secs,
+            r.total_secs,
+            pct(r.online.correct),
+            pct(r.online.error),
+            pct(r.online.mean())
+        );
+    })?;
+    let report = GridRunReport {
+        scenario,
+        calibration,
+        episodes,
+    };
+    let n = report.episodes.len();
+    let reached = report.episodes.iter().filter(|r| r.reached()).count();
+    let col = |f: fn(&errp_sim::GridEpisodeResult) -> f64| {
+        mean_sd(&report.episodes.iter().map(f).collect::<Vec<_>>())
+    };
+    let (am, asd) = col(|r| r.actions as f64);
+    let (nm, nsd) = col(|r| r.net_secs);
+    let (tm, tsd) = col(|r| r.total_secs);
+    let online = report.online_accuracy();
+    println!("Summary over {n} episodes:");
+    println!("  goals reached    {reached} / {n}");
+    println!("  actions          {am:.1} +- {asd:.1}");
+    println!("  net time (s)     {nm:.2} +- {nsd:.2}");
+    println!("  total time (s)   {tm:.2} +- {tsd:.2}");
+    println!(
+        "  online accuracy  correct {:.2} %, error {:.2} %, mean {:.2} % over {} actions",
+        100.0 * online.correct,
+        100.0 * online.error,
+        100.0 * online.mean(),
+        online.n_correct + online.n_error
+    );
+    if let Some(file) = rrd {
+        let path = record_grid_run(file, &report)?;
         println!(
             "Wrote {} (open with: rerun {})",
             path.display(),

@@ -123,3 +123,41 @@ fn subjects_lists_table1() {
         "{out}"
     );
 }
+
+#[test]
+fn every_shipped_scenario_loads_and_runs_with_the_oracle() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+    let mut n = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().and_then(|e| e.to_str()) != Some("toml") {
+            continue;
+        }
+        n += 1;
+        let o = errp(&["run", path.to_str().unwrap(), "--decoder", "oracle", "--quiet"]);
+        assert!(o.status.success(), "{}: {}", path.display(), stderr(&o));
+        let out = String::from_utf8_lossy(&o.stdout);
+        assert!(out.contains("goals reached"), "{out}");
+    }
+    assert!(n >= 2, "scenarios found: {n}");
+}
+
+#[test]
+fn a_broken_scenario_is_exit_2_naming_file_field_and_fix() {
+    let dir = temp_dir("scenario");
+    let path = dir.join("bad.toml");
+    std::fs::write(
+        &path,
+        "task = \"grid\"\n[user]\naccuracy = 0.8\n[[episode]]\nstart = [0, 0]\ngoal = [7, 1]\n",
+    )
+    .unwrap();
+    let rrd = dir.join("run.rrd");
+    let o = errp(&["run", path.to_str().unwrap(), "--save", rrd.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    let e = stderr(&o);
+    assert!(e.contains("bad.toml") && e.contains("episode[0].goal") && e.contains("[7, 1]"), "{e}");
+    assert!(e.contains("0 <= x, y <= 4"), "{e}");
+    assert!(!rrd.exists());
+    assert_eq!(files_in(&dir), ["bad.toml"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -7,15 +7,21 @@
 mod calibration;
 mod calibration_view;
 mod error;
+mod grid_run;
 mod grid_task;
+mod grid_view;
 mod output;
 mod record;
+mod scenario;
 
 pub use calibration::{CalibrationReport, CalibrationRequest, run_calibration};
 pub use calibration_view::{LATENCY_TIMELINE, calibration_recording, record_calibration};
 pub use error::{Result, SimError};
+pub use grid_run::{GridRunReport, mean_sd, prepare_decoder, run_grid_scenario};
 pub use grid_task::{
     AssessmentDecoder, EegDecoder, GridEpisodeResult, GridStep, GridTaskParams, run_grid_episode,
 };
+pub use grid_view::{SIM_TIME, grid_recording, record_grid_run};
 pub use output::PendingFile;
 pub use record::RrdFile;
+pub use scenario::{DecoderChoice, Scenario};

@@ -1,0 +1,113 @@
+//! Running a grid scenario: calibrate the decoder (EEG) or not (oracle), then
+//! every episode, each from its own derived seed.
+
+use errp_bci::{Accuracy, Montage, TargetingStep, rng::derive_seed};
+use errp_robot::{Grid, QTable};
+
+use crate::calibration::{CalibrationReport, CalibrationRequest, run_calibration};
+use crate::error::Result;
+use crate::grid_task::{AssessmentDecoder, EegDecoder, GridEpisodeResult, run_grid_episode};
+use crate::scenario::{DecoderChoice, Scenario};
+
+/// Everything a grid run produced.
+#[derive(Debug, Clone)]
+pub struct GridRunReport {
+    /// The scenario as run.
+    pub scenario: Scenario,
+    /// The calibration behind the EEG decoder (none for the oracle).
+    pub calibration: Option<CalibrationReport>,
+    /// One result per episode, in scenario order.
+    pub episodes: Vec<GridEpisodeResult>,
+}
+
+/// Mean and sample standard deviation.
+pub fn mean_sd(xs: &[f64]) -> (f64, f64) {
+    let n = xs.len() as f64;
+    if xs.is_empty() {
+        return (f64::NAN, f64::NAN);
+    }
+    let m = xs.iter().sum::<f64>() / n;
+    let sd = if xs.len() > 1 {
+        (xs.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+    } else {
+        0.0
+    };
+    (m, sd)
+}
+
+impl GridRunReport {
+    /// The decoder's accuracy pooled over every action of every episode.
+    pub fn online_accuracy(&self) -> Accuracy {
+        let (mut ch, mut cn, mut eh, mut en) = (0.0, 0, 0.0, 0);
+        for r in &self.episodes {
+            if r.online.n_correct > 0 {
+                ch += r.online.correct * r.online.n_correct as f64;
+                cn += r.online.n_correct;
+            }
+            if r.online.n_error > 0 {
+                eh += r.online.error * r.online.n_error as f64;
+                en += r.online.n_error;
+            }
+        }
+        Accuracy {
+            correct: ch / cn.max(1) as f64,
+            error: eh / en.max(1) as f64,
+            n_correct: cn,
+            n_error: en,
+        }
+    }
+}
+
+/// Builds the scenario's decoder: for the EEG decoder, a calibration session
+/// targeted at the scenario's accuracy (`progress` sees the search).
+pub fn prepare_decoder(
+    scenario: &Scenario,
+    progress: impl FnMut(&TargetingStep),
+) -> Result<(AssessmentDecoder, Option<CalibrationReport>)> {
+    match scenario.decoder {
+        DecoderChoice::Oracle => Ok((
+            AssessmentDecoder::Oracle {
+                accuracy: scenario.accuracy,
+            },
+            None,
+        )),
+        DecoderChoice::Eeg => {
+            let request = CalibrationRequest::new(scenario.accuracy, scenario.seed);
+            let report = run_calibration(&request, progress, None)?;
+            let decoder = AssessmentDecoder::Eeg(Box::new(EegDecoder {
+                generator: report.generator.clone(),
+                montage: Montage::standard(),
+                preprocessor: report.calibrated.session.preprocessor.clone(),
+                model: report.calibrated.model.clone(),
+            }));
+            Ok((decoder, Some(report)))
+        }
+    }
+}
+
+/// Runs every episode of `scenario` with `decoder`. Episode k uses the seed
+/// derived from (scenario seed, k); `record_steps` keeps every action.
+pub fn run_grid_scenario(
+    scenario: &Scenario,
+    decoder: &AssessmentDecoder,
+    record_steps: bool,
+    mut on_episode: impl FnMut(usize, &GridEpisodeResult),
+) -> Result<Vec<GridEpisodeResult>> {
+    let table = QTable::compute(Grid::paper(), &scenario.params.control.q)?;
+    let mut out = Vec::with_capacity(scenario.episodes.len());
+    for (k, &(start, goal)) in scenario.episodes.iter().enumerate() {
+        let seed = derive_seed(scenario.seed, "grid/episode", k as u64);
+        let r = run_grid_episode(
+            start,
+            goal,
+            &table,
+            &scenario.params,
+            decoder,
+            seed,
+            record_steps,
+        )?;
+        on_episode(k, &r);
+        out.push(r);
+    }
+    Ok(out)
+}

@@ -1,0 +1,220 @@
+//! What `errp run <grid scenario> --save` records.
+
+use std::path::{Path, PathBuf};
+
+use errp_robot::{Cell, Grid};
+use rerun::blueprint::{
+    Blueprint, Horizontal, Spatial2DView, TextLogView, TimeSeriesView, Vertical,
+};
+use rerun::{Boxes2D, Color, Image, Points2D, Scalars, SeriesLines, TextLog};
+
+use crate::error::Result;
+use crate::grid_run::GridRunReport;
+use crate::record::{RrdFile, record_error};
+
+/// The simulation timeline (s).
+pub const SIM_TIME: &str = "sim_time";
+/// Pause between episodes on the timeline (s).
+const EPISODE_GAP_SECS: f64 = 2.0;
+
+fn blueprint() -> Blueprint {
+    Blueprint::new(Horizontal::new([
+        Vertical::new([
+            Spatial2DView::new("Grid: cursor, goal, posterior")
+                .with_origin("/grid")
+                .into(),
+            TextLogView::new("Events").with_origin("/log").into(),
+        ])
+        .into(),
+        Vertical::new([
+            TimeSeriesView::new("p(error) per action")
+                .with_origin("/decoder")
+                .into(),
+            TimeSeriesView::new("Belief").with_origin("/belief").into(),
+            TimeSeriesView::new("EEG at FCz (uV, preprocessed)")
+                .with_origin("/eeg")
+                .into(),
+            Spatial2DView::new("Visited states (Fig. 4)")
+                .with_origin("/visits")
+                .into(),
+        ])
+        .into(),
+    ]))
+}
+
+/// Opens the `.rrd` of a grid run, with its layout, before the run.
+pub fn grid_recording(path: &Path) -> Result<RrdFile> {
+    RrdFile::create("errp_grid", path, blueprint())
+}
+
+/// Centre of a cell in view coordinates (row 0 at the bottom).
+fn centre(grid: &Grid, c: Cell) -> [f32; 2] {
+    [c.x as f32 + 0.5, (grid.height - 1 - c.y) as f32 + 0.5]
+}
+
+/// A heat map of per-cell values in [0, 1], one pixel per cell.
+fn heat_map(grid: &Grid, values: &[f64]) -> Image {
+    let mut rgb = Vec::with_capacity(grid.n_cells() * 3);
+    for row in 0..grid.height {
+        for x in 0..grid.width {
+            let v = values[grid.index(Cell::new(x, grid.height - 1 - row))].clamp(0.0, 1.0);
+            // White (0) to dark blue (1).
+            let shade = |lo: f64| (255.0 - v * (255.0 - lo)) as u8;
+            rgb.extend_from_slice(&[shade(20.0), shade(60.0), shade(140.0)]);
+        }
+    }
+    Image::from_rgb24(rgb, [grid.width as u32, grid.height as u32])
+}
+
+/// Writes every episode of `report` (run with `record_steps`) to `file`.
+pub fn record_grid_run(file: RrdFile, report: &GridRunReport) -> Result<PathBuf> {
+    let path = file.path().to_path_buf();
+    let rec = file.stream();
+    let err = record_error(&path);
+    let grid = Grid::paper();
+    let fs = 256.0;
+
+    let outline: Vec<([f32; 2], [f32; 2])> = grid
+        .cells()
+        .map(|c| (centre(&grid, c), [1.0, 1.0]))
+        .collect();
+    rec.log_static(
+        "grid/cells",
+        &Boxes2D::from_centers_and_sizes(outline.iter().map(|o| o.0), outline.iter().map(|o| o.1))
+            .with_colors([Color::from_rgb(160, 160, 160)]),
+    )
+    .map_err(&err)?;
+    rec.log_static(
+        "decoder/p_error",
+        &SeriesLines::new()
+            .with_names(["p(error)"])
+            .with_colors([Color::from_rgb(200, 40, 40)]),
+    )
+    .map_err(&err)?;
+    rec.log_static(
+        "decoder/threshold",
+        &SeriesLines::new()
+            .with_names(["0.5"])
+            .with_colors([Color::from_rgb(120, 120, 120)]),
+    )
+    .map_err(&err)?;
+    rec.log_static(
+        "belief/true_goal",
+        &SeriesLines::new().with_names(["p(true goal)"]),
+    )
+    .map_err(&err)?;
+    rec.log_static("belief/max", &SeriesLines::new().with_names(["max p"]))
+        .map_err(&err)?;
+
+    let mut t0 = 0.0;
+    for (k, ep) in report.episodes.iter().enumerate() {
+        rec.set_duration_secs(SIM_TIME, t0);
+        rec.log(
+            "log",
+            &TextLog::new(format!(
+                "episode {}: start {} goal {}",
+                k + 1,
+                ep.start,
+                ep.goal
+            )),
+        )
+        .map_err(&err)?;
+        rec.log(
+            "grid/goal",
+            &Boxes2D::from_centers_and_sizes([centre(&grid, ep.goal)], [[0.9, 0.9]])
+                .with_colors([Color::from_rgb(220, 40, 40)])
+                .with_labels(["G"]),
+        )
+        .map_err(&err)?;
+        rec.log(
+            "grid/start",
+            &Points2D::new([centre(&grid, ep.start)])
+                .with_labels(["S"])
+                .with_colors([Color::from_rgb(40, 160, 40)]),
+        )
+        .map_err(&err)?;
+        rec.log(
+            "grid/cursor",
+            &Points2D::new([centre(&grid, ep.start)])
+                .with_radii([0.25])
+                .with_colors([Color::from_rgb(30, 30, 30)]),
+        )
+        .map_err(&err)?;
+        for step in &ep.steps {
+            let t = t0 + step.onset_secs;
+            rec.set_duration_secs(SIM_TIME, t);
+            rec.log("grid/posterior", &heat_map(&grid, &step.belief))
+                .map_err(&err)?;
+            rec.log(
+                "grid/cursor",
+                &Points2D::new([centre(&grid, step.to)])
+                    .with_radii([0.25])
+                    .with_colors([Color::from_rgb(30, 30, 30)]),
+            )
+            .map_err(&err)?;
+            rec.log("decoder/p_error", &Scalars::single(step.p_error))
+                .map_err(&err)?;
+            rec.log("decoder/threshold", &Scalars::single(0.5))
+                .map_err(&err)?;
+            rec.log(
+                "belief/true_goal",
+                &Scalars::single(step.belief[grid.index(ep.goal)]),
+            )
+            .map_err(&err)?;
+            let max = step.belief.iter().copied().fold(0.0, f64::max);
+            rec.log("belief/max", &Scalars::single(max)).map_err(&err)?;
+            let decoded = if step.p_error >= 0.5 {
+                "error"
+            } else {
+                "correct"
+            };
+            let truth = if step.error { "error" } else { "correct" };
+            let level = if (step.p_error >= 0.5) == step.error {
+                "INFO"
+            } else {
+                "WARN"
+            };
+            rec.log(
+                "log",
+                &TextLog::new(format!(
+                    "{} {} -> {}: user {truth}, decoded {decoded} (p = {:.2})",
+                    step.action.name(),
+                    step.from,
+                    step.to,
+                    step.p_error
+                ))
+                .with_level(level),
+            )
+            .map_err(&err)?;
+            for (i, v) in step.fcz.iter().enumerate() {
+                rec.set_duration_secs(SIM_TIME, t + i as f64 / fs);
+                rec.log("eeg/FCz", &Scalars::single(*v)).map_err(&err)?;
+            }
+        }
+        let end = t0 + ep.total_secs;
+        rec.set_duration_secs(SIM_TIME, end);
+        let most = ep.visits.iter().copied().max().unwrap_or(1).max(1) as f64;
+        let visits: Vec<f64> = ep.visits.iter().map(|&v| f64::from(v) / most).collect();
+        rec.log("visits/map", &heat_map(&grid, &visits))
+            .map_err(&err)?;
+        let outcome = match ep.committed {
+            Some(c) if c == ep.goal => format!("reached the goal {c}"),
+            Some(c) => format!("committed to the wrong goal {c}"),
+            None => "did not converge".to_string(),
+        };
+        rec.log(
+            "log",
+            &TextLog::new(format!(
+                "episode {}: {outcome} after {} actions ({:.1} s net, {:.1} s total)",
+                k + 1,
+                ep.actions,
+                ep.net_secs,
+                ep.total_secs
+            ))
+            .with_level(if ep.reached() { "INFO" } else { "WARN" }),
+        )
+        .map_err(&err)?;
+        t0 = end + EPISODE_GAP_SECS;
+    }
+    file.finish()
+}

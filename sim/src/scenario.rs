@@ -1,0 +1,446 @@
+//! Scenario files: what to run, validated on load.
+//!
+//! A scenario is TOML. `ScenarioFile` mirrors the file (serde, unknown keys
+//! rejected); [`Scenario::load`] checks every value and returns a checked
+//! [`Scenario`], or an error naming the file, the field, the value and the
+//! accepted range.
+
+use std::path::{Path, PathBuf};
+
+use errp_bci::{GoalSet, subject};
+use errp_robot::{Cell, GridControlParams, QParams};
+use rand::Rng;
+use serde::Deserialize;
+
+use crate::error::{Result, SimError};
+use crate::grid_task::GridTaskParams;
+
+/// Which decoder turns the user's assessments into p(error).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DecoderChoice {
+    /// Synthetic EEG through the real preprocessing and LDA (the default).
+    Eeg,
+    /// Assessments flipped with probability 1 - accuracy; no EEG.
+    Oracle,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ScenarioFile {
+    task: String,
+    #[serde(default)]
+    name: Option<String>,
+    #[serde(default)]
+    description: Option<String>,
+    #[serde(default = "default_seed")]
+    seed: u64,
+    #[serde(default = "default_decoder")]
+    decoder: DecoderChoice,
+    user: UserFile,
+    #[serde(default)]
+    episode: Vec<EpisodeFile>,
+    #[serde(default)]
+    free_goals: Option<FreeGoalsFile>,
+    #[serde(default = "default_repeats")]
+    repeats: usize,
+    #[serde(default)]
+    control: Option<ControlFile>,
+    #[serde(default)]
+    timing: Option<TimingFile>,
+}
+
+fn default_seed() -> u64 {
+    1
+}
+fn default_decoder() -> DecoderChoice {
+    DecoderChoice::Eeg
+}
+fn default_repeats() -> usize {
+    1
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct UserFile {
+    #[serde(default)]
+    accuracy: Option<f64>,
+    #[serde(default)]
+    subject: Option<String>,
+    #[serde(default)]
+    goals: Option<GoalSetFile>,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(rename_all = "snake_case")]
+enum GoalSetFile {
+    Fixed,
+    Free,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct EpisodeFile {
+    start: [i64; 2],
+    goal: [i64; 2],
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FreeGoalsFile {
+    count: usize,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ControlFile {
+    tau: Option<f64>,
+    epsilon: Option<f64>,
+    p_c: Option<f64>,
+    discount: Option<f64>,
+    goal_reward: Option<f64>,
+    wrong_goal_reward: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TimingFile {
+    interval_min_secs: Option<f64>,
+    interval_max_secs: Option<f64>,
+    epoch_secs: Option<f64>,
+    max_actions: Option<usize>,
+}
+
+/// A validated grid scenario.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scenario {
+    /// The file it came from.
+    pub path: PathBuf,
+    /// Display name.
+    pub name: String,
+    /// What it reproduces, in words.
+    pub description: String,
+    /// Base seed of every episode.
+    pub seed: u64,
+    /// EEG or oracle decoder.
+    pub decoder: DecoderChoice,
+    /// The decoder's mean accuracy, in (0.5, 1] (1 only for the oracle).
+    pub accuracy: f64,
+    /// Who the accuracy comes from ("accuracy 0.7438", "subject S2, fixed goals").
+    pub user: String,
+    /// (start, goal) of every episode, in order (repeats included).
+    pub episodes: Vec<(Cell, Cell)>,
+    /// Strategy and timing.
+    pub params: GridTaskParams,
+}
+
+impl Scenario {
+    /// Reads and validates a scenario file.
+    pub fn load(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            SimError::Scenario(format!("{}: cannot read the scenario: {e}", path.display()))
+        })?;
+        Self::parse(&text, path)
+    }
+
+    /// Validates scenario text; `path` names it in errors.
+    pub fn parse(text: &str, path: &Path) -> Result<Self> {
+        let file: ScenarioFile = toml::from_str(text).map_err(|e| {
+            SimError::Scenario(format!("{}: {}", path.display(), e.to_string().trim_end()))
+        })?;
+        let bad = |field: &str, value: String, expected: &str| {
+            SimError::Scenario(format!(
+                "{}: field `{field}` = {value} is invalid: expected {expected}",
+                path.display()
+            ))
+        };
+        if file.task != "grid" {
+            return Err(bad(
+                "task",
+                format!("{:?}", file.task),
+                "\"grid\" (the only task this version runs)",
+            ));
+        }
+
+        // The user: an accuracy, or a subject of Table 1 with a goal set.
+        let (accuracy, user) = match (&file.user.accuracy, &file.user.subject) {
+            (Some(_), Some(_)) => {
+                return Err(bad(
+                    "user",
+                    "both accuracy and subject".into(),
+                    "one of `user.accuracy` or `user.subject`",
+                ));
+            }
+            (Some(a), None) => (*a, format!("accuracy {a}")),
+            (None, Some(name)) => {
+                let s = subject(name)
+                    .map_err(|e| bad("user.subject", format!("{name:?}"), &e.to_string()))?;
+                let (set, label) = match file.user.goals.unwrap_or(GoalSetFile::Fixed) {
+                    GoalSetFile::Fixed => (GoalSet::Fixed, "fixed"),
+                    GoalSetFile::Free => (GoalSet::Free, "free"),
+                };
+                (
+                    s.accuracy(set),
+                    format!("subject {}, {label} goals", s.name),
+                )
+            }
+            (None, None) => {
+                return Err(bad(
+                    "user",
+                    "empty".into(),
+                    "`user.accuracy = 0.7438` or `user.subject = \"S1\"`",
+                ));
+            }
+        };
+        let upper_ok = match file.decoder {
+            DecoderChoice::Oracle => accuracy <= 1.0,
+            DecoderChoice::Eeg => accuracy < 1.0,
+        };
+        if !(accuracy.is_finite() && accuracy > 0.5 && upper_ok) {
+            return Err(bad(
+                "user.accuracy",
+                accuracy.to_string(),
+                "a mean accuracy in (0.5, 1) for the EEG decoder, (0.5, 1] for the oracle",
+            ));
+        }
+
+        // Strategy and timing, on top of the paper's defaults.
+        let mut params = GridTaskParams::default();
+        if let Some(c) = &file.control {
+            let d = GridControlParams::default();
+            let q = QParams::default();
+            params.control = GridControlParams {
+                tau: c.tau.unwrap_or(d.tau),
+                epsilon: c.epsilon.unwrap_or(d.epsilon),
+                p_c: c.p_c.unwrap_or(d.p_c),
+                q: QParams {
+                    discount: c.discount.unwrap_or(q.discount),
+                    goal_reward: c.goal_reward.unwrap_or(q.goal_reward),
+                    wrong_goal_reward: c.wrong_goal_reward.unwrap_or(q.wrong_goal_reward),
+                },
+            };
+        }
+        let c = &params.control;
+        if !(c.tau.is_finite() && c.tau > 0.0) {
+            return Err(bad(
+                "control.tau",
+                c.tau.to_string(),
+                "a number > 0 (the paper: 0.3)",
+            ));
+        }
+        if !(c.epsilon.is_finite() && (0.0..=1.0).contains(&c.epsilon)) {
+            return Err(bad(
+                "control.epsilon",
+                c.epsilon.to_string(),
+                "a probability in [0, 1]",
+            ));
+        }
+        if !(c.p_c.is_finite() && c.p_c > 0.0 && c.p_c < 1.0) {
+            return Err(bad(
+                "control.p_c",
+                c.p_c.to_string(),
+                "a probability in (0, 1) (the paper: 0.9)",
+            ));
+        }
+        if !(c.q.discount.is_finite() && (0.0..1.0).contains(&c.q.discount)) {
+            return Err(bad(
+                "control.discount",
+                c.q.discount.to_string(),
+                "a number in [0, 1)",
+            ));
+        }
+        c.q.validate()
+            .map_err(|e| bad("control", "rewards".into(), &e.to_string()))?;
+        if let Some(t) = &file.timing {
+            let d = GridTaskParams::default();
+            params.interval_min_secs = t.interval_min_secs.unwrap_or(d.interval_min_secs);
+            params.interval_max_secs = t.interval_max_secs.unwrap_or(d.interval_max_secs);
+            params.epoch_secs = t.epoch_secs.unwrap_or(d.epoch_secs);
+            params.max_actions = t.max_actions.unwrap_or(d.max_actions);
+        }
+        if !(params.interval_min_secs.is_finite() && params.interval_min_secs >= 0.8) {
+            return Err(bad(
+                "timing.interval_min_secs",
+                params.interval_min_secs.to_string(),
+                "at least 0.8 s (an epoch) (the paper: 3)",
+            ));
+        }
+        if !(params.interval_max_secs.is_finite()
+            && params.interval_max_secs >= params.interval_min_secs)
+        {
+            return Err(bad(
+                "timing.interval_max_secs",
+                params.interval_max_secs.to_string(),
+                "a number of seconds >= interval_min_secs (the paper: 3.5)",
+            ));
+        }
+        if !(params.epoch_secs.is_finite() && params.epoch_secs > 0.0) {
+            return Err(bad(
+                "timing.epoch_secs",
+                params.epoch_secs.to_string(),
+                "a number > 0",
+            ));
+        }
+        if params.max_actions == 0 {
+            return Err(bad("timing.max_actions", "0".into(), "at least 1"));
+        }
+
+        // Episodes: fixed pairs and/or free goals drawn from the seed.
+        let grid = errp_robot::Grid::paper();
+        let mut pairs = Vec::new();
+        for (k, e) in file.episode.iter().enumerate() {
+            let cell = |field: &str, v: [i64; 2]| -> Result<Cell> {
+                let inside = (0..grid.width as i64).contains(&v[0])
+                    && (0..grid.height as i64).contains(&v[1]);
+                if inside {
+                    Ok(Cell::new(v[0] as usize, v[1] as usize))
+                } else {
+                    Err(bad(
+                        &format!("episode[{k}].{field}"),
+                        format!("[{}, {}]", v[0], v[1]),
+                        "a cell [x, y] with 0 <= x, y <= 4 on the 5x5 grid",
+                    ))
+                }
+            };
+            let (s, g) = (cell("start", e.start)?, cell("goal", e.goal)?);
+            if s == g {
+                return Err(bad(
+                    &format!("episode[{k}].goal"),
+                    format!("[{}, {}]", g.x, g.y),
+                    "a goal different from the start",
+                ));
+            }
+            pairs.push((s, g));
+        }
+        if let Some(free) = &file.free_goals {
+            if free.count == 0 {
+                return Err(bad("free_goals.count", "0".into(), "at least 1"));
+            }
+            let mut rng = errp_bci::rng::stream(file.seed, "scenario/free-goals");
+            for _ in 0..free.count {
+                let s = grid.cell(rng.random_range(0..grid.n_cells()));
+                let mut g = s;
+                while g == s {
+                    g = grid.cell(rng.random_range(0..grid.n_cells()));
+                }
+                pairs.push((s, g));
+            }
+        }
+        if pairs.is_empty() {
+            return Err(bad(
+                "episode",
+                "none".into(),
+                "at least one [[episode]] with start and goal, or a [free_goals] table",
+            ));
+        }
+        if file.repeats == 0 {
+            return Err(bad("repeats", "0".into(), "at least 1"));
+        }
+        let episodes = (0..file.repeats)
+            .flat_map(|_| pairs.iter().copied())
+            .collect();
+        Ok(Self {
+            path: path.to_path_buf(),
+            name: file.name.unwrap_or_else(|| {
+                path.file_stem()
+                    .map_or("scenario".into(), |s| s.to_string_lossy().into())
+            }),
+            description: file.description.unwrap_or_default(),
+            seed: file.seed,
+            decoder: file.decoder,
+            accuracy,
+            user,
+            episodes,
+            params,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const OK: &str = r#"
+task = "grid"
+[user]
+accuracy = 0.7438
+[[episode]]
+start = [0, 0]
+goal = [4, 4]
+"#;
+
+    fn err(text: &str) -> String {
+        Scenario::parse(text, Path::new("scenarios/x.toml"))
+            .unwrap_err()
+            .to_string()
+    }
+
+    #[test]
+    fn a_minimal_scenario_gets_the_papers_defaults() {
+        let s = Scenario::parse(OK, Path::new("x.toml")).unwrap();
+        assert_eq!(s.params.control.tau, 0.3);
+        assert_eq!(s.params.control.p_c, 0.9);
+        assert_eq!(s.decoder, DecoderChoice::Eeg);
+        assert_eq!(s.episodes, vec![(Cell::new(0, 0), Cell::new(4, 4))]);
+    }
+
+    #[test]
+    fn every_bad_value_names_file_field_value_and_range() {
+        for (text, field, value) in [
+            (OK.replace("[0, 0]", "[0, 5]"), "episode[0].start", "[0, 5]"),
+            (OK.replace("[4, 4]", "[0, 0]"), "episode[0].goal", "[0, 0]"),
+            (OK.replace("0.7438", "1.7"), "user.accuracy", "1.7"),
+            (OK.replace("0.7438", "0.5"), "user.accuracy", "0.5"),
+            (OK.replace("0.7438", "nan"), "user.accuracy", "NaN"),
+            (format!("{OK}[control]\ntau = -1.0\n"), "control.tau", "-1"),
+            (format!("{OK}[control]\np_c = 1.0\n"), "control.p_c", "1"),
+            (
+                format!("{OK}[control]\nepsilon = 2.0\n"),
+                "control.epsilon",
+                "2",
+            ),
+            (OK.replace("\"grid\"", "\"maze\""), "task", "maze"),
+        ] {
+            let e = err(&text);
+            assert!(e.contains("scenarios/x.toml"), "{e}");
+            assert!(e.contains(field), "{field}: {e}");
+            assert!(e.contains(value), "{value}: {e}");
+            assert!(e.contains("expected"), "{e}");
+        }
+    }
+
+    #[test]
+    fn unknown_keys_and_subjects_are_rejected() {
+        let e = err(&format!("{OK}colour = \"red\"\n"));
+        assert!(
+            e.contains("colour") && e.contains("scenarios/x.toml"),
+            "{e}"
+        );
+        let e = err(&OK.replace("accuracy = 0.7438", "subject = \"S9\""));
+        assert!(
+            e.contains("user.subject") && e.contains("S1, S2, S3, S4"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn the_oracle_may_be_perfect_the_eeg_decoder_may_not() {
+        let perfect = OK.replace("0.7438", "1.0");
+        assert!(
+            Scenario::parse(&format!("decoder = \"oracle\"\n{perfect}"), Path::new("x")).is_ok()
+        );
+        assert!(err(&perfect).contains("user.accuracy"));
+    }
+
+    #[test]
+    fn free_goals_are_drawn_from_the_seed() {
+        let text = "task = \"grid\"\nseed = 4\n[user]\nsubject = \"S2\"\ngoals = \"free\"\n[free_goals]\ncount = 5\n";
+        let a = Scenario::parse(text, Path::new("x")).unwrap();
+        let b = Scenario::parse(text, Path::new("x")).unwrap();
+        assert_eq!(a.episodes, b.episodes);
+        assert_eq!(a.episodes.len(), 5);
+        assert!(a.episodes.iter().all(|(s, g)| s != g));
+        assert!((a.accuracy - 0.8248).abs() < 1e-12);
+    }
+}
