@@ -9,9 +9,9 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
 use errp_bci::{EdfWriter, GoalSet, subject, subjects};
 use errp_sim::{
-    CalibrationRequest, DecoderChoice, GridRunReport, PendingFile, Scenario, calibration_recording,
-    grid_recording, mean_sd, prepare_decoder, record_calibration, record_grid_run, run_calibration,
-    run_grid_scenario,
+    CalibrationRequest, DecoderChoice, GridRunReport, PAPER, PendingFile, Scenario, Table1Options,
+    accuracy_time_correlation, calibration_recording, grid_recording, mean_sd, prepare_decoder,
+    record_calibration, record_grid_run, run_calibration, run_grid_scenario, run_table1,
 };
 
 /// Simulated shared control of a robot from EEG error potentials.
@@ -34,6 +34,10 @@ enum Command {
     /// Run a scenario: episodes of the grid task with the EEG decoder (or an
     /// oracle) in the loop, printed per episode and summarised like Table 1.
     Run(RunArgs),
+    /// Re-run Table 1: subjects S1-S4 at their accuracies on the fixed and
+    /// free goals, side by side with the paper, with the accuracy-time
+    /// correlation.
+    Table1(Table1Args),
     /// List the subjects of Table 1 of the paper and their accuracies.
     Subjects,
 }
@@ -101,6 +105,22 @@ struct RunArgs {
     quiet: bool,
 }
 
+#[derive(clap::Args)]
+struct Table1Args {
+    /// Runs per start/goal pair (5 pairs per subject and goal set).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=1000))]
+    episodes: u64,
+    /// Base seed.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// EEG decoder (default) or oracle.
+    #[arg(long, value_enum, default_value = "eeg")]
+    decoder: DecoderArg,
+    /// Print only the results.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
 fn parse_accuracy(s: &str) -> Result<f64, String> {
     let v: f64 = s.trim().parse().map_err(|_| {
         format!(
@@ -122,6 +142,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Calibrate(args) => calibrate(&args),
         Command::Run(args) => run(&args),
+        Command::Table1(args) => table1(&args),
         Command::Subjects => {
             print_subjects();
             Ok(())
@@ -400,6 +421,111 @@ fn run(args: &RunArgs) -> Result<()> {
             "Wrote {} (open with: rerun {})",
             path.display(),
             path.display()
+        );
+    }
+    Ok(())
+}
+
+fn table1(args: &Table1Args) -> Result<()> {
+    let options = Table1Options {
+        repeats: args.episodes as usize,
+        seed: args.seed,
+        decoder: match args.decoder {
+            DecoderArg::Eeg => DecoderChoice::Eeg,
+            DecoderArg::Oracle => DecoderChoice::Oracle,
+        },
+        params: errp_sim::GridTaskParams::default(),
+    };
+    let quiet = args.quiet;
+    if !quiet {
+        eprintln!(
+            "Table 1: 4 subjects x 2 goal sets x {} runs, seed {} (calibrating 8 decoders in parallel)",
+            5 * options.repeats,
+            options.seed
+        );
+    }
+    let cells = run_table1(&options, |label, s| {
+        if !quiet {
+            eprintln!(
+                "  {label}: ErrP-to-noise {:.4} -> {:.2} %",
+                s.ratio,
+                100.0 * s.accuracy.mean()
+            );
+        }
+    })?;
+    println!(
+        "{:<10} {:>8}  {:>18}  {:>22}  {:>24}  {:>22}",
+        "", "reached", "actions", "net time (s)", "total time (s)", "mean accuracy (%)"
+    );
+    println!(
+        "{:<10} {:>8}  {:>18}  {:>22}  {:>24}  {:>22}",
+        "", "", "ours [paper]", "ours [paper]", "ours [paper]", "ours [paper]"
+    );
+    let fmt = |(m, sd): (f64, f64), (pm, psd): (f64, f64), d: usize| {
+        format!("{m:.d$}+-{sd:.d$} [{pm:.d$}+-{psd:.d$}]")
+    };
+    for set in [GoalSet::Fixed, GoalSet::Free] {
+        let set_name = if set == GoalSet::Fixed {
+            "fixed"
+        } else {
+            "free"
+        };
+        let mut all: Vec<&errp_sim::GridEpisodeResult> = Vec::new();
+        for c in cells.iter().filter(|c| c.goals == set) {
+            let paper = PAPER
+                .iter()
+                .find(|p| p.0 == c.subject && p.1 == set)
+                .map(|p| p.2)
+                .unwrap_or([f64::NAN; 8]);
+            let reached = c.runs.iter().filter(|r| r.reached()).count();
+            println!(
+                "{:<10} {:>8}  {:>18}  {:>22}  {:>24}  {:>22}",
+                format!("{} {set_name}", c.subject),
+                format!("{reached}/{}", c.runs.len()),
+                fmt(c.stat(|r| r.actions as f64), (paper[0], paper[1]), 0),
+                fmt(c.stat(|r| r.net_secs), (paper[2], paper[3]), 2),
+                fmt(c.stat(|r| r.total_secs), (paper[4], paper[5]), 2),
+                fmt(c.stat(|r| 100.0 * r.online.mean()), (paper[6], paper[7]), 2),
+            );
+            all.extend(c.runs.iter());
+        }
+        let stat = |f: &dyn Fn(&errp_sim::GridEpisodeResult) -> f64| {
+            mean_sd(&all.iter().map(|r| f(r)).collect::<Vec<_>>())
+        };
+        let (paper_mean, paper_r, paper_p) = if set == GoalSet::Fixed {
+            (
+                [25.0, 13.0, 19.88, 10.75, 80.76, 73.68, 74.38, 4.66],
+                -0.47,
+                "0.038",
+            )
+        } else {
+            (
+                [21.0, 8.0, 16.40, 6.61, 66.63, 26.85, 77.67, 5.02],
+                -0.79,
+                "3e-5",
+            )
+        };
+        let reached = all.iter().filter(|r| r.reached()).count();
+        println!(
+            "{:<10} {:>8}  {:>18}  {:>22}  {:>24}  {:>22}",
+            format!("mean {set_name}"),
+            format!("{reached}/{}", all.len()),
+            fmt(
+                stat(&|r| r.actions as f64),
+                (paper_mean[0], paper_mean[1]),
+                0
+            ),
+            fmt(stat(&|r| r.net_secs), (paper_mean[2], paper_mean[3]), 2),
+            fmt(stat(&|r| r.total_secs), (paper_mean[4], paper_mean[5]), 2),
+            fmt(
+                stat(&|r| 100.0 * r.online.mean()),
+                (paper_mean[6], paper_mean[7]),
+                2
+            ),
+        );
+        let (r, p) = accuracy_time_correlation(&cells, set);
+        println!(
+            "           accuracy vs total time ({set_name} goals): r = {r:.2}, p = {p:.2e}   [paper: r = {paper_r}, p = {paper_p}]"
         );
     }
     Ok(())

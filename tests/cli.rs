@@ -134,7 +134,13 @@ fn every_shipped_scenario_loads_and_runs_with_the_oracle() {
             continue;
         }
         n += 1;
-        let o = errp(&["run", path.to_str().unwrap(), "--decoder", "oracle", "--quiet"]);
+        let o = errp(&[
+            "run",
+            path.to_str().unwrap(),
+            "--decoder",
+            "oracle",
+            "--quiet",
+        ]);
         assert!(o.status.success(), "{}: {}", path.display(), stderr(&o));
         let out = String::from_utf8_lossy(&o.stdout);
         assert!(out.contains("goals reached"), "{out}");
@@ -152,10 +158,18 @@ fn a_broken_scenario_is_exit_2_naming_file_field_and_fix() {
     )
     .unwrap();
     let rrd = dir.join("run.rrd");
-    let o = errp(&["run", path.to_str().unwrap(), "--save", rrd.to_str().unwrap()]);
+    let o = errp(&[
+        "run",
+        path.to_str().unwrap(),
+        "--save",
+        rrd.to_str().unwrap(),
+    ]);
     assert_eq!(o.status.code(), Some(2));
     let e = stderr(&o);
-    assert!(e.contains("bad.toml") && e.contains("episode[0].goal") && e.contains("[7, 1]"), "{e}");
+    assert!(
+        e.contains("bad.toml") && e.contains("episode[0].goal") && e.contains("[7, 1]"),
+        "{e}"
+    );
     assert!(e.contains("0 <= x, y <= 4"), "{e}");
     assert!(!rrd.exists());
     assert_eq!(files_in(&dir), ["bad.toml"]);

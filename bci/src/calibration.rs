@@ -11,6 +11,7 @@ use crate::error::{Result, check};
 use crate::features::EpochWindow;
 use crate::generator::{Assessment, Components, EegBlock, EegGenerator, GeneratorParams};
 use crate::montage::Montage;
+use crate::platt::PlattScaling;
 use crate::preprocess::{PreprocessParams, Preprocessor};
 use crate::rng::{derive_seed, stream};
 
@@ -399,6 +400,10 @@ pub struct Calibrated<M> {
     pub accuracy: Accuracy,
     /// The decoder trained on every trial, for online use.
     pub model: M,
+    /// Platt scaling of the decision values, fitted on the out-of-fold
+    /// decisions with the session's 20 % error prior removed: a calibrated
+    /// p(error) for online use.
+    pub platt: PlattScaling,
 }
 
 /// Runs a calibration session as the paper did: simulate it, score the
@@ -410,13 +415,17 @@ pub fn calibrate<C: Classifier>(
     options: SessionOptions<'_>,
 ) -> Result<Calibrated<C::Model>> {
     let session = simulate_session(setup, seed, options)?;
-    let accuracy = cross_validate(
+    let decisions = out_of_fold_decisions(
         classifier,
         &session.features,
         &session.labels,
         setup.calibration.folds,
         cv_seed(seed),
     )?;
+    let predicted: Vec<bool> = decisions.iter().map(|&d| d >= 0.0).collect();
+    let accuracy = Accuracy::score(&session.labels, &predicted);
+    let platt = PlattScaling::fit(&decisions, &session.labels)?
+        .balanced(accuracy.n_error, accuracy.n_correct);
     let model = classifier.fit(
         &session.features,
         &session.labels,
@@ -426,6 +435,7 @@ pub fn calibrate<C: Classifier>(
         session,
         accuracy,
         model,
+        platt,
     })
 }
 
@@ -452,8 +462,22 @@ pub fn cross_validate<C: Classifier>(
     folds: usize,
     seed: u64,
 ) -> Result<Accuracy> {
+    let decisions = out_of_fold_decisions(classifier, x, labels, folds, seed)?;
+    let predicted: Vec<bool> = decisions.iter().map(|&d| d >= 0.0).collect();
+    Ok(Accuracy::score(labels, &predicted))
+}
+
+/// The decision value of every trial from the model of the fold that left
+/// it out (stratified k-fold, folds drawn from `seed`).
+pub fn out_of_fold_decisions<C: Classifier>(
+    classifier: &C,
+    x: &Features,
+    labels: &[bool],
+    folds: usize,
+    seed: u64,
+) -> Result<Vec<f64>> {
     let fold_of = stratified_folds(labels, folds, seed);
-    let mut predicted = vec![false; labels.len()];
+    let mut decisions = vec![0.0; labels.len()];
     for k in 0..folds {
         let train: Vec<usize> = (0..labels.len()).filter(|&i| fold_of[i] != k).collect();
         let test: Vec<usize> = (0..labels.len()).filter(|&i| fold_of[i] == k).collect();
@@ -465,10 +489,10 @@ pub fn cross_validate<C: Classifier>(
         let model = classifier.fit(&xt, &yt, derive_seed(seed, "cv/fit", k as u64))?;
         for &i in &test {
             let row: Vec<f64> = x.row(i).iter().copied().collect();
-            predicted[i] = model.decision(&row) >= 0.0;
+            decisions[i] = model.decision(&row);
         }
     }
-    Ok(Accuracy::score(labels, &predicted))
+    Ok(decisions)
 }
 
 /// Fold index of every trial: each class shuffled and dealt round-robin.

@@ -26,6 +26,7 @@ mod generator;
 mod lda;
 mod montage;
 mod noise;
+mod platt;
 mod preprocess;
 pub mod rng;
 mod subjects;
@@ -33,8 +34,8 @@ mod targeting;
 
 pub use calibration::{
     Accuracy, Calibrated, CalibrationParams, CalibrationSession, CalibrationSetup, GrandAverage,
-    RawSink, SessionOptions, calibrate, cross_validate, cv_seed, eog_session, schedule,
-    simulate_session, stratified_folds,
+    RawSink, SessionOptions, calibrate, cross_validate, cv_seed, eog_session,
+    out_of_fold_decisions, schedule, simulate_session, stratified_folds,
 };
 pub use classify::{Classifier, ErrorModel, Features, sigmoid};
 pub use edf::EdfWriter;
@@ -46,6 +47,7 @@ pub use generator::{Assessment, Components, EegBlock, EegGenerator, GeneratorPar
 pub use lda::{LdaDecoder, LdaModel, Shrinkage, ledoit_wolf_shrinkage, pca_basis};
 pub use montage::{Channel, ChannelKind, DECODING_CHANNELS, Montage};
 pub use noise::{PinkNoise, Resonator};
+pub use platt::PlattScaling;
 pub use preprocess::{PreprocessParams, Preprocessor};
 pub use subjects::{GoalSet, Subject, subject, subjects};
 pub use targeting::{

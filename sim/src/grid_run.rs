@@ -6,8 +6,10 @@ use errp_robot::{Grid, QTable};
 
 use crate::calibration::{CalibrationReport, CalibrationRequest, run_calibration};
 use crate::error::Result;
-use crate::grid_task::{AssessmentDecoder, EegDecoder, GridEpisodeResult, run_grid_episode};
-use crate::scenario::{DecoderChoice, Scenario};
+use crate::grid_task::{
+    AssessmentDecoder, EegDecoder, GridEpisodeResult, PErrorMapping, run_grid_episode,
+};
+use crate::scenario::{DecoderChoice, PErrorChoice, Scenario};
 
 /// Everything a grid run produced.
 #[derive(Debug, Clone)]
@@ -79,6 +81,10 @@ pub fn prepare_decoder(
                 montage: Montage::standard(),
                 preprocessor: report.calibrated.session.preprocessor.clone(),
                 model: report.calibrated.model.clone(),
+                p_error: match scenario.p_error {
+                    PErrorChoice::Sigmoid => PErrorMapping::Sigmoid,
+                    PErrorChoice::Platt => PErrorMapping::Platt(report.calibrated.platt),
+                },
             }));
             Ok((decoder, Some(report)))
         }

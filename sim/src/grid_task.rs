@@ -4,7 +4,7 @@
 
 use errp_bci::{
     Accuracy, Assessment, AssessmentKind, EegGenerator, EpochWindow, ErrorModel, GeneratorParams,
-    LdaModel, Montage, Preprocessor, rng::derive_seed, rng::stream,
+    LdaModel, Montage, PlattScaling, Preprocessor, rng::derive_seed, rng::stream,
 };
 use errp_robot::{Cell, Grid, GridAction, GridControlParams, GridController, QTable};
 use rand::Rng;
@@ -66,6 +66,18 @@ pub struct EegDecoder {
     pub preprocessor: Preprocessor,
     /// The decoder trained on the calibration session.
     pub model: LdaModel,
+    /// How decision values become p(error).
+    pub p_error: PErrorMapping,
+}
+
+/// How the decoder's decision value y becomes p(error).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum PErrorMapping {
+    /// The paper's p = 1 / (1 + e^-y) (sec. 2.2.1).
+    Sigmoid,
+    /// Platt scaling fitted on the calibration session's out-of-fold
+    /// decisions: p = 1 / (1 + e^-(a y + b)).
+    Platt(PlattScaling),
 }
 
 /// One action of an episode, as recorded.
@@ -83,6 +95,8 @@ pub struct GridStep {
     pub error: bool,
     /// The decoder's p(error).
     pub p_error: f64,
+    /// The decoder's class: its decision value y >= 0 (sec. 2.2.1).
+    pub decoded_error: bool,
     /// The belief over the goals after the update (cell index order).
     pub belief: Vec<f64>,
     /// Preprocessed FCz during the epoch (uV, 256 Hz), EEG decoder only.
@@ -104,7 +118,8 @@ pub struct GridEpisodeResult {
     pub net_secs: f64,
     /// Wall time of the episode: the inter-action intervals.
     pub total_secs: f64,
-    /// The decoder's accuracy over this episode's actions.
+    /// The decoder's accuracy over this episode's actions (its class
+    /// decision y >= 0 against the user's assessment).
     pub online: Accuracy,
     /// How often the cursor was in each cell (index order), start included.
     pub visits: Vec<u32>,
@@ -160,7 +175,7 @@ pub fn run_grid_episode(
         let action = controller.choose(cell, &mut rng_policy);
         let error = !grid.is_correct(cell, action, goal);
         let interval = rng_user.random_range(params.interval_min_secs..=params.interval_max_secs);
-        let (p_error, fcz) = match (decoder, online.as_mut()) {
+        let (p_error, says_error, fcz) = match (decoder, online.as_mut()) {
             (AssessmentDecoder::Oracle { accuracy }, _) => {
                 let right = rng_oracle.random::<f64>() < *accuracy;
                 let says_error = if right { error } else { !error };
@@ -169,7 +184,7 @@ pub fn run_grid_episode(
                 } else {
                     1.0 - accuracy
                 };
-                (p, Vec::new())
+                (p, says_error, Vec::new())
             }
             (AssessmentDecoder::Eeg(_), Some(eeg)) => eeg.decode(error, interval, record_steps),
             (AssessmentDecoder::Eeg(_), None) => unreachable!("EEG decoder without a stream"),
@@ -177,7 +192,7 @@ pub fn run_grid_episode(
         controller.observe(cell, action, p_error)?;
         let to = grid.step(cell, action);
         labels.push(error);
-        decoded.push(p_error >= 0.5);
+        decoded.push(says_error);
         if record_steps {
             steps.push(GridStep {
                 onset_secs: total_secs,
@@ -186,6 +201,7 @@ pub fn run_grid_episode(
                 to,
                 error,
                 p_error,
+                decoded_error: says_error,
                 belief: controller.belief().probabilities(),
                 fcz,
             });
@@ -217,6 +233,7 @@ struct OnlineEeg<'a> {
     generator: EegGenerator,
     preprocessor: Preprocessor,
     model: &'a LdaModel,
+    mapping: PErrorMapping,
     window: EpochWindow,
     fcz_row: usize,
 }
@@ -245,6 +262,7 @@ impl<'a> OnlineEeg<'a> {
             generator,
             preprocessor,
             model: &d.model,
+            mapping: d.p_error,
             window: EpochWindow::paper(fs),
             fcz_row,
         }))
@@ -252,8 +270,8 @@ impl<'a> OnlineEeg<'a> {
 
     /// Streams the EEG from this action's onset to the next one (the whole
     /// inter-action interval, so filters see continuous EEG) and decodes the
-    /// epoch at the onset.
-    fn decode(&mut self, error: bool, interval_secs: f64, keep_fcz: bool) -> (f64, Vec<f64>) {
+    /// epoch at the onset. Returns p(error), the decoded class and FCz.
+    fn decode(&mut self, error: bool, interval_secs: f64, keep_fcz: bool) -> (f64, bool, Vec<f64>) {
         let fs = self.generator.params().sfreq_hz;
         let onset = self.generator.now_secs();
         self.generator.schedule(Assessment {
@@ -267,12 +285,16 @@ impl<'a> OnlineEeg<'a> {
         let n = ((interval_secs * fs).round() as usize).max(self.window.span());
         let raw = self.generator.generate(n);
         let clean = self.preprocessor.process(&raw);
-        let p = self.model.p_error(&self.window.extract(&clean, 0));
+        let y = self.model.decision(&self.window.extract(&clean, 0));
+        let p = match self.mapping {
+            PErrorMapping::Sigmoid => errp_bci::sigmoid(y),
+            PErrorMapping::Platt(s) => s.p_error(y),
+        };
         let fcz = if keep_fcz {
             clean.channel(self.fcz_row)[..self.window.span()].to_vec()
         } else {
             Vec::new()
         };
-        (p, fcz)
+        (p, y >= 0.0, fcz)
     }
 }

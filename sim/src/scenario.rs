@@ -37,6 +37,8 @@ struct ScenarioFile {
     seed: u64,
     #[serde(default = "default_decoder")]
     decoder: DecoderChoice,
+    #[serde(default = "default_p_error")]
+    p_error: PErrorChoice,
     user: UserFile,
     #[serde(default)]
     episode: Vec<EpisodeFile>,
@@ -56,8 +58,21 @@ fn default_seed() -> u64 {
 fn default_decoder() -> DecoderChoice {
     DecoderChoice::Eeg
 }
+fn default_p_error() -> PErrorChoice {
+    PErrorChoice::Platt
+}
 fn default_repeats() -> usize {
     1
+}
+
+/// How the EEG decoder's decision value becomes p(error).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PErrorChoice {
+    /// The paper's 1 / (1 + e^-y).
+    Sigmoid,
+    /// Platt scaling fitted on the calibration session (the default).
+    Platt,
 }
 
 #[derive(Debug, Deserialize)]
@@ -124,6 +139,8 @@ pub struct Scenario {
     pub seed: u64,
     /// EEG or oracle decoder.
     pub decoder: DecoderChoice,
+    /// p(error) mapping of the EEG decoder.
+    pub p_error: PErrorChoice,
     /// The decoder's mean accuracy, in (0.5, 1] (1 only for the oracle).
     pub accuracy: f64,
     /// Who the accuracy comes from ("accuracy 0.7438", "subject S2, fixed goals").
@@ -349,6 +366,7 @@ impl Scenario {
             description: file.description.unwrap_or_default(),
             seed: file.seed,
             decoder: file.decoder,
+            p_error: file.p_error,
             accuracy,
             user,
             episodes,

@@ -4,8 +4,8 @@
 use errp_bci::{Accuracy, Montage};
 use errp_robot::{Cell, Grid, QTable};
 use errp_sim::{
-    AssessmentDecoder, CalibrationRequest, EegDecoder, GridTaskParams, run_calibration,
-    run_grid_episode,
+    AssessmentDecoder, CalibrationRequest, EegDecoder, GridTaskParams, PErrorMapping,
+    run_calibration, run_grid_episode,
 };
 
 const PAIRS: [((usize, usize), (usize, usize)); 5] = [
@@ -23,6 +23,7 @@ fn eeg_decoder(accuracy: f64, seed: u64) -> AssessmentDecoder {
         montage: Montage::standard(),
         preprocessor: report.calibrated.session.preprocessor,
         model: report.calibrated.model,
+        p_error: PErrorMapping::Platt(report.calibrated.platt),
     }))
 }
 
@@ -72,6 +73,18 @@ fn pooled(results: &[errp_sim::GridEpisodeResult]) -> Accuracy {
 }
 
 #[test]
+fn at_90_percent_with_the_eeg_decoder_every_episode_reaches_its_goal() {
+    let decoder = eeg_decoder(0.90, 7);
+    let results = episodes(&decoder, 20, 7);
+    let reached = results.iter().filter(|r| r.reached()).count();
+    let actions: usize = results.iter().map(|r| r.actions).sum();
+    assert_eq!(
+        reached, 20,
+        "{reached}/20 reached; {actions} actions in all"
+    );
+}
+
+#[test]
 fn online_accuracy_matches_the_calibrated_accuracy() {
     let requested = 0.7438;
     let decoder = eeg_decoder(requested, 3);
@@ -104,4 +117,27 @@ fn same_seed_same_episode() {
     };
     assert_eq!(run(5), run(5));
     assert_ne!(run(5), run(6));
+}
+
+#[test]
+fn table1_gives_the_same_results_on_one_and_two_threads() {
+    let options = errp_sim::Table1Options {
+        repeats: 1,
+        seed: 4,
+        decoder: errp_sim::DecoderChoice::Oracle,
+        params: GridTaskParams::default(),
+    };
+    let on = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| errp_sim::run_table1(&options, |_, _| {}).unwrap())
+    };
+    let (one, two) = (on(1), on(2));
+    assert_eq!(one.len(), 8);
+    for (a, b) in one.iter().zip(&two) {
+        assert_eq!((&a.subject, a.goals), (&b.subject, b.goals));
+        assert_eq!(a.runs, b.runs, "{} {:?}", a.subject, a.goals);
+    }
 }

@@ -1,0 +1,147 @@
+//! Sensitivity of the grid task to what the paper leaves open.
+//!
+//! Runs 100 episodes (the five fixed start/goal pairs of
+//! `scenarios/grid_fixed_goals.toml`, 20 times each) for each variant, at the
+//! paper's mean accuracy (74.38 %) and at 90 %, and prints a markdown table:
+//! goals reached and actions (mean +- sd). The first row of each block uses
+//! only what the paper states (tau = 0.3, p_c = 0.9, p = 1 / (1 + e^-y)) plus
+//! our defaults for what it does not (epsilon, reward model).
+//!
+//! `cargo run -p errp_sim --example grid_sensitivity` (a few minutes).
+
+use errp_bci::Montage;
+use errp_robot::{Cell, Grid, QParams, QTable};
+use errp_sim::{
+    AssessmentDecoder, CalibrationRequest, EegDecoder, GridTaskParams, PErrorMapping, mean_sd,
+    run_calibration, run_grid_episode,
+};
+
+const PAIRS: [((usize, usize), (usize, usize)); 5] = [
+    ((0, 0), (4, 4)),
+    ((4, 0), (0, 4)),
+    ((0, 2), (4, 2)),
+    ((2, 0), (2, 4)),
+    ((1, 3), (3, 1)),
+];
+
+struct Variant {
+    label: &'static str,
+    platt: Option<bool>,
+    epsilon: f64,
+    discount: f64,
+    reward: f64,
+}
+
+fn main() {
+    let variants = [
+        Variant {
+            label: "paper: p = sigmoid(y)",
+            platt: Some(false),
+            epsilon: 0.1,
+            discount: 0.9,
+            reward: 1.0,
+        },
+        Variant {
+            label: "p = sigmoid(y), discount 0.5",
+            platt: Some(false),
+            epsilon: 0.1,
+            discount: 0.5,
+            reward: 1.0,
+        },
+        Variant {
+            label: "**default: Platt-scaled p**",
+            platt: Some(true),
+            epsilon: 0.1,
+            discount: 0.9,
+            reward: 1.0,
+        },
+        Variant {
+            label: "Platt, epsilon 0",
+            platt: Some(true),
+            epsilon: 0.0,
+            discount: 0.9,
+            reward: 1.0,
+        },
+        Variant {
+            label: "Platt, epsilon 0.3",
+            platt: Some(true),
+            epsilon: 0.3,
+            discount: 0.9,
+            reward: 1.0,
+        },
+        Variant {
+            label: "Platt, discount 0.5",
+            platt: Some(true),
+            epsilon: 0.1,
+            discount: 0.5,
+            reward: 1.0,
+        },
+        Variant {
+            label: "Platt, goal reward 3 (Q scale x3)",
+            platt: Some(true),
+            epsilon: 0.1,
+            discount: 0.9,
+            reward: 3.0,
+        },
+        Variant {
+            label: "oracle decoder, p = accuracy",
+            platt: None,
+            epsilon: 0.1,
+            discount: 0.9,
+            reward: 1.0,
+        },
+    ];
+    println!("| accuracy | variant | goals reached | actions |");
+    println!("|---|---|---|---|");
+    for accuracy in [0.7438, 0.90] {
+        let report = run_calibration(&CalibrationRequest::new(accuracy, 3), |_| {}, None)
+            .expect("calibration");
+        let eeg = |mapping| {
+            AssessmentDecoder::Eeg(Box::new(EegDecoder {
+                generator: report.generator.clone(),
+                montage: Montage::standard(),
+                preprocessor: report.calibrated.session.preprocessor.clone(),
+                model: report.calibrated.model.clone(),
+                p_error: mapping,
+            }))
+        };
+        for v in &variants {
+            let decoder = match v.platt {
+                Some(true) => eeg(PErrorMapping::Platt(report.calibrated.platt)),
+                Some(false) => eeg(PErrorMapping::Sigmoid),
+                None => AssessmentDecoder::Oracle { accuracy },
+            };
+            let mut params = GridTaskParams::default();
+            params.control.epsilon = v.epsilon;
+            params.control.q = QParams {
+                discount: v.discount,
+                goal_reward: v.reward,
+                ..QParams::default()
+            };
+            let table = QTable::compute(Grid::paper(), &params.control.q).expect("Q-values");
+            let mut reached = 0;
+            let mut actions = Vec::new();
+            for k in 0..100 {
+                let (s, g) = PAIRS[k % PAIRS.len()];
+                let r = run_grid_episode(
+                    Cell::new(s.0, s.1),
+                    Cell::new(g.0, g.1),
+                    &table,
+                    &params,
+                    &decoder,
+                    9000 + k as u64,
+                    false,
+                )
+                .expect("episode");
+                reached += usize::from(r.reached());
+                actions.push(r.actions as f64);
+            }
+            let (m, sd) = mean_sd(&actions);
+            println!(
+                "| {:.2} % | {} | {reached} / 100 | {m:.1} +- {sd:.1} |",
+                100.0 * accuracy,
+                v.label
+            );
+        }
+    }
+}

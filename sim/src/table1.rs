@@ -1,0 +1,207 @@
+//! Table 1 of the paper, re-run: the four subjects at their accuracies, on
+//! the fixed and the free goals.
+
+use errp_bci::{GoalSet, TargetingStep, rng::derive_seed, subjects};
+use errp_robot::{Cell, Grid, QTable};
+use rand::Rng;
+use rayon::prelude::*;
+
+use crate::error::Result;
+use crate::grid_run::{mean_sd, prepare_decoder};
+use crate::grid_task::{GridEpisodeResult, GridTaskParams, run_grid_episode};
+use crate::scenario::{DecoderChoice, PErrorChoice, Scenario};
+use crate::stats::pearson;
+
+/// The five fixed start/goal pairs (`scenarios/grid_fixed_goals.toml`).
+pub const FIXED_PAIRS: [(Cell, Cell); 5] = [
+    (Cell::new(0, 0), Cell::new(4, 4)),
+    (Cell::new(4, 0), Cell::new(0, 4)),
+    (Cell::new(0, 2), Cell::new(4, 2)),
+    (Cell::new(2, 0), Cell::new(2, 4)),
+    (Cell::new(1, 3), Cell::new(3, 1)),
+];
+
+/// The paper's Table 1, for comparison: per subject and goal set, (actions
+/// mean, sd, net s mean, sd, total s mean, sd, accuracy % mean, sd).
+pub const PAPER: [(&str, GoalSet, [f64; 8]); 8] = [
+    (
+        "S1",
+        GoalSet::Fixed,
+        [16.0, 2.0, 12.96, 1.91, 52.65, 7.76, 83.14, 15.15],
+    ),
+    (
+        "S1",
+        GoalSet::Free,
+        [23.0, 9.0, 18.08, 7.37, 73.45, 29.93, 78.75, 12.62],
+    ),
+    (
+        "S2",
+        GoalSet::Fixed,
+        [43.0, 9.0, 34.56, 7.10, 140.40, 28.83, 69.49, 4.13],
+    ),
+    (
+        "S2",
+        GoalSet::Free,
+        [21.0, 7.0, 16.48, 5.84, 66.95, 23.73, 82.48, 10.66],
+    ),
+    (
+        "S3",
+        GoalSet::Fixed,
+        [23.0, 12.0, 18.40, 9.73, 74.75, 39.54, 72.49, 3.74],
+    ),
+    (
+        "S3",
+        GoalSet::Free,
+        [16.0, 6.0, 12.96, 5.10, 52.65, 20.73, 88.18, 10.51],
+    ),
+    (
+        "S4",
+        GoalSet::Fixed,
+        [17.0, 5.0, 13.60, 4.38, 55.25, 17.80, 76.35, 8.89],
+    ),
+    (
+        "S4",
+        GoalSet::Free,
+        [23.0, 11.0, 18.08, 8.44, 73.45, 34.29, 78.66, 14.44],
+    ),
+];
+
+/// One cell of the table: a subject on a goal set.
+#[derive(Debug, Clone)]
+pub struct Table1Cell {
+    /// S1..S4.
+    pub subject: String,
+    /// Fixed or free goals.
+    pub goals: GoalSet,
+    /// The accuracy the decoder was calibrated to.
+    pub accuracy: f64,
+    /// Every run.
+    pub runs: Vec<GridEpisodeResult>,
+}
+
+impl Table1Cell {
+    /// (mean, sd) of a per-run quantity.
+    pub fn stat(&self, f: impl Fn(&GridEpisodeResult) -> f64) -> (f64, f64) {
+        mean_sd(&self.runs.iter().map(f).collect::<Vec<_>>())
+    }
+}
+
+/// Options of a Table 1 run.
+#[derive(Debug, Clone, Copy)]
+pub struct Table1Options {
+    /// Runs per start/goal pair (the paper: 1, so 5 runs per cell).
+    pub repeats: usize,
+    /// Base seed.
+    pub seed: u64,
+    /// EEG (default) or oracle decoder.
+    pub decoder: DecoderChoice,
+    /// Strategy and timing.
+    pub params: GridTaskParams,
+}
+
+/// Runs the eight cells (in parallel; the results do not depend on the
+/// number of threads: every cell and run has its own derived seed).
+pub fn run_table1(
+    options: &Table1Options,
+    progress: impl Fn(&str, &TargetingStep) + Sync,
+) -> Result<Vec<Table1Cell>> {
+    let grid = Grid::paper();
+    let table = QTable::compute(grid, &options.params.control.q)?;
+    let jobs: Vec<(String, GoalSet, f64, usize)> = subjects()
+        .into_iter()
+        .enumerate()
+        .flat_map(|(i, s)| {
+            [
+                (
+                    s.name.clone(),
+                    GoalSet::Fixed,
+                    s.accuracy(GoalSet::Fixed),
+                    2 * i,
+                ),
+                (
+                    s.name.clone(),
+                    GoalSet::Free,
+                    s.accuracy(GoalSet::Free),
+                    2 * i + 1,
+                ),
+            ]
+        })
+        .collect();
+    jobs.par_iter()
+        .map(|(name, goals, accuracy, k)| {
+            let cell_seed = derive_seed(options.seed, "table1/cell", *k as u64);
+            let pairs: Vec<(Cell, Cell)> = match goals {
+                GoalSet::Fixed => FIXED_PAIRS.to_vec(),
+                GoalSet::Free => {
+                    let mut rng = errp_bci::rng::stream(cell_seed, "table1/free-goals");
+                    (0..5)
+                        .map(|_| {
+                            let s = grid.cell(rng.random_range(0..grid.n_cells()));
+                            let mut g = s;
+                            while g == s {
+                                g = grid.cell(rng.random_range(0..grid.n_cells()));
+                            }
+                            (s, g)
+                        })
+                        .collect()
+                }
+            };
+            let scenario = Scenario {
+                path: "table1".into(),
+                name: format!("{name} {goals:?}"),
+                description: String::new(),
+                seed: cell_seed,
+                decoder: options.decoder,
+                p_error: PErrorChoice::Platt,
+                accuracy: *accuracy,
+                user: name.clone(),
+                episodes: Vec::new(),
+                params: options.params,
+            };
+            let label = format!(
+                "{name} {}",
+                if *goals == GoalSet::Fixed {
+                    "fixed"
+                } else {
+                    "free"
+                }
+            );
+            let (decoder, _) = prepare_decoder(&scenario, |s| progress(&label, s))?;
+            let mut runs = Vec::new();
+            for r in 0..options.repeats {
+                for (j, &(start, goal)) in pairs.iter().enumerate() {
+                    let seed = derive_seed(cell_seed, "table1/run", (r * pairs.len() + j) as u64);
+                    runs.push(run_grid_episode(
+                        start,
+                        goal,
+                        &table,
+                        &options.params,
+                        &decoder,
+                        seed,
+                        false,
+                    )?);
+                }
+            }
+            Ok(Table1Cell {
+                subject: name.clone(),
+                goals: *goals,
+                accuracy: *accuracy,
+                runs,
+            })
+        })
+        .collect()
+}
+
+/// Pearson r and p between each run's online mean accuracy and its total
+/// time, over every run of a goal set (the paper: r = -0.47, p = 0.038
+/// fixed; r = -0.79, p = 3e-5 free).
+pub fn accuracy_time_correlation(cells: &[Table1Cell], goals: GoalSet) -> (f64, f64) {
+    let runs: Vec<&GridEpisodeResult> = cells
+        .iter()
+        .filter(|c| c.goals == goals)
+        .flat_map(|c| c.runs.iter())
+        .collect();
+    let acc: Vec<f64> = runs.iter().map(|r| r.online.mean()).collect();
+    let time: Vec<f64> = runs.iter().map(|r| r.total_secs).collect();
+    pearson(&acc, &time)
+}
