@@ -1,0 +1,51 @@
+//! Grid episodes per second on one core, with the EEG decoder in the loop
+//! and with the oracle. Run with `cargo bench -p errp_sim`.
+
+use std::sync::LazyLock;
+
+use divan::{Bencher, black_box};
+use errp_bci::Montage;
+use errp_robot::{Grid, QTable};
+use errp_sim::{
+    AssessmentDecoder, CalibrationRequest, EegDecoder, FIXED_PAIRS, GridTaskParams, PErrorMapping,
+    run_calibration, run_grid_episode,
+};
+
+fn main() {
+    divan::main();
+}
+
+static EEG: LazyLock<AssessmentDecoder> = LazyLock::new(|| {
+    let report = run_calibration(&CalibrationRequest::new(0.7438, 1), |_| {}, None).unwrap();
+    AssessmentDecoder::Eeg(Box::new(EegDecoder {
+        generator: report.generator,
+        montage: Montage::standard(),
+        preprocessor: report.calibrated.session.preprocessor,
+        model: report.calibrated.model,
+        p_error: PErrorMapping::Platt(report.calibrated.platt),
+    }))
+});
+
+fn episodes(bencher: Bencher, decoder: &AssessmentDecoder) {
+    let params = GridTaskParams::default();
+    let table = QTable::compute(Grid::paper(), &params.control.q).unwrap();
+    let mut k = 0u64;
+    bencher.bench_local(|| {
+        let (start, goal) = FIXED_PAIRS[(k % 5) as usize];
+        k += 1;
+        black_box(run_grid_episode(start, goal, &table, &params, decoder, k, false).unwrap())
+    });
+}
+
+/// One grid episode (fixed goals, 74.38 %) with the EEG decoder: every
+/// inter-action interval synthesised, filtered and the epoch decoded.
+#[divan::bench(sample_count = 30, sample_size = 1)]
+fn episode_eeg(bencher: Bencher) {
+    episodes(bencher, &EEG);
+}
+
+/// One grid episode with the oracle decoder (no EEG).
+#[divan::bench]
+fn episode_oracle(bencher: Bencher) {
+    episodes(bencher, &AssessmentDecoder::Oracle { accuracy: 0.7438 });
+}
