@@ -9,9 +9,10 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
 use errp_bci::{EdfWriter, GoalSet, subject, subjects};
 use errp_sim::{
-    CalibrationRequest, DecoderChoice, GridRunReport, PAPER, PendingFile, Scenario, Table1Options,
-    accuracy_time_correlation, calibration_recording, grid_recording, mean_sd, prepare_decoder,
-    record_calibration, record_grid_run, run_calibration, run_grid_scenario, run_table1,
+    CalibrationRequest, DecoderChoice, EegMode, GridRunReport, PAPER, PendingFile, Scenario,
+    Table1Options, accuracy_time_correlation, calibration_recording, grid_recording, mean_sd,
+    prepare_decoder, record_calibration, record_grid_run, run_calibration, run_grid_scenario,
+    run_table1,
 };
 
 /// Simulated shared control of a robot from EEG error potentials.
@@ -86,6 +87,23 @@ enum DecoderArg {
     Oracle,
 }
 
+#[derive(Clone, Copy, ValueEnum)]
+enum EegArg {
+    /// Synthesise each action's EEG when it happens.
+    Stream,
+    /// Draw preprocessed epochs from a bank streamed in advance.
+    Bank,
+}
+
+impl EegArg {
+    fn mode(self) -> EegMode {
+        match self {
+            EegArg::Stream => EegMode::Stream,
+            EegArg::Bank => EegMode::Bank,
+        }
+    }
+}
+
 #[derive(clap::Args)]
 struct RunArgs {
     /// The scenario file (TOML), e.g. scenarios/grid_fixed_goals.toml.
@@ -96,6 +114,9 @@ struct RunArgs {
     /// Override the scenario's decoder.
     #[arg(long, value_enum)]
     decoder: Option<DecoderArg>,
+    /// Override how the EEG reaches the decoder: streamed or from a bank.
+    #[arg(long, value_enum)]
+    eeg: Option<EegArg>,
     /// Record every episode to this `.rrd` (grid, cursor, goal, posterior,
     /// visited states, p(error), EEG at FCz, event log).
     #[arg(long, value_name = "FILE.rrd")]
@@ -116,6 +137,10 @@ struct Table1Args {
     /// EEG decoder (default) or oracle.
     #[arg(long, value_enum, default_value = "eeg")]
     decoder: DecoderArg,
+    /// Stream each action's EEG (default) or draw epochs from a bank of
+    /// 1000 per class streamed in advance (much faster).
+    #[arg(long, value_enum, default_value = "stream")]
+    eeg: EegArg,
     /// Print only the results.
     #[arg(long, short)]
     quiet: bool,
@@ -309,6 +334,9 @@ fn run(args: &RunArgs) -> Result<()> {
             bail!("--decoder eeg needs an accuracy below 1; the scenario asks for 1");
         }
     }
+    if let Some(e) = args.eeg {
+        scenario.eeg = e.mode();
+    }
     if let Some(p) = &args.save {
         check_extension(p, "rrd", "--save")?;
     }
@@ -434,6 +462,7 @@ fn table1(args: &Table1Args) -> Result<()> {
             DecoderArg::Eeg => DecoderChoice::Eeg,
             DecoderArg::Oracle => DecoderChoice::Oracle,
         },
+        eeg: args.eeg.mode(),
         params: errp_sim::GridTaskParams::default(),
     };
     let quiet = args.quiet;

@@ -4,11 +4,10 @@
 use std::sync::LazyLock;
 
 use divan::{Bencher, black_box};
-use errp_bci::Montage;
 use errp_robot::{Grid, QTable};
 use errp_sim::{
-    AssessmentDecoder, CalibrationRequest, EegDecoder, FIXED_PAIRS, GridTaskParams, PErrorMapping,
-    run_calibration, run_grid_episode,
+    AssessmentDecoder, CalibrationRequest, EegDecoder, EpochBank, FIXED_PAIRS, GridTaskParams,
+    PErrorChoice, run_calibration, run_grid_episode,
 };
 
 fn main() {
@@ -17,13 +16,10 @@ fn main() {
 
 static EEG: LazyLock<AssessmentDecoder> = LazyLock::new(|| {
     let report = run_calibration(&CalibrationRequest::new(0.7438, 1), |_| {}, None).unwrap();
-    AssessmentDecoder::Eeg(Box::new(EegDecoder {
-        generator: report.generator,
-        montage: Montage::standard(),
-        preprocessor: report.calibrated.session.preprocessor,
-        model: report.calibrated.model,
-        p_error: PErrorMapping::Platt(report.calibrated.platt),
-    }))
+    AssessmentDecoder::Eeg(Box::new(EegDecoder::from_report(
+        &report,
+        PErrorChoice::Platt,
+    )))
 });
 
 fn episodes(bencher: Bencher, decoder: &AssessmentDecoder) {
@@ -42,6 +38,21 @@ fn episodes(bencher: Bencher, decoder: &AssessmentDecoder) {
 #[divan::bench(sample_count = 30, sample_size = 1)]
 fn episode_eeg(bencher: Bencher) {
     episodes(bencher, &EEG);
+}
+
+static BANK: LazyLock<AssessmentDecoder> = LazyLock::new(|| {
+    let AssessmentDecoder::Eeg(d) = &*EEG else {
+        unreachable!()
+    };
+    let bank = EpochBank::build((**d).clone(), &GridTaskParams::default(), 1000, 1).unwrap();
+    AssessmentDecoder::EegBank(Box::new(bank))
+});
+
+/// One grid episode with the EEG decoder reading epochs drawn from a bank
+/// of 1000 per class streamed in advance.
+#[divan::bench]
+fn episode_eeg_bank(bencher: Bencher) {
+    episodes(bencher, &BANK);
 }
 
 /// One grid episode with the oracle decoder (no EEG).

@@ -9,20 +9,11 @@
 //!
 //! `cargo run -p errp_sim --example grid_sensitivity` (a few minutes).
 
-use errp_bci::Montage;
-use errp_robot::{Cell, Grid, QParams, QTable};
+use errp_robot::{Grid, QParams, QTable};
 use errp_sim::{
-    AssessmentDecoder, CalibrationRequest, EegDecoder, GridTaskParams, PErrorMapping, mean_sd,
-    run_calibration, run_grid_episode,
+    AssessmentDecoder, CalibrationRequest, EegDecoder, FIXED_PAIRS, GridTaskParams, PErrorChoice,
+    mean_sd, run_calibration, run_grid_episode,
 };
-
-const PAIRS: [((usize, usize), (usize, usize)); 5] = [
-    ((0, 0), (4, 4)),
-    ((4, 0), (0, 4)),
-    ((0, 2), (4, 2)),
-    ((2, 0), (2, 4)),
-    ((1, 3), (3, 1)),
-];
 
 struct Variant {
     label: &'static str,
@@ -96,19 +87,12 @@ fn main() {
     for accuracy in [0.7438, 0.90] {
         let report = run_calibration(&CalibrationRequest::new(accuracy, 3), |_| {}, None)
             .expect("calibration");
-        let eeg = |mapping| {
-            AssessmentDecoder::Eeg(Box::new(EegDecoder {
-                generator: report.generator.clone(),
-                montage: Montage::standard(),
-                preprocessor: report.calibrated.session.preprocessor.clone(),
-                model: report.calibrated.model.clone(),
-                p_error: mapping,
-            }))
-        };
+        let eeg =
+            |choice| AssessmentDecoder::Eeg(Box::new(EegDecoder::from_report(&report, choice)));
         for v in &variants {
             let decoder = match v.platt {
-                Some(true) => eeg(PErrorMapping::Platt(report.calibrated.platt)),
-                Some(false) => eeg(PErrorMapping::Sigmoid),
+                Some(true) => eeg(PErrorChoice::Platt),
+                Some(false) => eeg(PErrorChoice::Sigmoid),
                 None => AssessmentDecoder::Oracle { accuracy },
             };
             let mut params = GridTaskParams::default();
@@ -122,17 +106,9 @@ fn main() {
             let mut reached = 0;
             let mut actions = Vec::new();
             for k in 0..100 {
-                let (s, g) = PAIRS[k % PAIRS.len()];
-                let r = run_grid_episode(
-                    Cell::new(s.0, s.1),
-                    Cell::new(g.0, g.1),
-                    &table,
-                    &params,
-                    &decoder,
-                    9000 + k as u64,
-                    false,
-                )
-                .expect("episode");
+                let (s, g) = FIXED_PAIRS[k % FIXED_PAIRS.len()];
+                let r = run_grid_episode(s, g, &table, &params, &decoder, 9000 + k as u64, false)
+                    .expect("episode");
                 reached += usize::from(r.reached());
                 actions.push(r.actions as f64);
             }

@@ -1,15 +1,15 @@
 //! Running a grid scenario: calibrate the decoder (EEG) or not (oracle), then
 //! every episode, each from its own derived seed.
 
-use errp_bci::{Accuracy, Montage, TargetingStep, rng::derive_seed};
+use errp_bci::{Accuracy, TargetingStep, rng::derive_seed};
 use errp_robot::{Grid, QTable};
 
 use crate::calibration::{CalibrationReport, CalibrationRequest, run_calibration};
 use crate::error::Result;
 use crate::grid_task::{
-    AssessmentDecoder, EegDecoder, GridEpisodeResult, PErrorMapping, run_grid_episode,
+    AssessmentDecoder, EegDecoder, EpochBank, GridEpisodeResult, run_grid_episode,
 };
-use crate::scenario::{DecoderChoice, PErrorChoice, Scenario};
+use crate::scenario::{DecoderChoice, EegMode, Scenario};
 
 /// Everything a grid run produced.
 #[derive(Debug, Clone)]
@@ -76,16 +76,16 @@ pub fn prepare_decoder(
         DecoderChoice::Eeg => {
             let request = CalibrationRequest::new(scenario.accuracy, scenario.seed);
             let report = run_calibration(&request, progress, None)?;
-            let decoder = AssessmentDecoder::Eeg(Box::new(EegDecoder {
-                generator: report.generator.clone(),
-                montage: Montage::standard(),
-                preprocessor: report.calibrated.session.preprocessor.clone(),
-                model: report.calibrated.model.clone(),
-                p_error: match scenario.p_error {
-                    PErrorChoice::Sigmoid => PErrorMapping::Sigmoid,
-                    PErrorChoice::Platt => PErrorMapping::Platt(report.calibrated.platt),
-                },
-            }));
+            let eeg = EegDecoder::from_report(&report, scenario.p_error);
+            let decoder = match scenario.eeg {
+                EegMode::Stream => AssessmentDecoder::Eeg(Box::new(eeg)),
+                EegMode::Bank => AssessmentDecoder::EegBank(Box::new(EpochBank::build(
+                    eeg,
+                    &scenario.params,
+                    scenario.bank_per_class,
+                    scenario.seed,
+                )?)),
+            };
             Ok((decoder, Some(report)))
         }
     }

@@ -10,7 +10,9 @@ use errp_robot::{Cell, Grid, GridAction, GridControlParams, GridController, QTab
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
+use crate::calibration::CalibrationReport;
 use crate::error::{Result, SimError};
+use crate::scenario::PErrorChoice;
 
 /// Timing and limits of a grid episode.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -51,8 +53,78 @@ pub enum AssessmentDecoder {
         accuracy: f64,
     },
     /// Synthetic EEG through the real preprocessing and decoder, as trained
-    /// on a calibration session.
+    /// on a calibration session; each action's EEG is streamed (the whole
+    /// inter-action interval) when the action happens.
     Eeg(Box<EegDecoder>),
+    /// The same decoder applied to epochs drawn from a bank of synthetic
+    /// epochs streamed and preprocessed in advance (one per class of
+    /// assessment): the decoder still reads real synthetic EEG for every
+    /// action, but no EEG is synthesised during the episode. For Monte Carlo
+    /// speed; epochs are reused across episodes.
+    EegBank(Box<EpochBank>),
+}
+
+/// Preprocessed epochs of each assessment class, ready to be decoded.
+#[derive(Debug, Clone)]
+pub struct EpochBank {
+    /// The decoder that reads them.
+    pub decoder: EegDecoder,
+    error: Vec<(Vec<f64>, Vec<f64>)>,
+    correct: Vec<(Vec<f64>, Vec<f64>)>,
+}
+
+impl EpochBank {
+    /// Streams `per_class` error and `per_class` correct assessments (in a
+    /// seeded random order, at the task's inter-action intervals) through the
+    /// generator and the preprocessor and keeps each epoch's features and
+    /// its FCz trace.
+    pub fn build(
+        decoder: EegDecoder,
+        params: &GridTaskParams,
+        per_class: usize,
+        seed: u64,
+    ) -> Result<Self> {
+        if per_class == 0 {
+            return Err(SimError::Scenario(
+                "an epoch bank needs at least one epoch per class".into(),
+            ));
+        }
+        let mut stream_eeg = OnlineEeg::start(&decoder, derive_seed(seed, "grid/bank", 0))?;
+        let mut rng = stream(seed, "grid/bank/order");
+        let mut error = Vec::with_capacity(per_class);
+        let mut correct = Vec::with_capacity(per_class);
+        while error.len() < per_class || correct.len() < per_class {
+            let want_error = if error.len() == per_class {
+                false
+            } else if correct.len() == per_class {
+                true
+            } else {
+                rng.random_bool(0.5)
+            };
+            let interval = rng.random_range(params.interval_min_secs..=params.interval_max_secs);
+            let epoch = stream_eeg.epoch(want_error, interval, true);
+            if want_error {
+                error.push(epoch);
+            } else {
+                correct.push(epoch);
+            }
+        }
+        Ok(Self {
+            decoder,
+            error,
+            correct,
+        })
+    }
+
+    /// Epochs per class.
+    pub fn len(&self) -> usize {
+        self.error.len().min(self.correct.len())
+    }
+
+    /// True if the bank holds no epochs.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
 }
 
 /// The calibrated EEG pipeline used online.
@@ -68,6 +140,23 @@ pub struct EegDecoder {
     pub model: LdaModel,
     /// How decision values become p(error).
     pub p_error: PErrorMapping,
+}
+
+impl EegDecoder {
+    /// The online decoder a calibration produced, with p(error) mapped as
+    /// `choice` says.
+    pub fn from_report(report: &CalibrationReport, choice: PErrorChoice) -> Self {
+        Self {
+            generator: report.generator.clone(),
+            montage: Montage::standard(),
+            preprocessor: report.calibrated.session.preprocessor.clone(),
+            model: report.calibrated.model.clone(),
+            p_error: match choice {
+                PErrorChoice::Sigmoid => PErrorMapping::Sigmoid,
+                PErrorChoice::Platt => PErrorMapping::Platt(report.calibrated.platt),
+            },
+        }
+    }
 }
 
 /// How the decoder's decision value y becomes p(error).
@@ -161,7 +250,11 @@ pub fn run_grid_episode(
     let mut rng_user = stream(seed, "grid/user");
     let mut rng_policy = stream(seed, "grid/policy");
     let mut rng_oracle = stream(seed, "grid/oracle");
-    let mut online = OnlineEeg::new(decoder, seed)?;
+    let mut rng_bank = stream(seed, "grid/bank/draw");
+    let mut online = match decoder {
+        AssessmentDecoder::Eeg(d) => Some(OnlineEeg::start(d, derive_seed(seed, "grid/eeg", 0))?),
+        _ => None,
+    };
 
     let mut cell = start;
     let mut visits = vec![0u32; grid.n_cells()];
@@ -186,8 +279,26 @@ pub fn run_grid_episode(
                 };
                 (p, says_error, Vec::new())
             }
-            (AssessmentDecoder::Eeg(_), Some(eeg)) => eeg.decode(error, interval, record_steps),
+            (AssessmentDecoder::Eeg(d), Some(eeg)) => {
+                let (x, fcz) = eeg.epoch(error, interval, record_steps);
+                let (p, says) = decide(d, &x);
+                (p, says, fcz)
+            }
             (AssessmentDecoder::Eeg(_), None) => unreachable!("EEG decoder without a stream"),
+            (AssessmentDecoder::EegBank(bank), _) => {
+                let pool = if error { &bank.error } else { &bank.correct };
+                let (x, fcz) = &pool[rng_bank.random_range(0..pool.len())];
+                let (p, says) = decide(&bank.decoder, x);
+                (
+                    p,
+                    says,
+                    if record_steps {
+                        fcz.clone()
+                    } else {
+                        Vec::new()
+                    },
+                )
+            }
         };
         controller.observe(cell, action, p_error)?;
         let to = grid.step(cell, action);
@@ -228,27 +339,29 @@ pub fn run_grid_episode(
     })
 }
 
-/// The EEG stream of one episode.
-struct OnlineEeg<'a> {
+/// The decoder's p(error) and class for one epoch's features.
+fn decide(d: &EegDecoder, features: &[f64]) -> (f64, bool) {
+    let y = d.model.decision(features);
+    let p = match d.p_error {
+        PErrorMapping::Sigmoid => errp_bci::sigmoid(y),
+        PErrorMapping::Platt(s) => s.p_error(y),
+    };
+    (p, y >= 0.0)
+}
+
+/// A continuous EEG stream through the decoder's preprocessing.
+struct OnlineEeg {
     generator: EegGenerator,
     preprocessor: Preprocessor,
-    model: &'a LdaModel,
-    mapping: PErrorMapping,
     window: EpochWindow,
     fcz_row: usize,
 }
 
-impl<'a> OnlineEeg<'a> {
-    fn new(decoder: &'a AssessmentDecoder, seed: u64) -> Result<Option<Self>> {
-        let AssessmentDecoder::Eeg(d) = decoder else {
-            return Ok(None);
-        };
+impl OnlineEeg {
+    /// Starts a stream and lets the filters settle.
+    fn start(d: &EegDecoder, seed: u64) -> Result<Self> {
         let fs = d.generator.sfreq_hz;
-        let mut generator = EegGenerator::new(
-            d.generator.clone(),
-            &d.montage,
-            derive_seed(seed, "grid/eeg", 0),
-        )?;
+        let mut generator = EegGenerator::new(d.generator.clone(), &d.montage, seed)?;
         let mut preprocessor = d.preprocessor.clone();
         preprocessor.reset();
         preprocessor.process(&generator.generate((WARM_UP_SECS * fs) as usize));
@@ -258,20 +371,18 @@ impl<'a> OnlineEeg<'a> {
             .iter()
             .position(|&o| o == fcz)
             .unwrap_or(0);
-        Ok(Some(Self {
+        Ok(Self {
             generator,
             preprocessor,
-            model: &d.model,
-            mapping: d.p_error,
             window: EpochWindow::paper(fs),
             fcz_row,
-        }))
+        })
     }
 
-    /// Streams the EEG from this action's onset to the next one (the whole
-    /// inter-action interval, so filters see continuous EEG) and decodes the
-    /// epoch at the onset. Returns p(error), the decoded class and FCz.
-    fn decode(&mut self, error: bool, interval_secs: f64, keep_fcz: bool) -> (f64, bool, Vec<f64>) {
+    /// Schedules an assessment now, streams the EEG up to the next action
+    /// (the whole inter-action interval, so filters see continuous EEG) and
+    /// returns the epoch's features and, if asked, its preprocessed FCz.
+    fn epoch(&mut self, error: bool, interval_secs: f64, keep_fcz: bool) -> (Vec<f64>, Vec<f64>) {
         let fs = self.generator.params().sfreq_hz;
         let onset = self.generator.now_secs();
         self.generator.schedule(Assessment {
@@ -285,16 +396,12 @@ impl<'a> OnlineEeg<'a> {
         let n = ((interval_secs * fs).round() as usize).max(self.window.span());
         let raw = self.generator.generate(n);
         let clean = self.preprocessor.process(&raw);
-        let y = self.model.decision(&self.window.extract(&clean, 0));
-        let p = match self.mapping {
-            PErrorMapping::Sigmoid => errp_bci::sigmoid(y),
-            PErrorMapping::Platt(s) => s.p_error(y),
-        };
+        let features = self.window.extract(&clean, 0);
         let fcz = if keep_fcz {
             clean.channel(self.fcz_row)[..self.window.span()].to_vec()
         } else {
             Vec::new()
         };
-        (p, y >= 0.0, fcz)
+        (features, fcz)
     }
 }

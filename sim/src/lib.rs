@@ -21,13 +21,13 @@ pub use calibration_view::{LATENCY_TIMELINE, calibration_recording, record_calib
 pub use error::{Result, SimError};
 pub use grid_run::{GridRunReport, mean_sd, prepare_decoder, run_grid_scenario};
 pub use grid_task::{
-    AssessmentDecoder, EegDecoder, GridEpisodeResult, GridStep, GridTaskParams, PErrorMapping,
-    run_grid_episode,
+    AssessmentDecoder, EegDecoder, EpochBank, GridEpisodeResult, GridStep, GridTaskParams,
+    PErrorMapping, run_grid_episode,
 };
 pub use grid_view::{SIM_TIME, grid_recording, record_grid_run};
 pub use output::PendingFile;
 pub use record::RrdFile;
-pub use scenario::{DecoderChoice, PErrorChoice, Scenario};
+pub use scenario::{DecoderChoice, EegMode, PErrorChoice, Scenario};
 pub use stats::{incomplete_beta, pearson};
 pub use table1::{
     FIXED_PAIRS, PAPER, Table1Cell, Table1Options, accuracy_time_correlation, run_table1,

@@ -39,6 +39,10 @@ struct ScenarioFile {
     decoder: DecoderChoice,
     #[serde(default = "default_p_error")]
     p_error: PErrorChoice,
+    #[serde(default = "default_eeg_mode")]
+    eeg: EegMode,
+    #[serde(default = "default_bank_per_class")]
+    bank_per_class: usize,
     user: UserFile,
     #[serde(default)]
     episode: Vec<EpisodeFile>,
@@ -61,8 +65,25 @@ fn default_decoder() -> DecoderChoice {
 fn default_p_error() -> PErrorChoice {
     PErrorChoice::Platt
 }
+fn default_eeg_mode() -> EegMode {
+    EegMode::Stream
+}
+fn default_bank_per_class() -> usize {
+    1000
+}
 fn default_repeats() -> usize {
     1
+}
+
+/// How the EEG reaches the decoder during episodes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EegMode {
+    /// Synthesised when each action happens, the whole inter-action
+    /// interval streamed (the default; faithful, ~0.7 ms per action).
+    Stream,
+    /// Drawn from a bank of epochs streamed in advance (fast, for sweeps).
+    Bank,
 }
 
 /// How the EEG decoder's decision value becomes p(error).
@@ -141,6 +162,10 @@ pub struct Scenario {
     pub decoder: DecoderChoice,
     /// p(error) mapping of the EEG decoder.
     pub p_error: PErrorChoice,
+    /// Streamed or banked EEG.
+    pub eeg: EegMode,
+    /// Epochs per class in the bank (bank mode).
+    pub bank_per_class: usize,
     /// The decoder's mean accuracy, in (0.5, 1] (1 only for the oracle).
     pub accuracy: f64,
     /// Who the accuracy comes from ("accuracy 0.7438", "subject S2, fixed goals").
@@ -351,6 +376,13 @@ impl Scenario {
                 "at least one [[episode]] with start and goal, or a [free_goals] table",
             ));
         }
+        if file.bank_per_class == 0 {
+            return Err(bad(
+                "bank_per_class",
+                "0".into(),
+                "at least 1 (default 1000)",
+            ));
+        }
         if file.repeats == 0 {
             return Err(bad("repeats", "0".into(), "at least 1"));
         }
@@ -367,6 +399,8 @@ impl Scenario {
             seed: file.seed,
             decoder: file.decoder,
             p_error: file.p_error,
+            eeg: file.eeg,
+            bank_per_class: file.bank_per_class,
             accuracy,
             user,
             episodes,

@@ -9,7 +9,7 @@ use rayon::prelude::*;
 use crate::error::Result;
 use crate::grid_run::{mean_sd, prepare_decoder};
 use crate::grid_task::{GridEpisodeResult, GridTaskParams, run_grid_episode};
-use crate::scenario::{DecoderChoice, PErrorChoice, Scenario};
+use crate::scenario::{DecoderChoice, EegMode, PErrorChoice, Scenario};
 use crate::stats::pearson;
 
 /// The five fixed start/goal pairs (`scenarios/grid_fixed_goals.toml`).
@@ -95,6 +95,8 @@ pub struct Table1Options {
     pub seed: u64,
     /// EEG (default) or oracle decoder.
     pub decoder: DecoderChoice,
+    /// Streamed (default) or banked EEG.
+    pub eeg: EegMode,
     /// Strategy and timing.
     pub params: GridTaskParams,
 }
@@ -153,6 +155,8 @@ pub fn run_table1(
                 seed: cell_seed,
                 decoder: options.decoder,
                 p_error: PErrorChoice::Platt,
+                eeg: options.eeg,
+                bank_per_class: 1000,
                 accuracy: *accuracy,
                 user: name.clone(),
                 episodes: Vec::new(),

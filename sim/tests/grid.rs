@@ -1,30 +1,19 @@
 //! The grid task with the EEG decoder in the loop: statistical and
 //! determinism checks with fixed seeds.
 
-use errp_bci::{Accuracy, Montage};
+use errp_bci::Accuracy;
 use errp_robot::{Cell, Grid, QTable};
 use errp_sim::{
-    AssessmentDecoder, CalibrationRequest, EegDecoder, GridTaskParams, PErrorMapping,
+    AssessmentDecoder, CalibrationRequest, EegDecoder, FIXED_PAIRS, GridTaskParams, PErrorChoice,
     run_calibration, run_grid_episode,
 };
 
-const PAIRS: [((usize, usize), (usize, usize)); 5] = [
-    ((0, 0), (4, 4)),
-    ((4, 0), (0, 4)),
-    ((0, 2), (4, 2)),
-    ((2, 0), (2, 4)),
-    ((1, 3), (3, 1)),
-];
-
 fn eeg_decoder(accuracy: f64, seed: u64) -> AssessmentDecoder {
     let report = run_calibration(&CalibrationRequest::new(accuracy, seed), |_| {}, None).unwrap();
-    AssessmentDecoder::Eeg(Box::new(EegDecoder {
-        generator: report.generator,
-        montage: Montage::standard(),
-        preprocessor: report.calibrated.session.preprocessor,
-        model: report.calibrated.model,
-        p_error: PErrorMapping::Platt(report.calibrated.platt),
-    }))
+    AssessmentDecoder::Eeg(Box::new(EegDecoder::from_report(
+        &report,
+        PErrorChoice::Platt,
+    )))
 }
 
 fn table(params: &GridTaskParams) -> QTable {
@@ -36,17 +25,8 @@ fn episodes(decoder: &AssessmentDecoder, n: usize, seed: u64) -> Vec<errp_sim::G
     let t = table(&params);
     (0..n)
         .map(|k| {
-            let (s, g) = PAIRS[k % PAIRS.len()];
-            run_grid_episode(
-                Cell::new(s.0, s.1),
-                Cell::new(g.0, g.1),
-                &t,
-                &params,
-                decoder,
-                seed * 1000 + k as u64,
-                false,
-            )
-            .unwrap()
+            let (s, g) = FIXED_PAIRS[k % FIXED_PAIRS.len()];
+            run_grid_episode(s, g, &t, &params, decoder, seed * 1000 + k as u64, false).unwrap()
         })
         .collect()
 }
@@ -125,6 +105,7 @@ fn table1_gives_the_same_results_on_one_and_two_threads() {
         repeats: 1,
         seed: 4,
         decoder: errp_sim::DecoderChoice::Oracle,
+        eeg: errp_sim::EegMode::Stream,
         params: GridTaskParams::default(),
     };
     let on = |threads| {
@@ -140,4 +121,48 @@ fn table1_gives_the_same_results_on_one_and_two_threads() {
         assert_eq!((&a.subject, a.goals), (&b.subject, b.goals));
         assert_eq!(a.runs, b.runs, "{} {:?}", a.subject, a.goals);
     }
+}
+
+#[test]
+fn banked_epochs_give_the_streamed_accuracy_and_reach_the_goals() {
+    let report = run_calibration(&CalibrationRequest::new(0.90, 7), |_| {}, None).unwrap();
+    let eeg = EegDecoder::from_report(&report, PErrorChoice::Platt);
+    let bank = errp_sim::EpochBank::build(eeg, &GridTaskParams::default(), 400, 7).unwrap();
+    assert_eq!(bank.len(), 400);
+    let decoder = AssessmentDecoder::EegBank(Box::new(bank));
+    let results = episodes(&decoder, 20, 7);
+    assert!(results.iter().all(|r| r.reached()));
+    let acc = pooled(&results);
+    assert!(
+        (acc.mean() - 0.90).abs() <= 0.05,
+        "bank online accuracy {}",
+        acc.mean()
+    );
+}
+
+#[test]
+fn a_decoder_without_errps_converges_to_the_right_goal_only_by_chance() {
+    // No ErrP at all (ratio 0): the real decoder is at chance.
+    use errp_bci::{CalibrationSetup, GeneratorParams, LdaDecoder, SessionOptions, calibrate};
+    let setup = CalibrationSetup {
+        generator: GeneratorParams {
+            errp_to_noise: 0.0,
+            ..GeneratorParams::default()
+        },
+        ..CalibrationSetup::default()
+    };
+    let c = calibrate(&LdaDecoder::default(), &setup, 5, SessionOptions::default()).unwrap();
+    let eeg = EegDecoder {
+        generator: setup.generator.clone(),
+        montage: setup.montage.clone(),
+        preprocessor: c.session.preprocessor.clone(),
+        model: c.model.clone(),
+        p_error: errp_sim::PErrorMapping::Platt(c.platt),
+    };
+    let bank = errp_sim::EpochBank::build(eeg, &GridTaskParams::default(), 300, 5).unwrap();
+    let decoder = AssessmentDecoder::EegBank(Box::new(bank));
+    let results = episodes(&decoder, 50, 5);
+    let right = results.iter().filter(|r| r.reached()).count();
+    // 1 in 25 by chance (2 expected in 50); 8 or more would be p < 0.001.
+    assert!(right < 8, "{right}/50 right goals with a chance decoder");
 }
