@@ -40,23 +40,28 @@ pub fn mean_sd(xs: &[f64]) -> (f64, f64) {
 impl GridRunReport {
     /// The decoder's accuracy pooled over every action of every episode.
     pub fn online_accuracy(&self) -> Accuracy {
-        let (mut ch, mut cn, mut eh, mut en) = (0.0, 0, 0.0, 0);
-        for r in &self.episodes {
-            if r.online.n_correct > 0 {
-                ch += r.online.correct * r.online.n_correct as f64;
-                cn += r.online.n_correct;
-            }
-            if r.online.n_error > 0 {
-                eh += r.online.error * r.online.n_error as f64;
-                en += r.online.n_error;
-            }
+        pooled_accuracy(&self.episodes)
+    }
+}
+
+/// The decoder's accuracy pooled over every action of `episodes`.
+pub fn pooled_accuracy(episodes: &[GridEpisodeResult]) -> Accuracy {
+    let (mut ch, mut cn, mut eh, mut en) = (0.0, 0, 0.0, 0);
+    for r in episodes {
+        if r.online.n_correct > 0 {
+            ch += r.online.correct * r.online.n_correct as f64;
+            cn += r.online.n_correct;
         }
-        Accuracy {
-            correct: ch / cn.max(1) as f64,
-            error: eh / en.max(1) as f64,
-            n_correct: cn,
-            n_error: en,
+        if r.online.n_error > 0 {
+            eh += r.online.error * r.online.n_error as f64;
+            en += r.online.n_error;
         }
+    }
+    Accuracy {
+        correct: ch / cn.max(1) as f64,
+        error: eh / en.max(1) as f64,
+        n_correct: cn,
+        n_error: en,
     }
 }
 

@@ -19,7 +19,7 @@ mod table1;
 pub use calibration::{CalibrationReport, CalibrationRequest, run_calibration};
 pub use calibration_view::{LATENCY_TIMELINE, calibration_recording, record_calibration};
 pub use error::{Result, SimError};
-pub use grid_run::{GridRunReport, mean_sd, prepare_decoder, run_grid_scenario};
+pub use grid_run::{GridRunReport, mean_sd, pooled_accuracy, prepare_decoder, run_grid_scenario};
 pub use grid_task::{
     AssessmentDecoder, EegDecoder, EpochBank, GridEpisodeResult, GridStep, GridTaskParams,
     PErrorMapping, run_grid_episode,
@@ -27,7 +27,7 @@ pub use grid_task::{
 pub use grid_view::{SIM_TIME, grid_recording, record_grid_run};
 pub use output::PendingFile;
 pub use record::RrdFile;
-pub use scenario::{DecoderChoice, EegMode, PErrorChoice, Scenario};
+pub use scenario::{DecoderChoice, EegMode, PErrorChoice, Scenario, free_pairs};
 pub use stats::{incomplete_beta, pearson};
 pub use table1::{
     FIXED_PAIRS, PAPER, Table1Cell, Table1Options, accuracy_time_correlation, run_table1,

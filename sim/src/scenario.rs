@@ -8,7 +8,7 @@
 use std::path::{Path, PathBuf};
 
 use errp_bci::{GoalSet, subject};
-use errp_robot::{Cell, GridControlParams, QParams};
+use errp_robot::{Cell, Grid, GridControlParams, QParams};
 use rand::Rng;
 use serde::Deserialize;
 
@@ -360,14 +360,7 @@ impl Scenario {
                 return Err(bad("free_goals.count", "0".into(), "at least 1"));
             }
             let mut rng = errp_bci::rng::stream(file.seed, "scenario/free-goals");
-            for _ in 0..free.count {
-                let s = grid.cell(rng.random_range(0..grid.n_cells()));
-                let mut g = s;
-                while g == s {
-                    g = grid.cell(rng.random_range(0..grid.n_cells()));
-                }
-                pairs.push((s, g));
-            }
+            pairs.extend(free_pairs(&grid, free.count, &mut rng));
         }
         if pairs.is_empty() {
             return Err(bad(
@@ -407,6 +400,21 @@ impl Scenario {
             params,
         })
     }
+}
+
+/// `count` start/goal pairs as a user choosing freely might: both cells
+/// uniform on the grid, the goal different from the start.
+pub fn free_pairs(grid: &Grid, count: usize, rng: &mut impl Rng) -> Vec<(Cell, Cell)> {
+    (0..count)
+        .map(|_| {
+            let s = grid.cell(rng.random_range(0..grid.n_cells()));
+            let mut g = s;
+            while g == s {
+                g = grid.cell(rng.random_range(0..grid.n_cells()));
+            }
+            (s, g)
+        })
+        .collect()
 }
 
 #[cfg(test)]

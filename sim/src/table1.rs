@@ -3,13 +3,12 @@
 
 use errp_bci::{GoalSet, TargetingStep, rng::derive_seed, subjects};
 use errp_robot::{Cell, Grid, QTable};
-use rand::Rng;
 use rayon::prelude::*;
 
 use crate::error::Result;
 use crate::grid_run::{mean_sd, prepare_decoder};
 use crate::grid_task::{GridEpisodeResult, GridTaskParams, run_grid_episode};
-use crate::scenario::{DecoderChoice, EegMode, PErrorChoice, Scenario};
+use crate::scenario::{DecoderChoice, EegMode, PErrorChoice, Scenario, free_pairs};
 use crate::stats::pearson;
 
 /// The five fixed start/goal pairs (`scenarios/grid_fixed_goals.toml`).
@@ -134,19 +133,11 @@ pub fn run_table1(
             let cell_seed = derive_seed(options.seed, "table1/cell", *k as u64);
             let pairs: Vec<(Cell, Cell)> = match goals {
                 GoalSet::Fixed => FIXED_PAIRS.to_vec(),
-                GoalSet::Free => {
-                    let mut rng = errp_bci::rng::stream(cell_seed, "table1/free-goals");
-                    (0..5)
-                        .map(|_| {
-                            let s = grid.cell(rng.random_range(0..grid.n_cells()));
-                            let mut g = s;
-                            while g == s {
-                                g = grid.cell(rng.random_range(0..grid.n_cells()));
-                            }
-                            (s, g)
-                        })
-                        .collect()
-                }
+                GoalSet::Free => free_pairs(
+                    &grid,
+                    5,
+                    &mut errp_bci::rng::stream(cell_seed, "table1/free-goals"),
+                ),
             };
             let scenario = Scenario {
                 path: "table1".into(),

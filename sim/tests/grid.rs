@@ -32,24 +32,7 @@ fn episodes(decoder: &AssessmentDecoder, n: usize, seed: u64) -> Vec<errp_sim::G
 }
 
 fn pooled(results: &[errp_sim::GridEpisodeResult]) -> Accuracy {
-    let mut correct = (0.0, 0usize);
-    let mut error = (0.0, 0usize);
-    for r in results {
-        if r.online.n_correct > 0 {
-            correct.0 += r.online.correct * r.online.n_correct as f64;
-            correct.1 += r.online.n_correct;
-        }
-        if r.online.n_error > 0 {
-            error.0 += r.online.error * r.online.n_error as f64;
-            error.1 += r.online.n_error;
-        }
-    }
-    Accuracy {
-        correct: correct.0 / correct.1 as f64,
-        error: error.0 / error.1 as f64,
-        n_correct: correct.1,
-        n_error: error.1,
-    }
+    errp_sim::pooled_accuracy(results)
 }
 
 #[test]
