@@ -9,10 +9,10 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
 use errp_bci::{EdfWriter, GoalSet, subject, subjects};
 use errp_sim::{
-    CalibrationRequest, DecoderChoice, EegMode, GridRunReport, PAPER, PendingFile, Scenario,
-    Table1Options, accuracy_time_correlation, calibration_recording, grid_recording, mean_sd,
-    prepare_decoder, record_calibration, record_grid_run, run_calibration, run_grid_scenario,
-    run_table1,
+    CalibrationRequest, DecoderChoice, EegMode, GridRunReport, PAPER, PAPER_POOLED, PendingFile,
+    Scenario, Table1Options, accuracy_time_correlation, calibration_recording, grid_recording,
+    mean_sd, prepare_decoder, record_calibration, record_grid_run, run_calibration,
+    run_grid_scenario, run_table1,
 };
 
 /// Simulated shared control of a robot from EEG error potentials.
@@ -521,19 +521,11 @@ fn table1(args: &Table1Args) -> Result<()> {
         let stat = |f: &dyn Fn(&errp_sim::GridEpisodeResult) -> f64| {
             mean_sd(&all.iter().map(|r| f(r)).collect::<Vec<_>>())
         };
-        let (paper_mean, paper_r, paper_p) = if set == GoalSet::Fixed {
-            (
-                [25.0, 13.0, 19.88, 10.75, 80.76, 73.68, 74.38, 4.66],
-                -0.47,
-                "0.038",
-            )
-        } else {
-            (
-                [21.0, 8.0, 16.40, 6.61, 66.63, 26.85, 77.67, 5.02],
-                -0.79,
-                "3e-5",
-            )
-        };
+        let (paper_mean, paper_r, paper_p) = PAPER_POOLED
+            .iter()
+            .find(|p| p.0 == set)
+            .map(|p| (p.1, p.2, p.3))
+            .expect("both goal sets are in the paper's table");
         let reached = all.iter().filter(|r| r.reached()).count();
         println!(
             "{:<10} {:>8}  {:>18}  {:>22}  {:>24}  {:>22}",
@@ -554,7 +546,7 @@ fn table1(args: &Table1Args) -> Result<()> {
         );
         let (r, p) = accuracy_time_correlation(&cells, set);
         println!(
-            "           accuracy vs total time ({set_name} goals): r = {r:.2}, p = {p:.2e}   [paper: r = {paper_r}, p = {paper_p}]"
+            "           accuracy vs total time ({set_name} goals): r = {r:.2}, p = {p:.2e}   [paper: r = {paper_r}, p = {paper_p:.2e}]"
         );
     }
     Ok(())

@@ -30,5 +30,6 @@ pub use record::RrdFile;
 pub use scenario::{DecoderChoice, EegMode, PErrorChoice, Scenario, free_pairs};
 pub use stats::{incomplete_beta, pearson};
 pub use table1::{
-    FIXED_PAIRS, PAPER, Table1Cell, Table1Options, accuracy_time_correlation, run_table1,
+    FIXED_PAIRS, PAPER, PAPER_POOLED, Table1Cell, Table1Options, accuracy_time_correlation,
+    run_table1,
 };

@@ -65,6 +65,24 @@ pub const PAPER: [(&str, GoalSet, [f64; 8]); 8] = [
     ),
 ];
 
+/// The paper's pooled rows of Table 1 (mean +- sd over the 20 runs of a goal
+/// set, same columns as [`PAPER`]) and its accuracy-vs-total-time
+/// correlation r and p (sec. 4.3).
+pub const PAPER_POOLED: [(GoalSet, [f64; 8], f64, f64); 2] = [
+    (
+        GoalSet::Fixed,
+        [25.0, 13.0, 19.88, 10.75, 80.76, 73.68, 74.38, 4.66],
+        -0.47,
+        0.038,
+    ),
+    (
+        GoalSet::Free,
+        [21.0, 8.0, 16.40, 6.61, 66.63, 26.85, 77.67, 5.02],
+        -0.79,
+        3e-5,
+    ),
+];
+
 /// One cell of the table: a subject on a goal set.
 #[derive(Debug, Clone)]
 pub struct Table1Cell {
