@@ -9,6 +9,10 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
 use errp_bci::{EdfWriter, GoalSet, subject, subjects};
 use errp_sim::{
+    AnyScenario, EpuckRecorder, EpuckScenario, PAPER_EPUCK, epuck_recording, load_scenario,
+    prepare_continuous_decoder, run_epuck_batch, run_epuck_once, summarise,
+};
+use errp_sim::{
     CalibrationRequest, DecoderChoice, EegMode, GridRunReport, PAPER, PAPER_POOLED, PendingFile,
     Scenario, Table1Options, accuracy_time_correlation, calibration_recording, grid_recording,
     mean_sd, prepare_decoder, record_calibration, record_grid_run, run_calibration,
@@ -32,8 +36,9 @@ enum Command {
     /// 400-action calibration session with 20 % errors, reaches the requested
     /// mean accuracy; then runs that session and reports per-class rates.
     Calibrate(CalibrateArgs),
-    /// Run a scenario: episodes of the grid task with the EEG decoder (or an
-    /// oracle) in the loop, printed per episode and summarised like Table 1.
+    /// Run a scenario: the e-puck in its arena steered by the sliding-window
+    /// ErrP decoder (sec. 5), or episodes of the grid task (sec. 4), printed
+    /// per run and summarised next to the paper.
     Run(RunArgs),
     /// Re-run Table 1: subjects S1-S4 at their accuracies on the fixed and
     /// free goals, side by side with the paper, with the accuracy-time
@@ -106,19 +111,31 @@ impl EegArg {
 
 #[derive(clap::Args)]
 struct RunArgs {
-    /// The scenario file (TOML), e.g. scenarios/grid_fixed_goals.toml.
+    /// The scenario file (TOML), e.g. scenarios/mexico_to_pisa.toml or
+    /// scenarios/grid_fixed_goals.toml.
     scenario: PathBuf,
     /// Override the scenario's seed.
     #[arg(long)]
     seed: Option<u64>,
-    /// Override the scenario's decoder.
+    /// Override the scenario's decoder (grid scenarios).
     #[arg(long, value_enum)]
     decoder: Option<DecoderArg>,
-    /// Override how the EEG reaches the decoder: streamed or from a bank.
+    /// Override the decoder's accuracy (mean of the per-class rates, in
+    /// (0.5, 1)).
+    #[arg(long, value_parser = parse_accuracy, allow_negative_numbers = true)]
+    accuracy: Option<f64>,
+    /// Override the number of runs (e-puck scenarios); each run has its own
+    /// seed derived from the scenario's.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=100_000))]
+    runs: Option<u64>,
+    /// Override how the EEG reaches the decoder: streamed or from a bank
+    /// (grid scenarios).
     #[arg(long, value_enum)]
     eeg: Option<EegArg>,
-    /// Record every episode to this `.rrd` (grid, cursor, goal, posterior,
-    /// visited states, p(error), EEG at FCz, event log).
+    /// Record every episode to this `.rrd`. Grid: cursor, goal, posterior,
+    /// visited states, p(error), EEG at FCz, event log. E-puck: arena,
+    /// cities coloured by belief, robot, trajectory, detected errors, belief
+    /// bars and series, p(error) and T_e, EEG at FCz and Cz, event log.
     #[arg(long, value_name = "FILE.rrd")]
     save: Option<PathBuf>,
     /// Print only the results.
@@ -321,9 +338,36 @@ fn calibrate(args: &CalibrateArgs) -> Result<()> {
 }
 
 fn run(args: &RunArgs) -> Result<()> {
-    let mut scenario = Scenario::load(&args.scenario)?;
+    match load_scenario(&args.scenario)? {
+        AnyScenario::Grid(s) => {
+            if args.runs.is_some() {
+                bail!(
+                    "--runs applies to e-puck scenarios; a grid scenario lists its episodes \
+                     (set `repeats` in {})",
+                    args.scenario.display()
+                );
+            }
+            run_grid(args, *s)
+        }
+        AnyScenario::Epuck(s) => {
+            if args.decoder.is_some() || args.eeg.is_some() {
+                bail!(
+                    "--decoder and --eeg apply to grid scenarios; the e-puck task always runs \
+                     the streamed EEG through the sliding-window SVM"
+                );
+            }
+            run_epuck(args, *s)
+        }
+    }
+}
+
+fn run_grid(args: &RunArgs, mut scenario: Scenario) -> Result<()> {
     if let Some(seed) = args.seed {
         scenario.seed = seed;
+    }
+    if let Some(a) = args.accuracy {
+        scenario.accuracy = a;
+        scenario.user = format!("accuracy {a} (--accuracy)");
     }
     if let Some(d) = args.decoder {
         scenario.decoder = match d {
@@ -547,6 +591,151 @@ fn table1(args: &Table1Args) -> Result<()> {
         let (r, p) = accuracy_time_correlation(&cells, set);
         println!(
             "           accuracy vs total time ({set_name} goals): r = {r:.2}, p = {p:.2e}   [paper: r = {paper_r}, p = {paper_p:.2e}]"
+        );
+    }
+    Ok(())
+}
+
+fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<()> {
+    if let Some(seed) = args.seed {
+        scenario.seed = seed;
+    }
+    if let Some(runs) = args.runs {
+        scenario.runs = runs as usize;
+    }
+    if let Some(a) = args.accuracy {
+        scenario.accuracy = a;
+    }
+    if let Some(p) = &args.save {
+        check_extension(p, "rrd", "--save")?;
+    }
+    let rrd = match &args.save {
+        Some(p) => Some(epuck_recording(p)?),
+        None => None,
+    };
+    let quiet = args.quiet;
+    let layout = &scenario.layout;
+    let start = &scenario.episode.start;
+    let goal = &layout.goals()[scenario.episode.goal].name;
+    if !quiet {
+        eprintln!(
+            "{}: e-puck from ({:.0}, {:.0}) cm to {goal}, {} run(s), decoder accuracy {:.2} %, seed {}",
+            scenario.name,
+            100.0 * start.x_m,
+            100.0 * start.y_m,
+            scenario.runs,
+            100.0 * scenario.accuracy,
+            scenario.seed
+        );
+    }
+    let (decoder, report) = prepare_continuous_decoder(&scenario, |s| {
+        if !quiet {
+            eprintln!(
+                "  calibrating: ErrP-to-noise {:.4} -> mean {:.2} %",
+                s.ratio,
+                100.0 * s.accuracy.mean()
+            );
+        }
+    })
+    .context("calibrating the continuous decoder")?;
+    let acc = report.calibrated.accuracy;
+    println!(
+        "SVM decoder calibrated on {} error + {} correct button-locked examples: correct {:.2} %, \
+         error {:.2} %, mean {:.2} % (cross-validated); {} support vectors",
+        acc.n_error,
+        acc.n_correct,
+        100.0 * acc.correct,
+        100.0 * acc.error,
+        100.0 * acc.mean(),
+        decoder.model.n_support()
+    );
+    let results = match &rrd {
+        Some(file) => {
+            let mut recorder =
+                EpuckRecorder::new(file, &scenario.arena, layout, scenario.params.control.t_e)?;
+            let mut out = Vec::with_capacity(scenario.runs);
+            for k in 0..scenario.runs {
+                recorder.next_run(&format!(
+                    "run {}: the user wants {goal} (decoder accuracy {:.2} %)",
+                    k + 1,
+                    100.0 * scenario.accuracy
+                ));
+                out.push(run_epuck_once(&scenario, &decoder, k, &mut recorder)?);
+            }
+            recorder.finish()?;
+            out
+        }
+        None => {
+            if !quiet && scenario.runs > 1 {
+                eprintln!("  running {} runs in parallel", scenario.runs);
+            }
+            run_epuck_batch(&scenario, &decoder, scenario.runs)?
+        }
+    };
+    println!(
+        "{:>4}  {:<16} {:>8}  {:>8} {:>6} {:>6} {:>6}  {:>8} {:>8}",
+        "run",
+        "converged on",
+        "time (s)",
+        "detected",
+        "false",
+        "missed",
+        "ErrPs",
+        "acc corr",
+        "acc err"
+    );
+    for (k, r) in results.iter().enumerate() {
+        let on = match r.committed {
+            Some(c) if c == r.goal => layout.goals()[c].name.clone(),
+            Some(c) => format!("{} WRONG", layout.goals()[c].name),
+            None => "time-out".into(),
+        };
+        println!(
+            "{:>4}  {:<16} {:>8.1}  {:>8} {:>6} {:>6} {:>6}  {:>8.1} {:>8.1}",
+            k + 1,
+            on,
+            r.time_secs,
+            r.detected_errors,
+            r.false_detections,
+            r.missed_errors,
+            r.errps,
+            100.0 * r.online.correct,
+            100.0 * r.online.error
+        );
+    }
+    let s = summarise(&results);
+    println!("Summary over {} run(s):", s.runs);
+    println!(
+        "  reached {goal}      {} / {} ({} converged on a wrong city)",
+        s.reached, s.runs, s.wrong
+    );
+    let paper = PAPER_EPUCK.iter().find(|p| p.0 == scenario.name);
+    let paper_note = |v: Option<String>| v.map(|v| format!("   [paper: {v}]")).unwrap_or_default();
+    println!(
+        "  median time (s)      {:.1}{}",
+        s.median_secs,
+        paper_note(paper.map(|p| format!("{:.0}", p.1)))
+    );
+    println!(
+        "  median detected      {:.1}{}",
+        s.median_detected,
+        paper_note(paper.map(|p| p.2.to_string()))
+    );
+    println!("  median false         {:.1}", s.median_false);
+    println!(
+        "  window accuracy      correct {:.2} %, error {:.2} % at T_e = {} ({} clean / {} ErrP windows)",
+        100.0 * s.online.correct,
+        100.0 * s.online.error,
+        scenario.params.control.t_e,
+        s.online.n_correct,
+        s.online.n_error
+    );
+    if let Some(file) = rrd {
+        let path = file.finish()?;
+        println!(
+            "Wrote {} (open with: rerun {})",
+            path.display(),
+            path.display()
         );
     }
     Ok(())

@@ -125,12 +125,16 @@ fn subjects_lists_table1() {
 }
 
 #[test]
-fn every_shipped_scenario_loads_and_runs_with_the_oracle() {
+fn every_shipped_grid_scenario_loads_and_runs_with_the_oracle() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
     let mut n = 0;
     for entry in std::fs::read_dir(&dir).unwrap() {
         let path = entry.unwrap().path();
-        if path.extension().and_then(|e| e.to_str()) != Some("toml") {
+        if path.extension().and_then(|e| e.to_str()) != Some("toml")
+            || std::fs::read_to_string(&path)
+                .unwrap()
+                .contains("task = \"epuck\"")
+        {
             continue;
         }
         n += 1;
@@ -173,5 +177,80 @@ fn a_broken_scenario_is_exit_2_naming_file_field_and_fix() {
     assert!(e.contains("0 <= x, y <= 4"), "{e}");
     assert!(!rrd.exists());
     assert_eq!(files_in(&dir), ["bad.toml"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn an_epuck_run_prints_the_outcome_and_the_papers_figures() {
+    let o = errp(&[
+        "run",
+        "scenarios/mexico_to_pisa.toml",
+        "--accuracy",
+        "0.95",
+        "--runs",
+        "2",
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    for want in [
+        "SVM decoder calibrated on 70 error + 70 correct",
+        "converged on",
+        "reached Pisa",
+        "[paper: 60]",
+        "[paper: 11]",
+        "window accuracy",
+    ] {
+        assert!(out.contains(want), "{want}: {out}");
+    }
+}
+
+#[test]
+fn a_broken_epuck_scenario_is_exit_2_naming_file_field_and_fix() {
+    let dir = temp_dir("epuck");
+    let rrd = dir.join("run.rrd");
+    for (text, field, fix) in [
+        (
+            "task = \"epuck\"\nstart = \"Mexico\"\ngoal = \"Atlantis\"\n[user]\naccuracy = 0.8\n",
+            "goal",
+            "Pisa",
+        ),
+        (
+            "task = \"epuck\"\nstart = \"Mexico\"\ngoal = \"Pisa\"\n[user]\naccuracy = 1.7\n",
+            "user.accuracy",
+            "between 0.5",
+        ),
+        (
+            "task = \"epuck\"\nstart = [20.0, 250.0]\ngoal = \"Pisa\"\n[user]\naccuracy = 0.8\n",
+            "start",
+            "inside the 200 cm arena",
+        ),
+    ] {
+        let path = dir.join("bad.toml");
+        std::fs::write(&path, text).unwrap();
+        let o = errp(&[
+            "run",
+            path.to_str().unwrap(),
+            "--save",
+            rrd.to_str().unwrap(),
+        ]);
+        assert_eq!(o.status.code(), Some(2), "{text}");
+        let e = stderr(&o);
+        assert!(
+            e.contains("bad.toml") && e.contains(field) && e.contains(fix),
+            "{e}"
+        );
+        assert!(!rrd.exists());
+        assert_eq!(files_in(&dir), ["bad.toml"]);
+    }
+    // Grid-only flags are refused for an e-puck scenario.
+    let o = errp(&[
+        "run",
+        "scenarios/mexico_to_pisa.toml",
+        "--decoder",
+        "oracle",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--decoder"), "{}", stderr(&o));
     std::fs::remove_dir_all(&dir).unwrap();
 }

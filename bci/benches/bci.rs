@@ -6,9 +6,9 @@ use std::sync::LazyLock;
 
 use divan::{Bencher, black_box};
 use errp_bci::{
-    Assessment, AssessmentKind, CalibrationParams, CalibrationSetup, EegGenerator, EpochWindow,
-    ErrorModel, GeneratorParams, LdaDecoder, LdaModel, Montage, Preprocessor, SessionOptions,
-    calibrate,
+    Assessment, AssessmentKind, CalibrationParams, CalibrationSetup, ContinuousFeatures,
+    ContinuousSetup, EegGenerator, EpochWindow, ErrorModel, GeneratorParams, LdaDecoder, LdaModel,
+    Montage, Preprocessor, SessionOptions, SvmDecoder, SvmModel, calibrate, calibrate_continuous,
 };
 
 fn main() {
@@ -101,5 +101,42 @@ fn action(bencher: Bencher, secs: f64) {
         let raw = g.generate(n);
         let clean = pre.process(&raw);
         black_box(t.model.p_error(&window.extract(&clean, 0)))
+    });
+}
+
+struct TrainedContinuous {
+    window: errp_bci::EegBlock,
+    model: SvmModel,
+}
+
+static TRAINED_CONTINUOUS: LazyLock<TrainedContinuous> = LazyLock::new(|| {
+    let setup = ContinuousSetup {
+        generator: GeneratorParams {
+            errp_to_noise: 1.0,
+            ..GeneratorParams::default()
+        },
+        ..ContinuousSetup::default()
+    };
+    let c = calibrate_continuous(&SvmDecoder::default(), &setup, 1).unwrap();
+    let mut g = EegGenerator::new(setup.generator.clone(), &setup.montage, 4).unwrap();
+    let mut pre = c.session.preprocessor.clone();
+    let window = pre.process(&g.generate(ContinuousFeatures::paper(FS as f64).span()));
+    TrainedContinuous {
+        window,
+        model: c.model,
+    }
+});
+
+/// One step of the continuous decoder's sliding window: the 512 features
+/// (temporal + theta PSD) of one preprocessed 800 ms window of the 8 decoding
+/// channels, and the SVM's p(error) (~130 support vectors, the paper's
+/// calibration of 70 examples per class).
+#[divan::bench(name = "continuous window: features + SVM p_error")]
+fn continuous_window(bencher: Bencher) {
+    let t = &*TRAINED_CONTINUOUS;
+    let features = ContinuousFeatures::paper(FS as f64);
+    bencher.bench_local(|| {
+        let x = features.extract(black_box(&t.window), 0);
+        black_box(t.model.p_error(&x))
     });
 }

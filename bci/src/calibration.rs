@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use crate::classify::{Classifier, ErrorModel, Features};
 use crate::erp::AssessmentKind;
 use crate::error::{Result, check};
-use crate::features::EpochWindow;
+use crate::features::{EpochWindow, FeatureExtractor};
 use crate::generator::{Assessment, Components, EegBlock, EegGenerator, GeneratorParams};
 use crate::montage::Montage;
 use crate::platt::PlattScaling;
@@ -185,7 +185,8 @@ impl CalibrationSetup {
 /// A simulated calibration session, preprocessed and cut into features.
 #[derive(Debug, Clone)]
 pub struct CalibrationSession {
-    /// Temporal features, `(n_actions, 312)`.
+    /// Features, `(n_actions, n_features)`: 312 temporal ones for the
+    /// discrete decoder.
     pub features: Features,
     /// `true` where the action was erroneous.
     pub labels: Vec<bool>,
@@ -259,9 +260,56 @@ pub fn schedule(calib: &CalibrationParams, seed: u64) -> Vec<Assessment> {
 pub fn simulate_session(
     setup: &CalibrationSetup,
     seed: u64,
+    options: SessionOptions<'_>,
+) -> Result<CalibrationSession> {
+    setup.validate()?;
+    let assessments = schedule(&setup.calibration, seed);
+    let onsets: Vec<f64> = assessments.iter().map(|a| a.onset_secs).collect();
+    let window = EpochWindow::paper(setup.generator.sfreq_hz);
+    simulate_session_with(setup, seed, &assessments, &onsets, &window, options)
+}
+
+/// Simulates a session with a given schedule and feature extractor: EOG
+/// recording, preprocessor fit, then `assessments` (sorted by onset) streamed
+/// through the generator and the preprocessor in 1 s blocks, and one feature
+/// vector per assessment from the window that starts at the matching entry of
+/// `window_onsets_secs` (rounded to samples), labelled by the assessment.
+///
+/// Only `eog_session_secs` of `setup.calibration` is used (and validated with
+/// the rest); the schedule is the one given. Grand averages are locked to the
+/// assessment onsets.
+pub fn simulate_session_with(
+    setup: &CalibrationSetup,
+    seed: u64,
+    assessments: &[Assessment],
+    window_onsets_secs: &[f64],
+    features: &dyn FeatureExtractor,
     mut options: SessionOptions<'_>,
 ) -> Result<CalibrationSession> {
     setup.validate()?;
+    check(
+        window_onsets_secs.len() == assessments.len(),
+        "window_onsets_secs",
+        window_onsets_secs.len(),
+        &format!("one window per assessment ({})", assessments.len()),
+    )?;
+    check(
+        assessments
+            .windows(2)
+            .all(|w| w[0].onset_secs <= w[1].onset_secs)
+            && assessments
+                .iter()
+                .all(|a| a.onset_secs.is_finite() && a.onset_secs >= 0.0),
+        "assessments",
+        "unsorted",
+        "onsets (s) finite, >= 0 and sorted",
+    )?;
+    check(
+        window_onsets_secs.iter().all(|w| w.is_finite()),
+        "window_onsets_secs",
+        "not finite",
+        "finite onsets (s)",
+    )?;
     let (params, calib, preprocess, montage) = (
         &setup.generator,
         &setup.calibration,
@@ -280,16 +328,18 @@ pub fn simulate_session(
         None
     };
 
-    let assessments = schedule(calib, seed);
-    let window = EpochWindow::paper(fs);
     let ga_before = (0.2 * fs).round() as usize;
     let ga_len = ga_before + (0.8 * fs).round() as usize;
-    let last_onset = assessments.last().map_or(0.0, |a| a.onset_secs);
-    let total = ((last_onset * fs).ceil() as usize + window.span().max(ga_len) + 1).max(1);
+    let last_onset = assessments
+        .iter()
+        .map(|a| a.onset_secs)
+        .chain(window_onsets_secs.iter().copied())
+        .fold(0.0, f64::max);
+    let total = ((last_onset * fs).ceil() as usize + features.span().max(ga_len) + 1).max(1);
 
     let mut generator =
         EegGenerator::new(params.clone(), montage, seed)?.with_components(options.components);
-    for a in &assessments {
+    for a in assessments {
         generator.schedule(*a);
     }
     let block_len = fs as usize;
@@ -321,11 +371,11 @@ pub fn simulate_session(
         .iter()
         .map(|a| (a.onset_secs * fs).round() as usize)
         .collect();
-    let mut flat = Vec::with_capacity(onsets.len() * window.n_features(decoding.len()));
-    for &o in &onsets {
-        window.extract_into(&decoded, o, &mut flat);
+    let n_features = features.n_features(decoding.len());
+    let mut flat = Vec::with_capacity(onsets.len() * n_features);
+    for &w in window_onsets_secs {
+        features.extract_into(&decoded, (w * fs).round().max(0.0) as usize, &mut flat);
     }
-    let n_features = window.n_features(decoding.len());
     let features = DMatrix::from_row_slice(onsets.len(), n_features, &flat);
     let labels: Vec<bool> = assessments
         .iter()
@@ -378,7 +428,7 @@ pub fn simulate_session(
     Ok(CalibrationSession {
         features,
         labels,
-        assessments,
+        assessments: assessments.to_vec(),
         preprocessor,
         grand_average,
     })

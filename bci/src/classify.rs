@@ -40,6 +40,27 @@ pub fn sigmoid(y: f64) -> f64 {
     }
 }
 
+/// Dot product with eight independent accumulators: a plain running sum is
+/// bound by the latency of each addition (floating-point addition is not
+/// reassociated by the compiler), this one vectorises.
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    debug_assert_eq!(a.len(), b.len());
+    let mut acc = [0.0f64; 8];
+    let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
+    let tail: f64 = ca
+        .remainder()
+        .iter()
+        .zip(cb.remainder())
+        .map(|(x, y)| x * y)
+        .sum();
+    for (x, y) in ca.zip(cb) {
+        for k in 0..8 {
+            acc[k] += x[k] * y[k];
+        }
+    }
+    acc.iter().sum::<f64>() + tail
+}
+
 /// Checks the shapes and that both classes are present.
 pub(crate) fn check_training_set(x: &Features, labels: &[bool]) -> Result<(usize, usize)> {
     use crate::error::BciError;

@@ -1,6 +1,24 @@
-//! Temporal features of the discrete decoder (sec. 2.2.1).
+//! Temporal features of the discrete decoder (sec. 2.2.1), and the shape
+//! every feature extractor shares.
 
 use crate::generator::EegBlock;
+
+/// Something that turns the preprocessed EEG after an onset into a feature
+/// vector: the temporal features ([`EpochWindow`]) or the continuous
+/// decoder's temporal + PSD features
+/// ([`ContinuousFeatures`](crate::ContinuousFeatures)).
+pub trait FeatureExtractor {
+    /// Samples needed from the onset on.
+    fn span(&self) -> usize;
+
+    /// Number of features for `n_channels` channels.
+    fn n_features(&self, n_channels: usize) -> usize;
+
+    /// Appends the features of the window whose onset is sample `onset` of
+    /// `block` (preprocessed, `(n_channels, n)`) to `out`. Panics if the
+    /// window does not fit in the block.
+    fn extract_into(&self, block: &EegBlock, onset: usize, out: &mut Vec<f64>);
+}
 
 /// Where the temporal features come from, relative to the action onset.
 ///
@@ -60,6 +78,20 @@ impl EpochWindow {
         let mut out = Vec::with_capacity(self.n_features(block.n_channels));
         self.extract_into(block, onset, &mut out);
         out
+    }
+}
+
+impl FeatureExtractor for EpochWindow {
+    fn span(&self) -> usize {
+        EpochWindow::span(self)
+    }
+
+    fn n_features(&self, n_channels: usize) -> usize {
+        EpochWindow::n_features(self, n_channels)
+    }
+
+    fn extract_into(&self, block: &EegBlock, onset: usize, out: &mut Vec<f64>) {
+        EpochWindow::extract_into(self, block, onset, out);
     }
 }
 

@@ -13,10 +13,17 @@
 //! * calibration sessions scored by cross-validation ([`calibrate`]) and
 //!   accuracy targeting ([`target_accuracy`]): the ErrP-to-noise ratio at
 //!   which the real decoder reaches a requested accuracy;
+//! * the continuous decoder of sec. 2.2.2: temporal + theta PSD features of
+//!   an 800 ms window ([`ContinuousFeatures`], [`ThetaPsd`]), an RBF SVM with
+//!   Platt-scaled output ([`SvmDecoder`]), its trigger-locked calibration
+//!   ([`calibrate_continuous`]) and accuracy targeting
+//!   ([`target_continuous_accuracy`]);
 //! * the subjects of Table 1 ([`subject`]) and EDF+ export ([`EdfWriter`]).
 
 mod calibration;
 mod classify;
+mod continuous;
+mod continuous_calibration;
 mod edf;
 mod erp;
 mod error;
@@ -28,20 +35,28 @@ mod montage;
 mod noise;
 mod platt;
 mod preprocess;
+mod psd;
 pub mod rng;
+mod smo;
 mod subjects;
+mod svm;
 mod targeting;
 
 pub use calibration::{
     Accuracy, Calibrated, CalibrationParams, CalibrationSession, CalibrationSetup, GrandAverage,
     RawSink, SessionOptions, calibrate, cross_validate, cv_seed, eog_session,
-    out_of_fold_decisions, schedule, simulate_session, stratified_folds,
+    out_of_fold_decisions, schedule, simulate_session, simulate_session_with, stratified_folds,
 };
 pub use classify::{Classifier, ErrorModel, Features, sigmoid};
+pub use continuous::ContinuousFeatures;
+pub use continuous_calibration::{
+    ContinuousCalibrationParams, ContinuousSetup, calibrate_continuous, continuous_schedule,
+    simulate_continuous_session,
+};
 pub use edf::EdfWriter;
 pub use erp::{AssessmentKind, Component, ErpTemplates};
 pub use error::{BciError, Result};
-pub use features::EpochWindow;
+pub use features::{EpochWindow, FeatureExtractor};
 pub use filter::{Biquad, FilterBank, FilterChain};
 pub use generator::{Assessment, Components, EegBlock, EegGenerator, GeneratorParams};
 pub use lda::{LdaDecoder, LdaModel, Shrinkage, ledoit_wolf_shrinkage, pca_basis};
@@ -49,8 +64,10 @@ pub use montage::{Channel, ChannelKind, DECODING_CHANNELS, Montage};
 pub use noise::{PinkNoise, Resonator};
 pub use platt::PlattScaling;
 pub use preprocess::{PreprocessParams, Preprocessor};
+pub use psd::ThetaPsd;
 pub use subjects::{GoalSet, Subject, subject, subjects};
+pub use svm::{SvmDecoder, SvmModel};
 pub use targeting::{
     TargetingParams, TargetingResult, TargetingStep, check_requested_accuracy, inverse_normal_cdf,
-    target_accuracy,
+    search_ratio, target_accuracy, target_continuous_accuracy,
 };

@@ -7,8 +7,10 @@ use crate::calibration::{
     Accuracy, CalibrationSetup, SessionOptions, cross_validate, cv_seed, simulate_session,
 };
 use crate::classify::{Classifier, Features};
+use crate::continuous_calibration::{ContinuousSetup, simulate_continuous_session};
 use crate::error::{BciError, Result, check};
 use crate::generator::{Components, GeneratorParams};
+use crate::svm::SvmDecoder;
 
 /// How closely and how hard to search.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -81,7 +83,7 @@ pub fn target_accuracy<C: Classifier>(
     setup: &CalibrationSetup,
     search: &TargetingParams,
     seed: u64,
-    mut progress: impl FnMut(&TargetingStep),
+    progress: impl FnMut(&TargetingStep),
 ) -> Result<TargetingResult> {
     check_requested_accuracy(requested)?;
     let unit = CalibrationSetup {
@@ -113,10 +115,76 @@ pub fn target_accuracy<C: Classifier>(
     })?;
     let labels = noise.labels.clone();
     let cv_seed = cv_seed(seed);
+    search_ratio(
+        requested,
+        search,
+        |ratio| {
+            let x: Features = &noise.features + &erp.features * ratio;
+            cross_validate(classifier, &x, &labels, setup.calibration.folds, cv_seed)
+        },
+        progress,
+    )
+}
+
+/// The continuous decoder's [`target_accuracy`]: the ErrP-to-noise ratio at
+/// which `classifier`, trained on a continuous calibration session simulated
+/// from `seed` (sec. 5.1), scores `requested` in cross-validation.
+///
+/// The PSD features are not linear in the signal, so each step re-simulates
+/// the session at the ratio tried (same seed: the same background, artifacts,
+/// schedule and button presses) and cross-validates on it, with the folds of
+/// [`calibrate_continuous`](crate::calibrate_continuous).
+pub fn target_continuous_accuracy(
+    requested: f64,
+    classifier: &SvmDecoder,
+    setup: &ContinuousSetup,
+    search: &TargetingParams,
+    seed: u64,
+    progress: impl FnMut(&TargetingStep),
+) -> Result<TargetingResult> {
+    check_requested_accuracy(requested)?;
+    setup.validate()?;
+    let cv_seed = cv_seed(seed);
+    search_ratio(
+        requested,
+        search,
+        |ratio| {
+            let at = ContinuousSetup {
+                generator: GeneratorParams {
+                    errp_to_noise: ratio,
+                    ..setup.generator.clone()
+                },
+                ..setup.clone()
+            };
+            let s = simulate_continuous_session(&at, seed, SessionOptions::default())?;
+            cross_validate(
+                classifier,
+                &s.features,
+                &s.labels,
+                setup.calibration.folds,
+                cv_seed,
+            )
+        },
+        progress,
+    )
+}
+
+/// The search of the targeting functions, over any evaluation of the mean
+/// accuracy at an ErrP-to-noise ratio: it brackets `requested` (from 0.25,
+/// doubling up to `search.max_ratio`; ratio 0 is taken as chance), then
+/// interpolates on the probit scale (accuracy ~ Phi(c r) for an ideal
+/// observer), bisecting when that stalls, until within `search.tolerance` or
+/// `search.max_evaluations`. Returns the closest evaluation.
+pub fn search_ratio(
+    requested: f64,
+    search: &TargetingParams,
+    mut evaluate: impl FnMut(f64) -> Result<Accuracy>,
+    mut progress: impl FnMut(&TargetingStep),
+) -> Result<TargetingResult> {
+    check_requested_accuracy(requested)?;
     let mut steps: Vec<TargetingStep> = Vec::new();
     let mut evaluate = |ratio: f64, steps: &mut Vec<TargetingStep>| -> Result<f64> {
-        let x: Features = &noise.features + &erp.features * ratio;
-        let accuracy = cross_validate(classifier, &x, &labels, setup.calibration.folds, cv_seed)?;
+        let accuracy = evaluate(ratio)?;
         let step = TargetingStep { ratio, accuracy };
         progress(&step);
         steps.push(step);

@@ -5,8 +5,8 @@
 
 use errp_bci::{
     AssessmentKind, CalibrationParams, CalibrationSetup, Classifier, Components, ErrorModel,
-    Features, GeneratorParams, LdaDecoder, SessionOptions, Shrinkage, TargetingParams, calibrate,
-    cross_validate, rng::stream, simulate_session, target_accuracy,
+    Features, GeneratorParams, LdaDecoder, SessionOptions, Shrinkage, SvmDecoder, TargetingParams,
+    calibrate, cross_validate, rng::stream, simulate_session, target_accuracy,
 };
 use rand::seq::SliceRandom;
 
@@ -42,13 +42,23 @@ fn classifier_contract<C: Classifier>(classifier: C) {
     let a = classifier.fit(&x, &y, 7).unwrap();
     let b = classifier.fit(&x, &y, 7).unwrap();
     assert_eq!(a.n_features(), 312);
+    let mut pairs = Vec::new();
     for i in 0..x.nrows() {
         let row: Vec<f64> = x.row(i).iter().copied().collect();
         let p = a.p_error(&row);
         assert!((0.0..=1.0).contains(&p), "p = {p}");
         assert_eq!(p, b.p_error(&row), "same seed, same model");
-        assert_eq!(a.decision(&row) >= 0.0, p >= 0.5, "decision and p agree");
+        assert_eq!(a.decision(&row), b.decision(&row), "same seed, same model");
+        pairs.push((a.decision(&row), p));
     }
+    // Decision and p agree: p(error) never decreases with the decision value
+    // (the LDA's p is its sigmoid; the SVM's is its Platt scaling, whose 0.5
+    // point need not sit exactly at decision 0, as in libsvm).
+    pairs.sort_by(|u, v| u.0.total_cmp(&v.0));
+    assert!(
+        pairs.windows(2).all(|w| w[1].1 >= w[0].1),
+        "p(error) increases with the decision"
+    );
     // One class only, or mismatched shapes: a clear error, not a panic.
     assert!(classifier.fit(&x, &vec![false; y.len()], 7).is_err());
     assert!(classifier.fit(&x, &y[1..], 7).is_err());
@@ -60,6 +70,12 @@ fn every_classifier_meets_the_contract() {
     classifier_contract(LdaDecoder {
         pca_variance: 0.99,
         shrinkage: Shrinkage::Fixed(0.2),
+    });
+    classifier_contract(SvmDecoder::default());
+    classifier_contract(SvmDecoder {
+        c: 10.0,
+        gamma: Some(0.01),
+        tolerance: 1e-4,
     });
 }
 

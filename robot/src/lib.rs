@@ -6,15 +6,34 @@
 //! the grid task's policy matching (sec. 4.2): the 5x5 [`Grid`], optimal
 //! Q-values ([`QTable`]), their soft-max (eq. 3), the likelihood of eq. (4)
 //! and the epsilon-greedy [`GridController`].
+//!
+//! For the continuous task (sec. 5) it holds the e-puck's constants and
+//! differential-drive kinematics ([`EpuckParams`], [`WheelSpeeds`],
+//! [`Twist`], [`integrate`]), the arena's goals ([`GoalLayout::cities`]),
+//! the potentials of eq. (5) ([`QuadraticPotential`]), the likelihoods of
+//! eq. (6) and (7) ([`turn_likelihood`], [`linear_likelihood`]) and the
+//! [`ContinuousController`] that turns, drives and stops the robot.
 
 mod belief;
+mod continuous_control;
+mod continuous_likelihood;
+mod epuck;
 mod error;
 mod grid;
 mod grid_control;
+mod layout;
+mod pose;
+mod potential;
 mod qvalues;
 
 pub use belief::{Belief, log_sum_exp};
+pub use continuous_control::{ContinuousController, Observation, Phase, StepKind, StopReason};
+pub use continuous_likelihood::{ContinuousControlParams, linear_likelihood, turn_likelihood};
+pub use epuck::{EpuckParams, Twist, WheelSpeeds, integrate};
 pub use error::{Result, RobotError};
 pub use grid::{Cell, Grid, GridAction};
 pub use grid_control::{GridControlParams, GridController, policy_likelihood};
+pub use layout::{Goal, GoalLayout, LAYOUT_GRID_CELLS};
+pub use pose::{Pose, wrap_angle};
+pub use potential::QuadraticPotential;
 pub use qvalues::{QParams, QTable, softmax};

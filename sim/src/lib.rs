@@ -6,6 +6,11 @@
 
 mod calibration;
 mod calibration_view;
+mod continuous_decoder;
+mod epuck_run;
+mod epuck_scenario;
+mod epuck_task;
+mod epuck_view;
 mod error;
 mod grid_run;
 mod grid_task;
@@ -15,9 +20,26 @@ mod record;
 mod scenario;
 mod stats;
 mod table1;
+mod tracker;
+mod user;
+mod world;
 
 pub use calibration::{CalibrationReport, CalibrationRequest, run_calibration};
 pub use calibration_view::{LATENCY_TIMELINE, calibration_recording, record_calibration};
+pub use continuous_decoder::{
+    ContinuousDecoder, ContinuousReport, ContinuousRequest, WARM_UP_SECS,
+    run_continuous_calibration,
+};
+pub use epuck_run::{
+    EpuckSummary, PAPER_EPUCK, epuck_run_seed, median, prepare_continuous_decoder, run_epuck_batch,
+    run_epuck_once, summarise,
+};
+pub use epuck_scenario::{AnyScenario, EpuckScenario, load_scenario};
+pub use epuck_task::{
+    AvoidanceParams, EpuckEpisode, EpuckEpisodeResult, EpuckObserver, EpuckTaskParams,
+    PHYSICS_DT_SECS, PhysicsFrame, WINDOW_STEP_SECS, WindowFrame, run_epuck_episode,
+};
+pub use epuck_view::{EpuckRecorder, RUN_GAP_SECS, epuck_recording};
 pub use error::{Result, SimError};
 pub use grid_run::{GridRunReport, mean_sd, pooled_accuracy, prepare_decoder, run_grid_scenario};
 pub use grid_task::{
@@ -33,3 +55,6 @@ pub use table1::{
     FIXED_PAIRS, PAPER, PAPER_POOLED, Table1Cell, Table1Options, accuracy_time_correlation,
     run_table1,
 };
+pub use tracker::{CameraTracker, TrackerParams};
+pub use user::{Elicited, Judgement, SeenMotion, SyntheticUser, UserParams};
+pub use world::{ArenaSpec, Obstacle, ProximitySensors, World};

@@ -201,7 +201,7 @@ impl Scenario {
             return Err(bad(
                 "task",
                 format!("{:?}", file.task),
-                "\"grid\" (the only task this version runs)",
+                "\"grid\" or \"epuck\"",
             ));
         }
 

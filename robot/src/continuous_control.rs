@@ -1,0 +1,525 @@
+//! Shared control of the e-puck from a probability of error: the likelihoods
+//! of sec. 5.2 of the paper (eq. 6 and 7) and the motion of sec. 5.1.
+//!
+//! The robot turns in place towards the most probable goal, then drives
+//! straight to it; it stops for `stop_secs` on reaching a goal or when the
+//! decoder reports an error (p(error) >= T_e), then heads for the goal that
+//! is most probable at that moment. Every decoder window (62.5 ms) updates
+//! the belief over the goals with eq. (6) while turning and eq. (7) while
+//! driving, and the run ends when a full stop on a goal ends with that
+//! goal's probability at p_c or more (so the user always has the whole stop
+//! to object to a wrong goal with an ErrP).
+//!
+//! What the paper leaves open, and our choices:
+//! - **The stop on a goal is an action too.** The user judges a stop on the
+//!   wrong goal as an error (sec. 5.1), but the paper gives no likelihood for
+//!   it. While the robot is stopped on goal j after reaching it, each window
+//!   applies eq. (7) with bearing 0 to goal j alone (the stop is an action
+//!   aimed exactly at j): 1 + k_p N(0) if no error is detected, 1 - k_n N(0)
+//!   (about 0.2) if one is; every other goal gets 1.
+//! - **The stop after a detected error is not.** It is the system's reaction,
+//!   not an action the user assesses, so windows during it do not update the
+//!   belief (the caller still decodes them).
+//! - **Goals under the robot.** A goal within `goal_radius_m` of the robot
+//!   has no defined bearing; it gets likelihood 1 in turn and linear steps.
+//! - **Goal choice** is greedy: the most probable goal, ties broken by the
+//!   goal nearest the robot, then by the lowest index. With the uniform
+//!   belief of the start, a robot placed on a goal therefore starts "stopped
+//!   on" it; the user judges that stop as wrong, which is how the start goal
+//!   gets rejected.
+//! - **The target is kept until the next stop**, as in sec. 5.1 ("the robot
+//!   stopped ... Then, it moved towards a new goal"): the belief changes
+//!   while the robot moves, the target does not.
+//! - **Motion details**: turning ends when the bearing to the target is below
+//!   `align_tolerance_deg`; while driving, a proportional heading correction
+//!   (limited so that no wheel exceeds the top speed) keeps the robot on the
+//!   target; if the target falls behind (|bearing| > 90 deg, e.g. after a
+//!   collision) the robot turns in place again.
+
+use std::f64::consts::FRAC_PI_2;
+
+use serde::{Deserialize, Serialize};
+
+use crate::belief::Belief;
+use crate::continuous_likelihood::{ContinuousControlParams, linear_likelihood, turn_likelihood};
+use crate::epuck::{Twist, WheelSpeeds};
+use crate::error::{Result, RobotError};
+use crate::layout::GoalLayout;
+use crate::pose::{Pose, wrap_angle};
+use crate::potential::QuadraticPotential;
+
+/// Why the robot is stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum StopReason {
+    /// It reached (or started on) this goal.
+    OnGoal(usize),
+    /// The decoder reported an error.
+    ErrorDetected,
+}
+
+/// What the robot is doing.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum Phase {
+    /// Turning in place towards the target.
+    Turning,
+    /// Driving straight to the target.
+    Driving,
+    /// Standing still until `until_secs` (simulated time).
+    Stopped {
+        /// When the stop ends, s.
+        until_secs: f64,
+        /// Why the robot stopped.
+        reason: StopReason,
+    },
+}
+
+/// The kind of action one decoder window assessed, which selects the
+/// likelihood.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum StepKind {
+    /// A turn step, eq. (6). `direction` is the heading change since the
+    /// previous window, rad; only its sign counts (> 0 anticlockwise).
+    Turn {
+        /// Heading change since the previous window, rad.
+        direction: f64,
+    },
+    /// A linear step, eq. (7).
+    Linear,
+    /// Stopped on this goal after reaching it: eq. (7) at bearing 0 for it.
+    StopOnGoal(usize),
+    /// Stopped after a detected error: no update.
+    Idle,
+}
+
+/// What one decoder window did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Observation {
+    /// The action the window assessed.
+    pub step: StepKind,
+    /// p(error) >= T_e while turning or driving: the robot has stopped
+    /// (a detected error while stopped on a goal only shows in the
+    /// likelihoods).
+    pub detected: bool,
+    /// The goal the robot converged on: a full stop on it ended with its
+    /// probability at p_c or more. The run is over.
+    pub converged: Option<usize>,
+    /// The likelihood applied to each goal (all 1 for an idle window).
+    pub likelihoods: Vec<f64>,
+}
+
+/// The device's side of the continuous task: a belief over the layout's
+/// goals, the current target and the motion phase. Deterministic. Call
+/// [`command`](Self::command) every physics step and
+/// [`observe`](Self::observe) every decoder window, both with the tracked
+/// pose and the simulated time (which starts at 0).
+#[derive(Debug, Clone)]
+pub struct ContinuousController {
+    params: ContinuousControlParams,
+    layout: GoalLayout,
+    potentials: Vec<QuadraticPotential>,
+    belief: Belief,
+    target: usize,
+    phase: Phase,
+    last_heading_rad: f64,
+    converged: Option<usize>,
+}
+
+impl ContinuousController {
+    /// A controller with a uniform belief, the robot at `start` at time 0.
+    /// The first target is the nearest goal; if the robot is on it, it starts
+    /// stopped on it until `stop_secs`.
+    pub fn new(params: ContinuousControlParams, layout: GoalLayout, start: Pose) -> Result<Self> {
+        params.validate()?;
+        let goals = layout.goals();
+        let mut closest = f64::INFINITY;
+        for (i, a) in goals.iter().enumerate() {
+            for b in &goals[..i] {
+                closest = closest.min((a.x_m - b.x_m).hypot(a.y_m - b.y_m));
+            }
+        }
+        if 2.0 * params.goal_radius_m >= closest {
+            return Err(RobotError::Parameter(format!(
+                "goal_radius_m = {} must be less than half the distance between the closest goals ({closest} m)",
+                params.goal_radius_m
+            )));
+        }
+        let potentials = goals
+            .iter()
+            .map(|g| QuadraticPotential::for_goal(g.x_m, g.y_m, layout.arena_size_m()))
+            .collect();
+        let mut c = Self {
+            params,
+            belief: Belief::uniform(layout.len()),
+            layout,
+            potentials,
+            target: 0,
+            phase: Phase::Turning,
+            last_heading_rad: start.heading_rad,
+            converged: None,
+        };
+        c.choose_next(&start, 0.0);
+        Ok(c)
+    }
+
+    /// The parameters in force.
+    pub fn params(&self) -> &ContinuousControlParams {
+        &self.params
+    }
+
+    /// The goals.
+    pub fn layout(&self) -> &GoalLayout {
+        &self.layout
+    }
+
+    /// The belief over goals, indexed like the layout.
+    pub fn belief(&self) -> &Belief {
+        &self.belief
+    }
+
+    /// The goal the robot is heading for (or stopped on).
+    pub fn target(&self) -> usize {
+        self.target
+    }
+
+    /// The current motion phase.
+    pub fn phase(&self) -> Phase {
+        self.phase
+    }
+
+    /// Goal `i`'s potential, eq. (5).
+    pub fn potential(&self, i: usize) -> &QuadraticPotential {
+        &self.potentials[i]
+    }
+
+    /// theta_i - theta_t: the greedy heading for goal `i` (eq. 5) relative to
+    /// the robot's heading, wrapped to (-pi, pi].
+    pub fn bearing_rad(&self, pose: &Pose, i: usize) -> f64 {
+        let greedy = self.potentials[i].greedy_heading_rad(pose.x_m, pose.y_m);
+        wrap_angle(greedy - pose.heading_rad)
+    }
+
+    fn on_goal(&self, pose: &Pose, i: usize) -> bool {
+        let g = self.layout.goal(i);
+        pose.distance_to(g.x_m, g.y_m) < self.params.goal_radius_m
+    }
+
+    /// The greedy goal choice: the most probable goal, ties broken by the
+    /// nearest to `pose`, then by the lowest index.
+    pub fn most_probable_goal(&self, pose: &Pose) -> usize {
+        let p = self.belief.probabilities();
+        let top = p.iter().copied().fold(0.0, f64::max);
+        let mut best: Option<(usize, f64)> = None;
+        for (i, g) in self.layout.goals().iter().enumerate() {
+            if p[i] < top * (1.0 - 1e-12) {
+                continue;
+            }
+            let d = pose.distance_to(g.x_m, g.y_m);
+            if best.is_none_or(|(_, bd)| d < bd - 1e-9) {
+                best = Some((i, d));
+            }
+        }
+        best.map_or(0, |(i, _)| i)
+    }
+
+    /// Picks the next target and starts towards it (or stays stopped on it).
+    fn choose_next(&mut self, pose: &Pose, time_secs: f64) {
+        self.target = self.most_probable_goal(pose);
+        self.phase = if self.on_goal(pose, self.target) {
+            self.stop(time_secs, StopReason::OnGoal(self.target))
+        } else {
+            Phase::Turning
+        };
+    }
+
+    fn stop(&self, time_secs: f64, reason: StopReason) -> Phase {
+        Phase::Stopped {
+            until_secs: time_secs + self.params.stop_secs,
+            reason,
+        }
+    }
+
+    /// The wheel speeds for this physics step (sec. 5.1: turn in place
+    /// towards the target, then straight to it, stopping on it), given the
+    /// tracked pose; also ends stops and switches between turning and
+    /// driving. Zero while stopped. Never above the top speed.
+    pub fn command(&mut self, pose: &Pose, time_secs: f64) -> WheelSpeeds {
+        let epuck = self.params.epuck;
+        let top = epuck.max_speed_m_per_s();
+        let align = self.params.align_tolerance_deg.to_radians();
+        // Each transition moves forward (stop -> turn -> drive -> stop), so
+        // this settles within a few passes.
+        loop {
+            match self.phase {
+                Phase::Stopped { until_secs, reason } => {
+                    if time_secs < until_secs || self.converged.is_some() {
+                        return WheelSpeeds::ZERO;
+                    }
+                    // The run ends at the end of a full stop on a goal whose
+                    // probability has reached p_c: the user had the whole
+                    // stop to object with an ErrP.
+                    if let StopReason::OnGoal(j) = reason
+                        && self.belief.probability(j) >= self.params.p_c
+                    {
+                        self.converged = Some(j);
+                        return WheelSpeeds::ZERO;
+                    }
+                    self.choose_next(pose, time_secs);
+                    if let Phase::Stopped { .. } = self.phase {
+                        return WheelSpeeds::ZERO;
+                    }
+                }
+                Phase::Turning => {
+                    if self.on_goal(pose, self.target) {
+                        self.phase = self.stop(time_secs, StopReason::OnGoal(self.target));
+                        return WheelSpeeds::ZERO;
+                    }
+                    let b = self.bearing_rad(pose, self.target);
+                    if b.abs() < align {
+                        self.phase = Phase::Driving;
+                        continue;
+                    }
+                    let s = b.signum() * self.params.turn_speed_fraction * top;
+                    return WheelSpeeds {
+                        left_m_per_s: -s,
+                        right_m_per_s: s,
+                    };
+                }
+                Phase::Driving => {
+                    if self.on_goal(pose, self.target) {
+                        self.phase = self.stop(time_secs, StopReason::OnGoal(self.target));
+                        return WheelSpeeds::ZERO;
+                    }
+                    let b = self.bearing_rad(pose, self.target);
+                    if b.abs() > FRAC_PI_2 {
+                        self.phase = Phase::Turning;
+                        continue;
+                    }
+                    let v = self.params.drive_speed_fraction * top;
+                    let w_max = 2.0 * (top - v) / epuck.axle_length_m;
+                    let w = (self.params.heading_gain * b).clamp(-w_max, w_max);
+                    let twist = Twist {
+                        linear_m_per_s: v,
+                        angular_rad_per_s: w,
+                    };
+                    return twist.to_wheels(&epuck).clamp(&epuck);
+                }
+            }
+        }
+    }
+
+    /// The likelihood of `step` for every goal, given p(error) and the pose:
+    /// eq. (6) for a turn, eq. (7) for a linear step, eq. (7) at bearing 0
+    /// for the goal the robot is stopped on, 1 elsewhere (see the module
+    /// doc).
+    pub fn likelihoods(&self, step: StepKind, p_error: f64, pose: &Pose) -> Vec<f64> {
+        (0..self.layout.len())
+            .map(|i| match step {
+                StepKind::Turn { direction } if !self.on_goal(pose, i) => {
+                    turn_likelihood(&self.params, p_error, direction, self.bearing_rad(pose, i))
+                }
+                StepKind::Linear if !self.on_goal(pose, i) => {
+                    linear_likelihood(&self.params, p_error, self.bearing_rad(pose, i))
+                }
+                StepKind::StopOnGoal(j) if i == j => linear_likelihood(&self.params, p_error, 0.0),
+                _ => 1.0,
+            })
+            .collect()
+    }
+
+    /// One decoder window: classifies the step from the phase and the
+    /// heading change since the previous call, updates the belief by Bayes'
+    /// rule (eq. 2) with [`likelihoods`](Self::likelihoods), and on a
+    /// detected error while turning or driving stops the robot until
+    /// `time_secs + stop_secs`. Reports convergence when the robot is
+    /// stopped on a goal whose probability is >= p_c.
+    pub fn observe(&mut self, p_error: f64, pose: &Pose, time_secs: f64) -> Result<Observation> {
+        if !(p_error.is_finite() && (0.0..=1.0).contains(&p_error)) {
+            return Err(RobotError::Likelihood(format!(
+                "p(error) = {p_error} is not a probability"
+            )));
+        }
+        let heading_change = wrap_angle(pose.heading_rad - self.last_heading_rad);
+        self.last_heading_rad = pose.heading_rad;
+        let step = match self.phase {
+            Phase::Turning => StepKind::Turn {
+                direction: heading_change,
+            },
+            Phase::Driving => StepKind::Linear,
+            Phase::Stopped {
+                reason: StopReason::OnGoal(j),
+                ..
+            } => StepKind::StopOnGoal(j),
+            Phase::Stopped {
+                reason: StopReason::ErrorDetected,
+                ..
+            } => StepKind::Idle,
+        };
+        let likelihoods = self.likelihoods(step, p_error, pose);
+        if step != StepKind::Idle {
+            self.belief.update(&likelihoods)?;
+        }
+        let detected =
+            p_error >= self.params.t_e && matches!(self.phase, Phase::Turning | Phase::Driving);
+        if detected {
+            self.phase = self.stop(time_secs, StopReason::ErrorDetected);
+        }
+        let converged = self.converged;
+        Ok(Observation {
+            step,
+            detected,
+            converged,
+            likelihoods,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::epuck::EpuckParams;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+    use std::f64::consts::PI;
+
+    fn params() -> ContinuousControlParams {
+        ContinuousControlParams::default()
+    }
+
+    fn on(layout: &GoalLayout, name: &str, heading_rad: f64) -> Pose {
+        let g = layout.goal(layout.index_of(name).unwrap());
+        Pose::new(g.x_m, g.y_m, heading_rad)
+    }
+
+    #[test]
+    fn starting_on_a_goal_is_a_stop_on_it() {
+        let l = GoalLayout::cities();
+        let start = on(&l, "Mexico", 0.0);
+        let mut c = ContinuousController::new(params(), l, start).unwrap();
+        let mexico = 0;
+        assert_eq!(c.target(), mexico);
+        assert_eq!(
+            c.phase(),
+            Phase::Stopped {
+                until_secs: 1.0,
+                reason: StopReason::OnGoal(mexico)
+            }
+        );
+        assert_eq!(c.command(&start, 0.5), WheelSpeeds::ZERO);
+        // Judged wrong: only Mexico is penalised.
+        let o = c.observe(0.9, &start, 0.5).unwrap();
+        assert_eq!(o.step, StepKind::StopOnGoal(mexico));
+        assert!(!o.detected && o.converged.is_none(), "no stop to report");
+        assert!((o.likelihoods[mexico] - (1.0 - 0.7 * c.params().pdf_peak())).abs() < 1e-12);
+        assert!(o.likelihoods[1..].iter().all(|&v| v == 1.0));
+        assert_eq!(
+            c.phase(),
+            Phase::Stopped {
+                until_secs: 1.0,
+                reason: StopReason::OnGoal(mexico)
+            }
+        );
+        // The stop ends: the nearest of the now most probable goals, Havana
+        // and Bogota tie at 0.4 m, the lower index (Havana) wins.
+        let w = c.command(&start, 1.0);
+        assert_eq!(c.target(), 1);
+        assert_eq!(
+            c.phase(),
+            Phase::Driving,
+            "Havana is straight ahead: no turn"
+        );
+        assert!(w.left_m_per_s > 0.0 && (w.left_m_per_s - w.right_m_per_s).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_detected_error_stops_the_robot_and_freezes_the_belief() {
+        let l = GoalLayout::cities();
+        let start = Pose::new(1.0, 0.9, PI / 2.0); // just below Athens
+        let mut c = ContinuousController::new(params(), l, start).unwrap();
+        let athens = c.layout().index_of("Athens").unwrap();
+        assert_eq!(c.target(), athens);
+        let w = c.command(&start, 0.0);
+        assert_eq!(c.phase(), Phase::Driving);
+        assert!(w.left_m_per_s > 0.0 && (w.left_m_per_s - w.right_m_per_s).abs() < 1e-12);
+        let o = c.observe(0.95, &start, 0.0625).unwrap();
+        assert_eq!(o.step, StepKind::Linear);
+        assert!(o.detected);
+        assert!(o.likelihoods[athens] < 0.21);
+        let rome = c.layout().index_of("Rome").unwrap();
+        assert!(o.likelihoods[rome] < 0.21, "Rome is straight ahead too");
+        assert_eq!(
+            c.phase(),
+            Phase::Stopped {
+                until_secs: 1.0625,
+                reason: StopReason::ErrorDetected
+            }
+        );
+        let before = c.belief().clone();
+        let o = c.observe(0.99, &start, 0.125).unwrap();
+        assert_eq!(o.step, StepKind::Idle);
+        assert!(!o.detected && o.likelihoods.iter().all(|&v| v == 1.0));
+        assert_eq!(c.belief(), &before);
+        assert_eq!(c.command(&start, 1.0), WheelSpeeds::ZERO);
+        c.command(&start, 1.0625);
+        assert_ne!(c.target(), athens);
+        assert_ne!(c.target(), rome);
+        assert_eq!(c.phase(), Phase::Turning);
+    }
+
+    #[test]
+    fn belief_stays_a_distribution_under_any_decoder_output() {
+        let l = GoalLayout::cities();
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let mut c = ContinuousController::new(params(), l, Pose::new(0.9, 1.1, 0.0)).unwrap();
+        for k in 0..5000 {
+            let pose = Pose::new(
+                rng.random_range(0.0..2.0),
+                rng.random_range(0.0..2.0),
+                rng.random_range(-PI..PI),
+            );
+            let t = k as f64 * 0.0625;
+            c.command(&pose, t);
+            let p = match rng.random_range(0..4) {
+                0 => 0.0,
+                1 => 1.0,
+                _ => rng.random::<f64>(),
+            };
+            let o = c.observe(p, &pose, t).unwrap();
+            assert!(o.likelihoods.iter().all(|v| v.is_finite() && *v > 0.0));
+            let probs = c.belief().probabilities();
+            assert!(probs.iter().all(|v| v.is_finite() && *v >= 0.0));
+            assert!((probs.iter().sum::<f64>() - 1.0).abs() < 1e-9);
+        }
+        assert!(c.observe(f64::NAN, &Pose::default(), 0.0).is_err());
+        assert!(c.observe(1.01, &Pose::default(), 0.0).is_err());
+    }
+
+    #[test]
+    fn wheel_commands_respect_the_top_speed() {
+        let l = GoalLayout::cities();
+        let top = EpuckParams::default().max_speed_m_per_s();
+        let mut rng = ChaCha8Rng::seed_from_u64(8);
+        for _ in 0..2000 {
+            let pose = Pose::new(
+                rng.random_range(0.0..2.0),
+                rng.random_range(0.0..2.0),
+                rng.random_range(-PI..PI),
+            );
+            let mut c = ContinuousController::new(params(), l.clone(), pose).unwrap();
+            let w = c.command(&pose, 0.0);
+            assert!(w.left_m_per_s.abs() <= top + 1e-12 && w.right_m_per_s.abs() <= top + 1e-12);
+        }
+    }
+
+    #[test]
+    fn a_goal_radius_wider_than_half_the_goal_spacing_is_rejected() {
+        let d = ContinuousControlParams::default();
+        let wide = ContinuousControlParams {
+            goal_radius_m: 0.2,
+            ..d
+        };
+        let e = ContinuousController::new(wide, GoalLayout::cities(), Pose::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("goal_radius_m"), "{e}");
+    }
+}

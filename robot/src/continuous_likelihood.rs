@@ -1,0 +1,356 @@
+//! The parameters of the continuous strategy and its likelihoods: eq. (6)
+//! for turn steps and eq. (7) for linear steps (sec. 5.2 of the paper).
+
+use std::f64::consts::PI;
+
+use serde::{Deserialize, Serialize};
+
+use crate::epuck::EpuckParams;
+use crate::error::{Result, RobotError};
+use crate::pose::wrap_angle;
+
+/// Parameters of the continuous strategy (sec. 5.2) and of the motion
+/// (sec. 5.1).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ContinuousControlParams {
+    /// T_e: p(error) at or above it counts as a detected error; the paper:
+    /// 0.8. In (0, 1].
+    pub t_e: f64,
+    /// k_n of eq. (6), the penalty of goals on the side the robot turns to;
+    /// the paper: 0.2. In (0, 1).
+    pub k_turn: f64,
+    /// k_p of eq. (7), the reward of goals ahead after a correct window; the
+    /// paper: 0.01. >= 0.
+    pub k_p: f64,
+    /// k_n of eq. (7), the penalty of goals ahead after an error; the paper:
+    /// 0.7. 1 - k_n N(0; 0, sigma) must stay > 0.
+    pub k_n: f64,
+    /// sigma of eq. (7), the user's field of view; the paper: 20 deg. The
+    /// normal pdf is taken in radians (peak 1.14 for 20 deg).
+    pub sigma_deg: f64,
+    /// Convergence: probability of the goal the robot is stopped on that
+    /// ends the run; the paper: 0.4. In (0, 1).
+    pub p_c: f64,
+    /// Length of a stop, on a goal or after a detected error, s; the paper:
+    /// "for a second". > 0.
+    pub stop_secs: f64,
+    /// Forward speed while driving, as a fraction of the top speed. In (0, 1].
+    pub drive_speed_fraction: f64,
+    /// Wheel speed while turning in place (one wheel forwards, one
+    /// backwards), as a fraction of the top speed. In (0, 1].
+    pub turn_speed_fraction: f64,
+    /// A turn ends when the bearing to the target is below this, deg. In
+    /// (0, 90).
+    pub align_tolerance_deg: f64,
+    /// Proportional heading correction while driving, rad/s per rad of
+    /// bearing. >= 0.
+    pub heading_gain: f64,
+    /// The robot has reached (is "on") a goal within this distance, m. > 0,
+    /// and less than half the distance between the two closest goals.
+    pub goal_radius_m: f64,
+    /// The robot's constants (top speed, axle length).
+    pub epuck: EpuckParams,
+}
+
+impl Default for ContinuousControlParams {
+    fn default() -> Self {
+        Self {
+            t_e: 0.8,
+            k_turn: 0.2,
+            k_p: 0.01,
+            k_n: 0.7,
+            sigma_deg: 20.0,
+            p_c: 0.4,
+            stop_secs: 1.0,
+            drive_speed_fraction: 0.5,
+            turn_speed_fraction: 0.25,
+            align_tolerance_deg: 3.0,
+            heading_gain: 2.0,
+            goal_radius_m: 0.02,
+            epuck: EpuckParams::default(),
+        }
+    }
+}
+
+impl ContinuousControlParams {
+    /// Checks every field; messages name the field and the accepted range.
+    pub fn validate(&self) -> Result<()> {
+        let check = |ok: bool, name: &str, v: f64, range: &str| {
+            if ok && v.is_finite() {
+                Ok(())
+            } else {
+                Err(RobotError::Parameter(format!(
+                    "{name} = {v} must be {range}"
+                )))
+            }
+        };
+        let open01 = |v: f64| v > 0.0 && v < 1.0;
+        let half_open01 = |v: f64| v > 0.0 && v <= 1.0;
+        check(half_open01(self.t_e), "t_e", self.t_e, "in (0, 1]")?;
+        check(open01(self.k_turn), "k_turn", self.k_turn, "in (0, 1)")?;
+        check(self.k_p >= 0.0, "k_p", self.k_p, "a finite number >= 0")?;
+        check(self.sigma_deg > 0.0, "sigma_deg", self.sigma_deg, "> 0")?;
+        let floor = 1.0 - self.k_n * self.pdf_peak();
+        check(
+            self.k_n >= 0.0 && floor > 0.0,
+            "k_n",
+            self.k_n,
+            &format!(
+                ">= 0 with 1 - k_n N(0; 0, sigma) > 0, i.e. < {} for sigma_deg = {}",
+                1.0 / self.pdf_peak(),
+                self.sigma_deg
+            ),
+        )?;
+        check(open01(self.p_c), "p_c", self.p_c, "in (0, 1)")?;
+        check(self.stop_secs > 0.0, "stop_secs", self.stop_secs, "> 0")?;
+        check(
+            half_open01(self.drive_speed_fraction),
+            "drive_speed_fraction",
+            self.drive_speed_fraction,
+            "in (0, 1]",
+        )?;
+        check(
+            half_open01(self.turn_speed_fraction),
+            "turn_speed_fraction",
+            self.turn_speed_fraction,
+            "in (0, 1]",
+        )?;
+        check(
+            self.align_tolerance_deg > 0.0 && self.align_tolerance_deg < 90.0,
+            "align_tolerance_deg",
+            self.align_tolerance_deg,
+            "in (0, 90)",
+        )?;
+        check(
+            self.heading_gain >= 0.0,
+            "heading_gain",
+            self.heading_gain,
+            "a finite number >= 0",
+        )?;
+        check(
+            self.goal_radius_m > 0.0,
+            "goal_radius_m",
+            self.goal_radius_m,
+            "> 0",
+        )?;
+        self.epuck.validate()
+    }
+
+    /// sigma of eq. (7) in radians.
+    pub fn sigma_rad(&self) -> f64 {
+        self.sigma_deg.to_radians()
+    }
+
+    /// N(0; 0, sigma), the peak of eq. (7)'s normal pdf (1.1399 for 20 deg).
+    pub fn pdf_peak(&self) -> f64 {
+        normal_pdf(0.0, self.sigma_rad())
+    }
+}
+
+/// The normal pdf N(x; 0, sigma).
+fn normal_pdf(x: f64, sigma: f64) -> f64 {
+    (-0.5 * (x / sigma).powi(2)).exp() / (sigma * (2.0 * PI).sqrt())
+}
+
+/// Eq. (6) of the paper, the likelihood of a turn step for one goal: k_n
+/// (`k_turn`) if an error is detected (p(error) >= T_e) while the robot turns
+/// anticlockwise (`turn_direction` > 0, the sign of theta_t - theta_{t-1})
+/// and the goal is to its left (bearing theta_i - theta_t in (0, pi]), or
+/// while it turns clockwise and the goal is to its right (bearing in
+/// (-pi, 0]); 1 otherwise, including when the robot is not turning. The
+/// paper's "(theta_t - theta_t)" is read as (theta_i - theta_t), as its text
+/// says. `bearing_rad` is wrapped here.
+pub fn turn_likelihood(
+    params: &ContinuousControlParams,
+    p_error: f64,
+    turn_direction: f64,
+    bearing_rad: f64,
+) -> f64 {
+    let b = wrap_angle(bearing_rad);
+    let left = b > 0.0; // (0, pi]; wrapped, so b <= pi
+    let error = p_error >= params.t_e;
+    if error && ((turn_direction > 0.0 && left) || (turn_direction < 0.0 && !left)) {
+        params.k_turn
+    } else {
+        1.0
+    }
+}
+
+/// Eq. (7) of the paper, the likelihood of a linear step for one goal:
+/// 1 + k_p N(bearing; 0, sigma) if no error is detected (p(error) < T_e),
+/// 1 - k_n N(bearing; 0, sigma) if one is, with the bearing
+/// theta_i - theta_t in radians (N is even, so its sign does not matter).
+pub fn linear_likelihood(params: &ContinuousControlParams, p_error: f64, bearing_rad: f64) -> f64 {
+    let n = normal_pdf(wrap_angle(bearing_rad), params.sigma_rad());
+    if p_error < params.t_e {
+        1.0 + params.k_p * n
+    } else {
+        1.0 - params.k_n * n
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pose::Pose;
+
+    fn params() -> ContinuousControlParams {
+        ContinuousControlParams::default()
+    }
+
+    #[test]
+    fn eq6_penalises_goals_on_the_side_of_the_turn() {
+        let p = params();
+        let (err, ok) = (0.9, 0.5);
+        let (acw, cw) = (0.05, -0.05);
+        // Anticlockwise: goals to the left, bearing in (0, pi].
+        assert_eq!(turn_likelihood(&p, err, acw, 0.5), 0.2);
+        assert_eq!(turn_likelihood(&p, err, acw, PI), 0.2);
+        assert_eq!(turn_likelihood(&p, err, acw, 0.0), 1.0);
+        assert_eq!(turn_likelihood(&p, err, acw, -0.5), 1.0);
+        // Clockwise: goals to the right, bearing in (-pi, 0].
+        assert_eq!(turn_likelihood(&p, err, cw, -0.5), 0.2);
+        assert_eq!(turn_likelihood(&p, err, cw, 0.0), 0.2);
+        assert_eq!(turn_likelihood(&p, err, cw, 0.5), 1.0);
+        assert_eq!(turn_likelihood(&p, err, cw, -PI), 1.0, "-pi wraps to pi");
+        // No detected error, or no turn: no change. T_e itself is an error.
+        assert_eq!(turn_likelihood(&p, ok, acw, 0.5), 1.0);
+        assert_eq!(turn_likelihood(&p, 0.8, acw, 0.5), 0.2);
+        assert_eq!(turn_likelihood(&p, err, 0.0, 0.5), 1.0);
+    }
+
+    #[test]
+    fn eq6_typo_is_read_as_the_goal_bearing() {
+        // The paper prints (theta_t - theta_t), always 0; read as
+        // theta_i - theta_t, the same turn and p(error) treat two goals on
+        // opposite sides differently, and the robot's own heading alone
+        // decides nothing.
+        let p = params();
+        let robot = Pose::new(1.0, 1.0, 0.3);
+        let left = robot.bearing_to(0.6, 1.8);
+        let right = robot.bearing_to(1.8, 0.6);
+        assert!(left > 0.0 && right < 0.0);
+        assert_eq!(turn_likelihood(&p, 0.95, 0.02, left), 0.2);
+        assert_eq!(turn_likelihood(&p, 0.95, 0.02, right), 1.0);
+        assert_eq!(turn_likelihood(&p, 0.95, -0.02, left), 1.0);
+        assert_eq!(turn_likelihood(&p, 0.95, -0.02, right), 0.2);
+    }
+
+    #[test]
+    fn eq7_peak_values() {
+        let p = params();
+        let peak = 1.0 / (20f64.to_radians() * (2.0 * PI).sqrt());
+        assert!((p.pdf_peak() - peak).abs() < 1e-12);
+        assert!((peak - 1.1429).abs() < 1e-4, "{peak}");
+        assert!((linear_likelihood(&p, 0.1, 0.0) - (1.0 + 0.01 * peak)).abs() < 1e-12);
+        assert!((linear_likelihood(&p, 0.8, 0.0) - (1.0 - 0.7 * peak)).abs() < 1e-12);
+        assert!(linear_likelihood(&p, 0.8, 0.0) > 0.19);
+        // Even in the bearing, and flat far from the field of view.
+        let b = 0.3;
+        assert_eq!(
+            linear_likelihood(&p, 0.9, b),
+            linear_likelihood(&p, 0.9, -b)
+        );
+        assert!((linear_likelihood(&p, 0.9, PI) - 1.0).abs() < 1e-8);
+        assert!((linear_likelihood(&p, 0.1, 2.0) - 1.0).abs() < 1e-5);
+        // One sigma off the heading: N = peak * e^(-1/2).
+        let one_sigma = linear_likelihood(&p, 0.9, 20f64.to_radians());
+        assert!((one_sigma - (1.0 - 0.7 * peak * (-0.5f64).exp())).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bad_parameters_name_the_field() {
+        let d = ContinuousControlParams::default();
+        d.validate().unwrap();
+        for (p, field) in [
+            (
+                ContinuousControlParams {
+                    t_e: 0.0,
+                    ..d.clone()
+                },
+                "t_e",
+            ),
+            (
+                ContinuousControlParams {
+                    k_turn: 1.0,
+                    ..d.clone()
+                },
+                "k_turn",
+            ),
+            (
+                ContinuousControlParams {
+                    k_p: -0.1,
+                    ..d.clone()
+                },
+                "k_p",
+            ),
+            (
+                ContinuousControlParams {
+                    k_n: 0.9,
+                    ..d.clone()
+                },
+                "k_n",
+            ),
+            (
+                ContinuousControlParams {
+                    sigma_deg: 0.0,
+                    ..d.clone()
+                },
+                "sigma_deg",
+            ),
+            (
+                ContinuousControlParams {
+                    p_c: 1.0,
+                    ..d.clone()
+                },
+                "p_c",
+            ),
+            (
+                ContinuousControlParams {
+                    stop_secs: 0.0,
+                    ..d.clone()
+                },
+                "stop_secs",
+            ),
+            (
+                ContinuousControlParams {
+                    drive_speed_fraction: 1.5,
+                    ..d.clone()
+                },
+                "drive_speed_fraction",
+            ),
+            (
+                ContinuousControlParams {
+                    turn_speed_fraction: 0.0,
+                    ..d.clone()
+                },
+                "turn_speed_fraction",
+            ),
+            (
+                ContinuousControlParams {
+                    align_tolerance_deg: 90.0,
+                    ..d.clone()
+                },
+                "align_tolerance_deg",
+            ),
+            (
+                ContinuousControlParams {
+                    heading_gain: f64::NAN,
+                    ..d.clone()
+                },
+                "heading_gain",
+            ),
+            (
+                ContinuousControlParams {
+                    goal_radius_m: 0.0,
+                    ..d.clone()
+                },
+                "goal_radius_m",
+            ),
+        ] {
+            let e = p.validate().unwrap_err().to_string();
+            assert!(e.contains(field), "{e}");
+        }
+    }
+}

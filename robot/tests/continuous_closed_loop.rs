@@ -1,0 +1,157 @@
+//! Closed-loop runs of the continuous controller with exact kinematics (no
+//! physics, no EEG): an oracle plays the user and the decoder.
+
+use std::f64::consts::PI;
+
+use errp_robot::{
+    ContinuousControlParams, ContinuousController, GoalLayout, Phase, Pose, StopReason, integrate,
+    wrap_angle,
+};
+
+/// Physics step, s: 5 per 62.5 ms decoder window.
+const DT_SECS: f64 = 0.0125;
+const STEPS_PER_WINDOW: usize = 5;
+
+/// How a run ended.
+struct Run {
+    converged: Option<usize>,
+    secs: f64,
+    pose: Pose,
+    /// Detected errors (each stopped a turn or a drive).
+    detections: usize,
+    /// Every goal the robot set off for or stopped on, in order.
+    targets: Vec<usize>,
+}
+
+/// The oracle's p(error) for the last window: 0.95 if the motion was wrong
+/// for `truth` (turning away from it while |bearing| > 20 deg, driving with
+/// |bearing| > 20 deg, or stopped on another goal), 0.05 otherwise.
+fn oracle_p(c: &ContinuousController, pose: &Pose, heading_change_rad: f64, truth: usize) -> f64 {
+    let g = c.layout().goal(truth);
+    let b = pose.bearing_to(g.x_m, g.y_m);
+    let off = b.abs() > 20f64.to_radians();
+    let wrong = match c.phase() {
+        Phase::Turning => off && heading_change_rad * b < 0.0,
+        Phase::Driving => off,
+        Phase::Stopped {
+            reason: StopReason::OnGoal(j),
+            ..
+        } => j != truth,
+        Phase::Stopped { .. } => false,
+    };
+    if wrong { 0.95 } else { 0.05 }
+}
+
+/// Runs until convergence or `max_secs`; `truth = None` means a decoder that
+/// never reports an error (p = 0.05).
+fn run(start: Pose, truth: Option<usize>, max_secs: f64) -> Run {
+    let params = ContinuousControlParams::default();
+    let epuck = params.epuck;
+    let mut c = ContinuousController::new(params, GoalLayout::cities(), start).unwrap();
+    let mut pose = start;
+    let mut window_heading = start.heading_rad;
+    let mut detections = 0;
+    let mut targets = vec![c.target()];
+    let steps = (max_secs / DT_SECS) as usize;
+    for k in 0..steps {
+        let w = c.command(&pose, k as f64 * DT_SECS);
+        if targets.last() != Some(&c.target()) {
+            targets.push(c.target());
+        }
+        let before = pose;
+        pose = integrate(&pose, &w.to_twist(&epuck), DT_SECS);
+        // No lateral velocity: every step moves along the mean heading.
+        let moved = pose.distance_to(before.x_m, before.y_m);
+        if moved > 1e-9 {
+            let chord = (pose.y_m - before.y_m).atan2(pose.x_m - before.x_m);
+            let mean = before.heading_rad + 0.5 * wrap_angle(pose.heading_rad - before.heading_rad);
+            assert!(
+                wrap_angle(chord - mean).abs() < 1e-6,
+                "sideways motion: {before:?} -> {pose:?}, {w:?}"
+            );
+        }
+        if (k + 1) % STEPS_PER_WINDOW == 0 {
+            let t = (k + 1) as f64 * DT_SECS;
+            let dh = wrap_angle(pose.heading_rad - window_heading);
+            window_heading = pose.heading_rad;
+            let p = truth.map_or(0.05, |g| oracle_p(&c, &pose, dh, g));
+            let o = c.observe(p, &pose, t).unwrap();
+            detections += usize::from(o.detected);
+            if o.converged.is_some() {
+                return Run {
+                    converged: o.converged,
+                    secs: t,
+                    pose,
+                    detections,
+                    targets,
+                };
+            }
+        }
+    }
+    Run {
+        converged: None,
+        secs: max_secs,
+        pose,
+        detections,
+        targets,
+    }
+}
+
+fn names(targets: &[usize]) -> Vec<String> {
+    let l = GoalLayout::cities();
+    targets.iter().map(|&i| l.goal(i).name.clone()).collect()
+}
+
+fn goal_pose(name: &str, heading_rad: f64) -> (Pose, usize) {
+    let l = GoalLayout::cities();
+    let i = l.index_of(name).unwrap();
+    let g = l.goal(i);
+    (Pose::new(g.x_m, g.y_m, heading_rad), i)
+}
+
+#[test]
+fn oracle_user_takes_the_robot_from_mexico_to_pisa() {
+    let pisa = GoalLayout::cities().index_of("Pisa").unwrap();
+    for heading in [0.0, PI / 2.0, PI, -PI / 4.0, 2.5] {
+        let (start, _) = goal_pose("Mexico", heading);
+        let r = run(start, Some(pisa), 300.0);
+        assert_eq!(r.converged, Some(pisa), "heading {heading}: {} s", r.secs);
+        let g = GoalLayout::cities().goal(pisa).clone();
+        assert!(r.pose.distance_to(g.x_m, g.y_m) < 0.02);
+        eprintln!(
+            "Mexico -> Pisa, heading {heading:.2}: {:.1} s, {} detected errors, via {:?}",
+            r.secs,
+            r.detections,
+            names(&r.targets)
+        );
+    }
+}
+
+#[test]
+fn oracle_user_takes_the_robot_from_lisbon_to_tokyo() {
+    let tokyo = GoalLayout::cities().index_of("Tokyo").unwrap();
+    for heading in [0.0, -PI / 2.0, PI / 3.0] {
+        let (start, _) = goal_pose("Lisbon", heading);
+        let r = run(start, Some(tokyo), 300.0);
+        assert_eq!(r.converged, Some(tokyo), "heading {heading}: {} s", r.secs);
+        eprintln!(
+            "Lisbon -> Tokyo, heading {heading:.2}: {:.1} s, {} detected errors, via {:?}",
+            r.secs,
+            r.detections,
+            names(&r.targets)
+        );
+    }
+}
+
+#[test]
+fn without_errors_the_robot_drives_to_the_nearest_goal_and_stays() {
+    let l = GoalLayout::cities();
+    let havana = l.index_of("Havana").unwrap();
+    let start = Pose::new(0.5, 0.3, 2.0); // Havana (0.6, 0.2) is 0.14 m away
+    let r = run(start, None, 300.0);
+    assert_eq!(r.converged, Some(havana), "{} s", r.secs);
+    let g = l.goal(havana);
+    assert!(r.pose.distance_to(g.x_m, g.y_m) < 0.02);
+    assert_eq!(r.detections, 0);
+    eprintln!("no errors: converged on Havana after {:.1} s", r.secs);
+}

@@ -1,0 +1,130 @@
+//! Running an e-puck scenario: calibrate the continuous decoder at the
+//! scenario's accuracy, then every run of the episode, each from its own
+//! derived seed (in parallel when no recording watches).
+
+use errp_bci::{Accuracy, TargetingStep, rng::derive_seed};
+use rayon::prelude::*;
+
+use crate::continuous_decoder::{
+    ContinuousDecoder, ContinuousReport, ContinuousRequest, run_continuous_calibration,
+};
+use crate::epuck_scenario::EpuckScenario;
+use crate::epuck_task::{EpuckEpisodeResult, EpuckObserver, run_epuck_episode};
+use crate::error::Result;
+
+/// The paper's two e-puck runs (sec. 5.3): (scenario name, seconds to the
+/// goal, error events).
+pub const PAPER_EPUCK: [(&str, f64, usize); 2] =
+    [("Mexico to Pisa", 60.0, 11), ("Lisbon to Tokyo", 121.0, 26)];
+
+/// Calibrates the scenario's continuous decoder (`progress` sees the search).
+pub fn prepare_continuous_decoder(
+    scenario: &EpuckScenario,
+    progress: impl FnMut(&TargetingStep),
+) -> Result<(ContinuousDecoder, ContinuousReport)> {
+    let report = run_continuous_calibration(
+        &ContinuousRequest::new(scenario.accuracy, scenario.seed),
+        progress,
+    )?;
+    Ok((ContinuousDecoder::from_report(&report), report))
+}
+
+/// The seed of run `k` of a scenario with base seed `seed`.
+pub fn epuck_run_seed(seed: u64, k: usize) -> u64 {
+    derive_seed(seed, "epuck/run", k as u64)
+}
+
+/// Runs run `k` of `scenario` with `observer` watching.
+pub fn run_epuck_once(
+    scenario: &EpuckScenario,
+    decoder: &ContinuousDecoder,
+    k: usize,
+    observer: &mut impl EpuckObserver,
+) -> Result<EpuckEpisodeResult> {
+    run_epuck_episode(
+        &scenario.params,
+        &scenario.arena,
+        &scenario.layout,
+        scenario.episode,
+        decoder,
+        epuck_run_seed(scenario.seed, k),
+        observer,
+    )
+}
+
+/// Runs `runs` runs of `scenario` in parallel, without recording. Results
+/// are in run order and do not depend on the number of threads.
+pub fn run_epuck_batch(
+    scenario: &EpuckScenario,
+    decoder: &ContinuousDecoder,
+    runs: usize,
+) -> Result<Vec<EpuckEpisodeResult>> {
+    (0..runs)
+        .into_par_iter()
+        .map(|k| run_epuck_once(scenario, decoder, k, &mut ()))
+        .collect()
+}
+
+/// Median of `xs` (NaN if empty).
+pub fn median(xs: &[f64]) -> f64 {
+    if xs.is_empty() {
+        return f64::NAN;
+    }
+    let mut v = xs.to_vec();
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// Summary of many runs of one e-puck scenario.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EpuckSummary {
+    /// Runs.
+    pub runs: usize,
+    /// Runs that converged on the user's goal.
+    pub reached: usize,
+    /// Runs that converged on another goal.
+    pub wrong: usize,
+    /// Median time to convergence over the runs that reached the goal (s).
+    pub median_secs: f64,
+    /// Median detected errors over those runs.
+    pub median_detected: f64,
+    /// Median false detections over those runs.
+    pub median_false: f64,
+    /// Window accuracy pooled over every run.
+    pub online: Accuracy,
+}
+
+/// Summarises `results`.
+pub fn summarise(results: &[EpuckEpisodeResult]) -> EpuckSummary {
+    let ok: Vec<&EpuckEpisodeResult> = results.iter().filter(|r| r.reached()).collect();
+    let col = |f: &dyn Fn(&EpuckEpisodeResult) -> f64| ok.iter().map(|r| f(r)).collect::<Vec<_>>();
+    let (mut ch, mut cn, mut eh, mut en) = (0.0, 0, 0.0, 0);
+    for r in results {
+        ch += r.online.correct * r.online.n_correct as f64;
+        cn += r.online.n_correct;
+        eh += r.online.error * r.online.n_error as f64;
+        en += r.online.n_error;
+    }
+    EpuckSummary {
+        runs: results.len(),
+        reached: ok.len(),
+        wrong: results
+            .iter()
+            .filter(|r| r.committed.is_some() && !r.reached())
+            .count(),
+        median_secs: median(&col(&|r| r.time_secs)),
+        median_detected: median(&col(&|r| r.detected_errors as f64)),
+        median_false: median(&col(&|r| r.false_detections as f64)),
+        online: Accuracy {
+            correct: ch / cn.max(1) as f64,
+            error: eh / en.max(1) as f64,
+            n_correct: cn,
+            n_error: en,
+        },
+    }
+}

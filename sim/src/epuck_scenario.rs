@@ -1,0 +1,527 @@
+//! Scenario files of the continuous e-puck task, and loading a scenario of
+//! either task.
+//!
+//! Lengths are in centimetres and angles in degrees in the file, as a user
+//! measures them on the arena; they are converted to SI once, here.
+
+use std::path::{Path, PathBuf};
+
+use errp_bci::check_requested_accuracy;
+use errp_robot::{GoalLayout, Pose};
+use serde::Deserialize;
+
+use crate::epuck_task::{EpuckEpisode, EpuckTaskParams};
+use crate::error::{Result, SimError};
+use crate::scenario::Scenario;
+use crate::world::{ArenaSpec, Obstacle};
+
+/// A scenario of either task, as `errp run` takes it.
+#[derive(Debug, Clone)]
+pub enum AnyScenario {
+    /// The discrete 5x5 grid task (sec. 4).
+    Grid(Box<Scenario>),
+    /// The continuous e-puck task (sec. 5).
+    Epuck(Box<EpuckScenario>),
+}
+
+/// Reads a scenario file and validates it according to its `task` field.
+pub fn load_scenario(path: impl AsRef<Path>) -> Result<AnyScenario> {
+    let path = path.as_ref();
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        SimError::Scenario(format!("{}: cannot read the scenario: {e}", path.display()))
+    })?;
+    #[derive(Deserialize)]
+    struct Task {
+        task: Option<String>,
+    }
+    let task: Task = toml::from_str(&text).map_err(|e| {
+        SimError::Scenario(format!("{}: {}", path.display(), e.to_string().trim_end()))
+    })?;
+    match task.task.as_deref() {
+        Some("epuck") => Ok(AnyScenario::Epuck(Box::new(EpuckScenario::parse(
+            &text, path,
+        )?))),
+        _ => Ok(AnyScenario::Grid(Box::new(Scenario::parse(&text, path)?))),
+    }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct EpuckFile {
+    task: String,
+    #[serde(default)]
+    name: Option<String>,
+    #[serde(default)]
+    description: Option<String>,
+    #[serde(default = "default_seed")]
+    seed: u64,
+    start: StartFile,
+    #[serde(default = "default_heading")]
+    start_heading_deg: f64,
+    goal: String,
+    #[serde(default = "default_runs")]
+    runs: usize,
+    #[serde(default = "default_max_secs")]
+    max_secs: f64,
+    user: UserFile,
+    #[serde(default)]
+    control: Option<ControlFile>,
+    #[serde(default)]
+    tracker: Option<TrackerFile>,
+    #[serde(default)]
+    avoidance: Option<AvoidanceFile>,
+    #[serde(default)]
+    arena: Option<ArenaFile>,
+}
+
+fn default_seed() -> u64 {
+    1
+}
+fn default_heading() -> f64 {
+    90.0
+}
+fn default_runs() -> usize {
+    1
+}
+fn default_max_secs() -> f64 {
+    600.0
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+enum StartFile {
+    City(String),
+    Cm([f64; 2]),
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct UserFile {
+    accuracy: f64,
+    fov_deg: Option<f64>,
+    reaction_latency_ms: Option<f64>,
+    reelicit_secs: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ControlFile {
+    t_e: Option<f64>,
+    k_turn: Option<f64>,
+    k_p: Option<f64>,
+    k_n: Option<f64>,
+    sigma_deg: Option<f64>,
+    p_c: Option<f64>,
+    stop_secs: Option<f64>,
+    drive_speed_fraction: Option<f64>,
+    turn_speed_fraction: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TrackerFile {
+    rate_hz: Option<f64>,
+    position_noise_cm: Option<f64>,
+    heading_noise_deg: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct AvoidanceFile {
+    enabled: Option<bool>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ArenaFile {
+    #[serde(default)]
+    obstacle: Vec<ObstacleFile>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ObstacleFile {
+    shape: String,
+    center_cm: [f64; 2],
+    #[serde(default)]
+    size_cm: Option<[f64; 2]>,
+    #[serde(default)]
+    radius_cm: Option<f64>,
+    #[serde(default)]
+    angle_deg: f64,
+}
+
+/// A validated e-puck scenario.
+#[derive(Debug, Clone)]
+pub struct EpuckScenario {
+    /// The file it came from.
+    pub path: PathBuf,
+    /// Display name.
+    pub name: String,
+    /// What it reproduces, in words.
+    pub description: String,
+    /// Base seed (calibration and runs).
+    pub seed: u64,
+    /// The continuous decoder's cross-validated mean accuracy, in (0.5, 1).
+    pub accuracy: f64,
+    /// Runs of the episode, each from its own derived seed.
+    pub runs: usize,
+    /// Start pose and goal.
+    pub episode: EpuckEpisode,
+    /// Walls and obstacles.
+    pub arena: ArenaSpec,
+    /// The 25 city goals.
+    pub layout: GoalLayout,
+    /// Robot, control, user, tracker, avoidance, time-out.
+    pub params: EpuckTaskParams,
+}
+
+impl EpuckScenario {
+    /// Reads and validates an e-puck scenario file.
+    pub fn load(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            SimError::Scenario(format!("{}: cannot read the scenario: {e}", path.display()))
+        })?;
+        Self::parse(&text, path)
+    }
+
+    /// Validates scenario text; `path` names it in errors.
+    pub fn parse(text: &str, path: &Path) -> Result<Self> {
+        let file: EpuckFile = toml::from_str(text).map_err(|e| {
+            SimError::Scenario(format!("{}: {}", path.display(), e.to_string().trim_end()))
+        })?;
+        let bad = |field: &str, value: String, expected: &str| {
+            SimError::Scenario(format!(
+                "{}: field `{field}` = {value} is invalid: expected {expected}",
+                path.display()
+            ))
+        };
+        if file.task != "epuck" {
+            return Err(bad("task", format!("{:?}", file.task), "\"epuck\""));
+        }
+        let layout = GoalLayout::cities();
+        let size_m = layout.arena_size_m();
+        let size_cm = size_m * 100.0;
+        let cities = || layout.names().join(", ");
+        let goal = layout.index_of(&file.goal).ok_or_else(|| {
+            bad(
+                "goal",
+                format!("{:?}", file.goal),
+                &format!("one of the 25 cities: {}", cities()),
+            )
+        })?;
+
+        let mut params = EpuckTaskParams::default();
+        let radius_m = params.control.epuck.body_diameter_m / 2.0;
+        let (sx, sy) = match &file.start {
+            StartFile::City(name) => {
+                let i = layout.index_of(name).ok_or_else(|| {
+                    bad(
+                        "start",
+                        format!("{name:?}"),
+                        &format!("a city ({}) or a position [x_cm, y_cm]", cities()),
+                    )
+                })?;
+                (layout.goals()[i].x_m, layout.goals()[i].y_m)
+            }
+            StartFile::Cm([x, y]) => {
+                let lo = radius_m * 100.0;
+                let inside = |v: f64| v.is_finite() && v >= lo && v <= size_cm - lo;
+                if !(inside(*x) && inside(*y)) {
+                    return Err(bad(
+                        "start",
+                        format!("[{x}, {y}]"),
+                        &format!(
+                            "a position [x_cm, y_cm] with both in [{lo:.1}, {:.1}] so the \
+                             e-puck's body is inside the {size_cm} cm arena",
+                            size_cm - lo
+                        ),
+                    ));
+                }
+                (x / 100.0, y / 100.0)
+            }
+        };
+        if !file.start_heading_deg.is_finite() {
+            return Err(bad(
+                "start_heading_deg",
+                file.start_heading_deg.to_string(),
+                "an angle in degrees (0 = +x, 90 = up)",
+            ));
+        }
+        let start = Pose {
+            x_m: sx,
+            y_m: sy,
+            heading_rad: errp_robot::wrap_angle(file.start_heading_deg.to_radians()),
+        };
+        if start.distance_to(layout.goals()[goal].x_m, layout.goals()[goal].y_m) < 0.05 {
+            return Err(bad(
+                "goal",
+                format!("{:?}", file.goal),
+                "a goal away from the start",
+            ));
+        }
+
+        check_requested_accuracy(file.user.accuracy).map_err(|e| {
+            bad(
+                "user.accuracy",
+                file.user.accuracy.to_string(),
+                &e.to_string(),
+            )
+        })?;
+        if let Some(v) = file.user.fov_deg {
+            params.user.fov_rad = v.to_radians();
+        }
+        if let Some(v) = file.user.reaction_latency_ms {
+            params.user.reaction_latency_secs = v / 1000.0;
+        }
+        if let Some(v) = file.user.reelicit_secs {
+            params.user.reelicit_secs = v;
+        }
+        params
+            .user
+            .validate()
+            .map_err(|e| SimError::Scenario(format!("{}: {e}", path.display())))?;
+
+        if let Some(c) = &file.control {
+            let p = &mut params.control;
+            let set = |dst: &mut f64, v: Option<f64>| {
+                if let Some(v) = v {
+                    *dst = v;
+                }
+            };
+            set(&mut p.t_e, c.t_e);
+            set(&mut p.k_turn, c.k_turn);
+            set(&mut p.k_p, c.k_p);
+            set(&mut p.k_n, c.k_n);
+            set(&mut p.sigma_deg, c.sigma_deg);
+            set(&mut p.p_c, c.p_c);
+            set(&mut p.stop_secs, c.stop_secs);
+            set(&mut p.drive_speed_fraction, c.drive_speed_fraction);
+            set(&mut p.turn_speed_fraction, c.turn_speed_fraction);
+        }
+        params
+            .control
+            .validate()
+            .map_err(|e| SimError::Scenario(format!("{}: [control] {e}", path.display())))?;
+
+        if let Some(t) = &file.tracker {
+            if let Some(v) = t.rate_hz {
+                params.tracker.rate_hz = v;
+            }
+            if let Some(v) = t.position_noise_cm {
+                params.tracker.position_noise_m = v / 100.0;
+            }
+            if let Some(v) = t.heading_noise_deg {
+                params.tracker.heading_noise_rad = v.to_radians();
+            }
+        }
+        params
+            .tracker
+            .validate()
+            .map_err(|e| SimError::Scenario(format!("{}: {e}", path.display())))?;
+        if let Some(v) = file.avoidance.as_ref().and_then(|a| a.enabled) {
+            params.avoidance.enabled = v;
+        }
+        if !(file.max_secs.is_finite() && file.max_secs > 0.0) {
+            return Err(bad(
+                "max_secs",
+                file.max_secs.to_string(),
+                "a time-out > 0 s (default 600)",
+            ));
+        }
+        params.max_secs = file.max_secs;
+        if file.runs == 0 {
+            return Err(bad("runs", "0".into(), "at least 1"));
+        }
+
+        let mut arena = ArenaSpec {
+            size_m,
+            ..ArenaSpec::paper()
+        };
+        for (k, o) in file
+            .arena
+            .iter()
+            .flat_map(|a| a.obstacle.iter())
+            .enumerate()
+        {
+            let field = |f: &str| format!("arena.obstacle[{k}].{f}");
+            let [cx, cy] = o.center_cm;
+            if !(cx.is_finite()
+                && cy.is_finite()
+                && (0.0..=size_cm).contains(&cx)
+                && (0.0..=size_cm).contains(&cy))
+            {
+                return Err(bad(
+                    &field("center_cm"),
+                    format!("[{cx}, {cy}]"),
+                    &format!("a point inside the arena, both coordinates in [0, {size_cm}]"),
+                ));
+            }
+            let obstacle = match o.shape.as_str() {
+                "box" => {
+                    let [w, h] = o.size_cm.ok_or_else(|| {
+                        bad(&field("size_cm"), "missing".into(), "[width_cm, height_cm]")
+                    })?;
+                    if !(w.is_finite() && h.is_finite() && w > 0.0 && h > 0.0) {
+                        return Err(bad(
+                            &field("size_cm"),
+                            format!("[{w}, {h}]"),
+                            "two sizes > 0 cm",
+                        ));
+                    }
+                    if !o.angle_deg.is_finite() {
+                        return Err(bad(
+                            &field("angle_deg"),
+                            o.angle_deg.to_string(),
+                            "an angle in degrees",
+                        ));
+                    }
+                    Obstacle::Box {
+                        x_m: cx / 100.0,
+                        y_m: cy / 100.0,
+                        half_width_m: w / 200.0,
+                        half_height_m: h / 200.0,
+                        angle_rad: o.angle_deg.to_radians(),
+                    }
+                }
+                "circle" => {
+                    let r = o.radius_cm.ok_or_else(|| {
+                        bad(&field("radius_cm"), "missing".into(), "a radius in cm")
+                    })?;
+                    if !(r.is_finite() && r > 0.0) {
+                        return Err(bad(&field("radius_cm"), r.to_string(), "a radius > 0 cm"));
+                    }
+                    Obstacle::Circle {
+                        x_m: cx / 100.0,
+                        y_m: cy / 100.0,
+                        radius_m: r / 100.0,
+                    }
+                }
+                other => {
+                    return Err(bad(
+                        &field("shape"),
+                        format!("{other:?}"),
+                        "\"box\" or \"circle\"",
+                    ));
+                }
+            };
+            // Every goal must stay reachable: the robot has to fit on it.
+            if let Some(g) = layout
+                .goals()
+                .iter()
+                .find(|g| obstacle.signed_distance(g.x_m, g.y_m) < radius_m + 0.01)
+            {
+                return Err(bad(
+                    &field("center_cm"),
+                    format!("[{cx}, {cy}]"),
+                    &format!(
+                        "an obstacle clear of every goal: this one covers {} (keep its edge \
+                         at least {:.1} cm from the goal)",
+                        g.name,
+                        (radius_m + 0.01) * 100.0
+                    ),
+                ));
+            }
+            if obstacle.signed_distance(start.x_m, start.y_m) < radius_m {
+                return Err(bad(
+                    &field("center_cm"),
+                    format!("[{cx}, {cy}]"),
+                    "an obstacle clear of the e-puck's start",
+                ));
+            }
+            arena.obstacles.push(obstacle);
+        }
+
+        Ok(Self {
+            path: path.to_path_buf(),
+            name: file.name.unwrap_or_else(|| {
+                path.file_stem()
+                    .map_or("scenario".into(), |s| s.to_string_lossy().into())
+            }),
+            description: file.description.unwrap_or_default(),
+            seed: file.seed,
+            accuracy: file.user.accuracy,
+            runs: file.runs,
+            episode: EpuckEpisode { start, goal },
+            arena,
+            layout,
+            params,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const OK: &str = r#"
+task = "epuck"
+start = "Mexico"
+goal = "Pisa"
+[user]
+accuracy = 0.7438
+"#;
+
+    fn err(text: &str) -> String {
+        EpuckScenario::parse(text, Path::new("scenarios/x.toml"))
+            .unwrap_err()
+            .to_string()
+    }
+
+    #[test]
+    fn a_minimal_scenario_gets_the_papers_defaults() {
+        let s = EpuckScenario::parse(OK, Path::new("x.toml")).unwrap();
+        assert_eq!(s.params.control.t_e, 0.8);
+        assert_eq!(s.params.control.p_c, 0.4);
+        assert_eq!(s.layout.goals()[s.episode.goal].name, "Pisa");
+        assert!((s.episode.start.x_m - 0.2).abs() < 1e-12);
+        assert!(s.arena.obstacles.is_empty());
+    }
+
+    #[test]
+    fn every_bad_value_names_file_field_value_and_range() {
+        for (text, field, value) in [
+            (OK.replace("0.7438", "1.7"), "user.accuracy", "1.7"),
+            (OK.replace("0.7438", "nan"), "user.accuracy", "NaN"),
+            (OK.replace("\"Pisa\"", "\"Atlantis\""), "goal", "Atlantis"),
+            (OK.replace("\"Pisa\"", "\"Mexico\""), "goal", "Mexico"),
+            (
+                OK.replace("\"Mexico\"", "[250.0, 10.0]"),
+                "start",
+                "[250, 10]",
+            ),
+            (
+                format!(
+                    "{OK}[[arena.obstacle]]\nshape = \"circle\"\ncenter_cm = [100.0, 100.0]\nradius_cm = 10.0\n"
+                ),
+                "arena.obstacle[0].center_cm",
+                "Athens",
+            ),
+            (
+                format!(
+                    "{OK}[[arena.obstacle]]\nshape = \"circle\"\ncenter_cm = [300.0, 100.0]\nradius_cm = 5.0\n"
+                ),
+                "arena.obstacle[0].center_cm",
+                "[300, 100]",
+            ),
+            (
+                format!("{OK}[[arena.obstacle]]\nshape = \"star\"\ncenter_cm = [80.0, 80.0]\n"),
+                "arena.obstacle[0].shape",
+                "star",
+            ),
+            (format!("{OK}max_secs = -1.0\n"), "max_secs", "-1"),
+            (OK.replace("\"epuck\"", "\"epuk\""), "task", "epuk"),
+        ] {
+            let e = err(&text);
+            assert!(e.contains("scenarios/x.toml"), "{e}");
+            assert!(e.contains(field), "{field}: {e}");
+            assert!(e.contains(value), "{value}: {e}");
+            assert!(e.contains("expected"), "{e}");
+        }
+        let e = err(&format!("{OK}[control]\nt_e = 1.5\n"));
+        assert!(e.contains("scenarios/x.toml") && e.contains("t_e"), "{e}");
+        let e = err(&OK.replace("accuracy = 0.7438", "accuracy = 0.7438\nfov_deg = 0.0"));
+        assert!(e.contains("fov_deg"), "{e}");
+    }
+}

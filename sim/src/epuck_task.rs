@@ -1,0 +1,410 @@
+//! One episode of the continuous task (sec. 5 of the paper): the e-puck in
+//! the rapier2d arena, the overhead tracker, the synthetic user, streamed
+//! EEG, the sliding-window SVM and the shared control, in one loop.
+//!
+//! Time advances in physics steps of 1/64 s (4 EEG samples). Every 4 steps
+//! (62.5 ms, the paper's window step) 16 more EEG samples are streamed
+//! through the preprocessing, the 800 ms window is decoded into p(error) and
+//! the controller updates its belief (eq. 6-7) and reacts to a detection.
+
+use errp_bci::{Accuracy, Assessment, AssessmentKind, rng::stream};
+use errp_robot::{
+    ContinuousControlParams, ContinuousController, EpuckParams, GoalLayout, Phase, Pose,
+    WheelSpeeds, wrap_angle,
+};
+use serde::{Deserialize, Serialize};
+
+use crate::continuous_decoder::{ContinuousDecoder, OnlineWindow, WARM_UP_SECS};
+use crate::error::{Result, SimError};
+use crate::tracker::{CameraTracker, TrackerParams};
+use crate::user::{SyntheticUser, UserParams};
+use crate::world::{ArenaSpec, World};
+
+/// Obstacle avoidance from the proximity sensors, layered under the shared
+/// control (a Braitenberg reflex, as classic e-puck controllers do): the
+/// closer something is in front, the slower the robot drives and the harder
+/// it turns away from the more obstructed side. Sweeps of the paper's empty
+/// arena never trigger it: goals are 20 cm from the walls.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct AvoidanceParams {
+    /// Off: the robot drives into whatever is in front (for tests).
+    pub enabled: bool,
+    /// Front reading at which the robot starts slowing (~2.5 cm).
+    pub react_reading: f64,
+    /// Front reading at which forward motion stops (~1 cm).
+    pub stop_reading: f64,
+    /// Turn rate away from the obstruction at the stop reading (rad/s).
+    pub turn_rate_rad_per_s: f64,
+}
+
+impl Default for AvoidanceParams {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            react_reading: 300.0,
+            stop_reading: 1000.0,
+            turn_rate_rad_per_s: 1.5,
+        }
+    }
+}
+
+impl AvoidanceParams {
+    /// Blends the reflex into `wheels` given the eight readings ps0..ps7.
+    pub fn apply(
+        &self,
+        readings: &[f64; 8],
+        wheels: WheelSpeeds,
+        epuck: &EpuckParams,
+    ) -> WheelSpeeds {
+        if !self.enabled {
+            return wheels;
+        }
+        // ps0, ps1 on the right-front; ps6, ps7 on the left-front.
+        let right = readings[0].max(readings[1]);
+        let left = readings[7].max(readings[6]);
+        let front = right.max(left);
+        if front <= self.react_reading {
+            return wheels;
+        }
+        let k = ((front - self.react_reading) / (self.stop_reading - self.react_reading))
+            .clamp(0.0, 1.0);
+        let twist = wheels.to_twist(epuck);
+        let forward = twist.linear_m_per_s.max(0.0) * (1.0 - k);
+        let away = if right >= left { 1.0 } else { -1.0 };
+        let turn = (1.0 - k) * twist.angular_rad_per_s + k * away * self.turn_rate_rad_per_s;
+        errp_robot::Twist {
+            linear_m_per_s: forward.min(twist.linear_m_per_s.max(0.0)),
+            angular_rad_per_s: turn,
+        }
+        .to_wheels(epuck)
+        .clamp(epuck)
+    }
+}
+
+/// Everything that shapes a continuous episode besides the decoder.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EpuckTaskParams {
+    /// Shared control and motion (sec. 5.1-5.2).
+    pub control: ContinuousControlParams,
+    /// The synthetic user.
+    pub user: UserParams,
+    /// The ceiling camera.
+    pub tracker: TrackerParams,
+    /// Obstacle reflex.
+    pub avoidance: AvoidanceParams,
+    /// The episode gives up after this long (s).
+    pub max_secs: f64,
+}
+
+impl Default for EpuckTaskParams {
+    fn default() -> Self {
+        Self {
+            control: ContinuousControlParams::default(),
+            user: UserParams::default(),
+            tracker: TrackerParams::default(),
+            avoidance: AvoidanceParams::default(),
+            max_secs: 600.0,
+        }
+    }
+}
+
+/// Physics steps per decoder window step.
+pub const STEPS_PER_WINDOW: usize = 4;
+/// The decoder's window step: 62.5 ms (sec. 2.2.2).
+pub const WINDOW_STEP_SECS: f64 = 0.0625;
+/// The physics time step (s).
+pub const PHYSICS_DT_SECS: f64 = WINDOW_STEP_SECS / STEPS_PER_WINDOW as f64;
+/// An ErrP counts as inside a window ending at t if its time zero lies in
+/// [t - 0.8, t - 0.45] s: its three peaks (250-455 ms) are then inside.
+const ERRP_IN_WINDOW_SECS: (f64, f64) = (0.8, 0.45);
+/// A detection is attributed to an ErrP with time zero in [t - 0.8, t - 0.1].
+const DETECTION_SPAN_SECS: (f64, f64) = (0.8, 0.1);
+
+/// One physics step, for observers.
+#[derive(Debug, Clone, Copy)]
+pub struct PhysicsFrame {
+    /// Episode time at the end of the step (s).
+    pub time_secs: f64,
+    /// True pose.
+    pub pose: Pose,
+    /// Pose seen by the camera.
+    pub tracked: Pose,
+    /// Wheel speeds actually applied (after avoidance and noise).
+    pub wheels: WheelSpeeds,
+}
+
+/// One decoder window, for observers.
+#[derive(Debug, Clone)]
+pub struct WindowFrame {
+    /// Episode time at the end of the window (s).
+    pub time_secs: f64,
+    /// The decoder's output.
+    pub p_error: f64,
+    /// The belief after the update.
+    pub belief: Vec<f64>,
+    /// The goal the robot is heading to.
+    pub target: usize,
+    /// Whether this window stopped the robot.
+    pub detected: bool,
+    /// The tracked pose the controller used.
+    pub tracked: Pose,
+    /// Preprocessed FCz and Cz samples of the last 62.5 ms (uV).
+    pub fcz_cz: [Vec<f64>; 2],
+}
+
+/// Watches an episode as it runs. Every method does nothing by default, and
+/// `()` watches nothing, so runs without a recording pay nothing.
+pub trait EpuckObserver {
+    /// After each physics step.
+    fn on_physics(&mut self, _frame: &PhysicsFrame) {}
+    /// After each decoder window.
+    fn on_window(&mut self, _frame: &WindowFrame) {}
+    /// A notable event, in words.
+    fn on_event(&mut self, _time_secs: f64, _text: &str, _warn: bool) {}
+}
+
+impl EpuckObserver for () {}
+
+/// An episode: where the e-puck starts and which goal the user wants.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EpuckEpisode {
+    /// Start pose.
+    pub start: Pose,
+    /// Index of the user's goal in the layout.
+    pub goal: usize,
+}
+
+/// What one continuous episode produced.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EpuckEpisodeResult {
+    /// The user's goal.
+    pub goal: usize,
+    /// The goal the belief converged on while the robot stood on it.
+    pub committed: Option<usize>,
+    /// Time from the start to convergence, or to the time-out (s).
+    pub time_secs: f64,
+    /// Errors detected (p >= T_e during motion: each stopped the robot).
+    pub detected_errors: usize,
+    /// Detections with no ErrP behind them.
+    pub false_detections: usize,
+    /// ErrPs elicited during motion that no window detected.
+    pub missed_errors: usize,
+    /// ErrPs elicited (error onsets and re-elicitations).
+    pub errps: usize,
+    /// Per-window accuracy at T_e: windows holding an ErrP against windows
+    /// with none near.
+    pub online: Accuracy,
+    /// Distance driven (m).
+    pub path_m: f64,
+    /// Largest sideways speed of the body seen over the episode (m/s).
+    pub max_lateral_m_per_s: f64,
+    /// Where errors were detected (true positions, m).
+    pub detections: Vec<[f64; 2]>,
+}
+
+impl EpuckEpisodeResult {
+    /// True if the robot converged on the user's goal.
+    pub fn reached(&self) -> bool {
+        self.committed == Some(self.goal)
+    }
+}
+
+/// Runs one episode to convergence or time-out. Every random stream (EEG,
+/// tracker, wheels) is derived from `seed`.
+pub fn run_epuck_episode(
+    params: &EpuckTaskParams,
+    arena: &ArenaSpec,
+    layout: &GoalLayout,
+    episode: EpuckEpisode,
+    decoder: &ContinuousDecoder,
+    seed: u64,
+    observer: &mut impl EpuckObserver,
+) -> Result<EpuckEpisodeResult> {
+    if episode.goal >= layout.goals().len() {
+        return Err(SimError::Scenario(format!(
+            "goal index {} is not in the layout of {} goals",
+            episode.goal,
+            layout.goals().len()
+        )));
+    }
+    let mut world = World::new(arena, &params.control.epuck, episode.start, PHYSICS_DT_SECS)?;
+    let mut tracker = CameraTracker::new(params.tracker, stream(seed, "epuck/tracker"));
+    let mut wheels_rng = stream(seed, "epuck/wheels");
+    let mut user = SyntheticUser::new(params.user, layout, episode.goal);
+    let mut controller =
+        ContinuousController::new(params.control.clone(), layout.clone(), episode.start)?;
+    let mut eeg = OnlineWindow::start(decoder, errp_bci::rng::derive_seed(seed, "epuck/eeg", 0))?;
+
+    let goal_name = &layout.goals()[episode.goal].name;
+    observer.on_event(0.0, &format!("the user wants {goal_name}"), false);
+
+    let mut time_secs = 0.0;
+    let mut pose = world.pose();
+    let mut tracked = tracker.observe(0.0, &pose);
+    let mut errps: Vec<(f64, bool)> = Vec::new(); // (time zero, during motion)
+    let mut detections: Vec<f64> = Vec::new();
+    let mut detected_at = Vec::new();
+    let (mut hits, mut n_err_windows, mut false_alarms, mut n_clean_windows) = (0, 0, 0, 0);
+    let mut path_m = 0.0;
+    let mut max_lateral: f64 = 0.0;
+    let mut committed = None;
+    let n_windows = (params.max_secs / WINDOW_STEP_SECS).ceil() as usize;
+    let mut last_target = controller.target();
+    'episode: for _ in 0..n_windows {
+        for _ in 0..STEPS_PER_WINDOW {
+            if let Some(e) = user.observe(time_secs, &tracked) {
+                let moving = !matches!(controller.phase(), Phase::Stopped { .. });
+                if e.kind == AssessmentKind::Error {
+                    errps.push((e.onset_secs, moving));
+                }
+                eeg.generator.schedule(Assessment {
+                    onset_secs: WARM_UP_SECS + e.onset_secs,
+                    kind: e.kind,
+                });
+                if e.kind == AssessmentKind::Error {
+                    observer.on_event(time_secs, "the user sees an error (ErrP)", false);
+                }
+            }
+            let command = controller.command(&tracked, time_secs);
+            let readings = if params.avoidance.enabled {
+                world.proximity()
+            } else {
+                [0.0; 8]
+            };
+            let safe = params
+                .avoidance
+                .apply(&readings, command, &params.control.epuck);
+            let applied = safe.apply_noise(&params.control.epuck, &mut wheels_rng);
+            world.step(applied.to_twist(&params.control.epuck));
+            time_secs += PHYSICS_DT_SECS;
+            let next = world.pose();
+            let (dx, dy) = (next.x_m - pose.x_m, next.y_m - pose.y_m);
+            let mid = pose.heading_rad + 0.5 * wrap_angle(next.heading_rad - pose.heading_rad);
+            let lateral = (-mid.sin() * dx + mid.cos() * dy) / PHYSICS_DT_SECS;
+            max_lateral = max_lateral.max(lateral.abs());
+            path_m += (dx * dx + dy * dy).sqrt();
+            pose = next;
+            tracked = tracker.observe(time_secs, &pose);
+            observer.on_physics(&PhysicsFrame {
+                time_secs,
+                pose,
+                tracked,
+                wheels: applied,
+            });
+        }
+
+        let fresh = eeg.advance();
+        let p_error = eeg.p_error(&decoder.model);
+        let obs = controller.observe(p_error, &tracked, time_secs)?;
+
+        // Scoring of this window against the ErrPs the user produced.
+        let says_error = p_error >= params.control.t_e;
+        let has_errp = errps.iter().any(|&(o, _)| {
+            o >= time_secs - ERRP_IN_WINDOW_SECS.0 && o <= time_secs - ERRP_IN_WINDOW_SECS.1
+        });
+        let near_errp = errps
+            .iter()
+            .any(|&(o, _)| o >= time_secs - 1.0 && o <= time_secs);
+        if has_errp {
+            n_err_windows += 1;
+            hits += usize::from(says_error);
+        } else if !near_errp {
+            n_clean_windows += 1;
+            false_alarms += usize::from(says_error);
+        }
+        if obs.detected {
+            detections.push(time_secs);
+            detected_at.push([pose.x_m, pose.y_m]);
+            let real = errps.iter().any(|&(o, _)| {
+                o >= time_secs - DETECTION_SPAN_SECS.0 && o <= time_secs - DETECTION_SPAN_SECS.1
+            });
+            observer.on_event(
+                time_secs,
+                &format!(
+                    "error detected (p = {p_error:.2}){}: stop {:.0} s",
+                    if real { "" } else { ", a false positive" },
+                    params.control.stop_secs
+                ),
+                !real,
+            );
+        }
+        if controller.target() != last_target {
+            last_target = controller.target();
+            observer.on_event(
+                time_secs,
+                &format!("new goal: {}", layout.goals()[last_target].name),
+                false,
+            );
+        }
+        observer.on_window(&WindowFrame {
+            time_secs,
+            p_error,
+            belief: controller.belief().probabilities(),
+            target: controller.target(),
+            detected: obs.detected,
+            tracked,
+            fcz_cz: [
+                fresh.channel(eeg.fcz_cz[0]).to_vec(),
+                fresh.channel(eeg.fcz_cz[1]).to_vec(),
+            ],
+        });
+        if let Some(j) = obs.converged {
+            committed = Some(j);
+            observer.on_event(
+                time_secs,
+                &format!(
+                    "converged on {} ({})",
+                    layout.goals()[j].name,
+                    if j == episode.goal {
+                        "the user's goal"
+                    } else {
+                        "a wrong goal"
+                    }
+                ),
+                j != episode.goal,
+            );
+            break 'episode;
+        }
+    }
+    if committed.is_none() {
+        observer.on_event(time_secs, "time-out: no convergence", true);
+    }
+
+    // ErrPs during motion whose detection span saw no detection.
+    let missed_errors = errps
+        .iter()
+        .filter(|&&(o, moving)| {
+            moving
+                && o + DETECTION_SPAN_SECS.0 <= time_secs
+                && !detections
+                    .iter()
+                    .any(|&t| t >= o + DETECTION_SPAN_SECS.1 && t <= o + DETECTION_SPAN_SECS.0)
+        })
+        .count();
+    let false_detections = detections
+        .iter()
+        .filter(|&&t| {
+            !errps
+                .iter()
+                .any(|&(o, _)| o >= t - DETECTION_SPAN_SECS.0 && o <= t - DETECTION_SPAN_SECS.1)
+        })
+        .count();
+    Ok(EpuckEpisodeResult {
+        goal: episode.goal,
+        committed,
+        time_secs,
+        detected_errors: detections.len(),
+        false_detections,
+        missed_errors,
+        errps: errps.len(),
+        online: Accuracy {
+            correct: 1.0 - false_alarms as f64 / n_clean_windows.max(1) as f64,
+            error: hits as f64 / n_err_windows.max(1) as f64,
+            n_correct: n_clean_windows,
+            n_error: n_err_windows,
+        },
+        path_m,
+        max_lateral_m_per_s: max_lateral,
+        detections: detected_at,
+    })
+}

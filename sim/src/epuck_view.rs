@@ -1,0 +1,324 @@
+//! What `errp run <e-puck scenario> --save` records: the arena as seen from
+//! the ceiling (walls, obstacles, the 25 cities coloured by belief, the
+//! e-puck, its trajectory and red marks where errors were detected, as in
+//! Fig. 5), the belief as bars and one series per city, p(error) against
+//! T_e, preprocessed EEG at FCz and Cz, and a log of events, all on the
+//! `sim_time` timeline in seconds. Lengths are in centimetres.
+
+use std::path::Path;
+
+use errp_robot::GoalLayout;
+use rerun::blueprint::{
+    BarChartView, Blueprint, Horizontal, Spatial2DView, TextLogView, TimeSeriesView, Vertical,
+};
+use rerun::{
+    Arrows2D, BarChart, Color, LineStrips2D, Points2D, RecordingStream, Scalars, SeriesLines,
+    TextLog,
+};
+
+use crate::epuck_task::{EpuckObserver, PhysicsFrame, WindowFrame};
+use crate::error::{Result, SimError};
+use crate::grid_view::SIM_TIME;
+use crate::record::{RrdFile, record_error};
+use crate::world::{ArenaSpec, Obstacle};
+
+/// Pause between runs on the timeline (s).
+pub const RUN_GAP_SECS: f64 = 2.0;
+/// The trajectory is logged every this many physics steps (8 Hz).
+const TRAJECTORY_EVERY: usize = 8;
+
+fn blueprint() -> Blueprint {
+    Blueprint::new(Horizontal::new([
+        Vertical::new([
+            Spatial2DView::new("Arena (cm): e-puck, trajectory, detected errors")
+                .with_origin("/arena")
+                .into(),
+            TextLogView::new("Events").with_origin("/log").into(),
+        ])
+        .into(),
+        Vertical::new([
+            BarChartView::new("Belief over the 25 cities")
+                .with_origin("/belief/bars")
+                .into(),
+            TimeSeriesView::new("Belief per city")
+                .with_origin("/belief/city")
+                .into(),
+            TimeSeriesView::new("p(error) and T_e")
+                .with_origin("/decoder")
+                .into(),
+            TimeSeriesView::new("EEG (uV, preprocessed)")
+                .with_origin("/eeg")
+                .into(),
+        ])
+        .into(),
+    ]))
+}
+
+/// Opens the `.rrd` of an e-puck run, with its layout, before the run.
+pub fn epuck_recording(path: &Path) -> Result<RrdFile> {
+    RrdFile::create("errp_epuck", path, blueprint())
+}
+
+fn cm(x: f64, y: f64) -> [f32; 2] {
+    [(x * 100.0) as f32, (y * 100.0) as f32]
+}
+
+/// Polygon outline of an obstacle (cm).
+fn outline(o: &Obstacle) -> Vec<[f32; 2]> {
+    match *o {
+        Obstacle::Circle { x_m, y_m, radius_m } => (0..=48)
+            .map(|k| {
+                let a = k as f64 / 48.0 * std::f64::consts::TAU;
+                cm(x_m + radius_m * a.cos(), y_m + radius_m * a.sin())
+            })
+            .collect(),
+        Obstacle::Box {
+            x_m,
+            y_m,
+            half_width_m,
+            half_height_m,
+            angle_rad,
+        } => {
+            let (s, c) = angle_rad.sin_cos();
+            [
+                (-1.0, -1.0),
+                (1.0, -1.0),
+                (1.0, 1.0),
+                (-1.0, 1.0),
+                (-1.0, -1.0),
+            ]
+            .iter()
+            .map(|(u, v)| {
+                let (lx, ly) = (u * half_width_m, v * half_height_m);
+                cm(x_m + c * lx - s * ly, y_m + s * lx + c * ly)
+            })
+            .collect()
+        }
+    }
+}
+
+/// Belief in [0, 1] as a colour: grey (0) to saturated green (1), on a
+/// square-root scale so that small beliefs stay visible.
+fn belief_colour(p: f64) -> Color {
+    let v = p.clamp(0.0, 1.0).sqrt();
+    let mix = |a: f64, b: f64| (a + (b - a) * v) as u8;
+    Color::from_rgb(mix(170.0, 20.0), mix(170.0, 170.0), mix(170.0, 60.0))
+}
+
+/// Records one or more runs of an e-puck scenario as they happen.
+pub struct EpuckRecorder<'a> {
+    rec: &'a RecordingStream,
+    path: &'a Path,
+    layout: GoalLayout,
+    t_e: f64,
+    offset_secs: f64,
+    trajectory: Vec<[f32; 2]>,
+    detections: Vec<[f32; 2]>,
+    steps: usize,
+    last_secs: f64,
+    error: Option<SimError>,
+}
+
+impl<'a> EpuckRecorder<'a> {
+    /// Logs the static scene (walls, obstacles, city labels, series styles).
+    pub fn new(
+        file: &'a RrdFile,
+        arena: &ArenaSpec,
+        layout: &GoalLayout,
+        t_e: f64,
+    ) -> Result<Self> {
+        let rec = file.stream();
+        let path = file.path();
+        let err = record_error(path);
+        let s = arena.size_m;
+        rec.log_static(
+            "arena/walls",
+            &LineStrips2D::new([[cm(0.0, 0.0), cm(s, 0.0), cm(s, s), cm(0.0, s), cm(0.0, 0.0)]])
+                .with_colors([Color::from_rgb(60, 60, 60)])
+                .with_radii([1.0]),
+        )
+        .map_err(&err)?;
+        if !arena.obstacles.is_empty() {
+            rec.log_static(
+                "arena/obstacles",
+                &LineStrips2D::new(arena.obstacles.iter().map(outline))
+                    .with_colors([Color::from_rgb(110, 80, 50)])
+                    .with_radii([0.8]),
+            )
+            .map_err(&err)?;
+        }
+        rec.log_static(
+            "decoder/p_error",
+            &SeriesLines::new()
+                .with_names(["p(error)"])
+                .with_colors([Color::from_rgb(200, 40, 40)]),
+        )
+        .map_err(&err)?;
+        rec.log_static(
+            "decoder/threshold",
+            &SeriesLines::new()
+                .with_names(["T_e"])
+                .with_colors([Color::from_rgb(120, 120, 120)]),
+        )
+        .map_err(&err)?;
+        for g in layout.goals() {
+            rec.log_static(
+                format!("belief/city/{}", g.name),
+                &SeriesLines::new().with_names([g.name.as_str()]),
+            )
+            .map_err(&err)?;
+        }
+        Ok(Self {
+            rec,
+            path,
+            layout: layout.clone(),
+            t_e,
+            offset_secs: 0.0,
+            trajectory: Vec::new(),
+            detections: Vec::new(),
+            steps: 0,
+            last_secs: 0.0,
+            error: None,
+        })
+    }
+
+    /// Starts the next run after the previous one on the timeline.
+    pub fn next_run(&mut self, start_goal_and_user: &str) {
+        if self.steps > 0 {
+            self.offset_secs += self.last_secs + RUN_GAP_SECS;
+        }
+        self.trajectory.clear();
+        self.detections.clear();
+        self.steps = 0;
+        self.last_secs = 0.0;
+        self.rec.set_duration_secs(SIM_TIME, self.offset_secs);
+        let r = self.rec.log("log", &TextLog::new(start_goal_and_user));
+        self.keep(r);
+        let r = self
+            .rec
+            .log("arena/detections", &Points2D::new(Vec::<[f32; 2]>::new()));
+        self.keep(r);
+    }
+
+    /// The first recording error, if any (logging goes on regardless).
+    pub fn finish(self) -> Result<()> {
+        self.error.map_or(Ok(()), Err)
+    }
+
+    fn keep(&mut self, r: std::result::Result<(), rerun::RecordingStreamError>) {
+        if let Err(e) = r
+            && self.error.is_none()
+        {
+            self.error = Some(record_error(self.path)(e));
+        }
+    }
+
+    fn at(&self, time_secs: f64) {
+        self.rec
+            .set_duration_secs(SIM_TIME, self.offset_secs + time_secs);
+    }
+}
+
+impl EpuckObserver for EpuckRecorder<'_> {
+    fn on_physics(&mut self, f: &PhysicsFrame) {
+        self.steps += 1;
+        self.last_secs = f.time_secs;
+        if self.steps % TRAJECTORY_EVERY != 1 && self.steps > 1 {
+            return;
+        }
+        self.at(f.time_secs);
+        let p = f.pose;
+        self.trajectory.push(cm(p.x_m, p.y_m));
+        let r = self.rec.log(
+            "arena/trajectory",
+            &LineStrips2D::new([self.trajectory.clone()])
+                .with_colors([Color::from_rgb(40, 90, 200)])
+                .with_radii([0.6]),
+        );
+        self.keep(r);
+        let r = self.rec.log(
+            "arena/robot",
+            &Points2D::new([cm(p.x_m, p.y_m)])
+                .with_radii([3.7])
+                .with_colors([Color::from_rgb(30, 30, 30)]),
+        );
+        self.keep(r);
+        let (s, c) = p.heading_rad.sin_cos();
+        let r = self.rec.log(
+            "arena/heading",
+            &Arrows2D::from_vectors([[(8.0 * c) as f32, (8.0 * s) as f32]])
+                .with_origins([cm(p.x_m, p.y_m)])
+                .with_colors([Color::from_rgb(230, 120, 20)]),
+        );
+        self.keep(r);
+    }
+
+    fn on_window(&mut self, f: &WindowFrame) {
+        self.at(f.time_secs);
+        let labels: Vec<String> = self
+            .layout
+            .goals()
+            .iter()
+            .enumerate()
+            .map(|(i, g)| {
+                if i == f.target {
+                    format!("{} (target)", g.name)
+                } else {
+                    g.name.clone()
+                }
+            })
+            .collect();
+        let r = self.rec.log(
+            "arena/goals",
+            &Points2D::new(self.layout.goals().iter().map(|g| cm(g.x_m, g.y_m)))
+                .with_radii([5.0])
+                .with_colors(f.belief.iter().map(|&p| belief_colour(p)))
+                .with_labels(labels),
+        );
+        self.keep(r);
+        let r = self
+            .rec
+            .log("belief/bars", &BarChart::new(f.belief.clone()));
+        self.keep(r);
+        for (i, &p) in f.belief.iter().enumerate() {
+            let path = format!("belief/city/{}", self.layout.goals()[i].name);
+            let r = self.rec.log(path, &Scalars::single(p));
+            self.keep(r);
+        }
+        let r = self.rec.log("decoder/p_error", &Scalars::single(f.p_error));
+        self.keep(r);
+        let r = self
+            .rec
+            .log("decoder/threshold", &Scalars::single(self.t_e));
+        self.keep(r);
+        if f.detected {
+            self.detections.push(cm(f.tracked.x_m, f.tracked.y_m));
+            let r = self.rec.log(
+                "arena/detections",
+                &Points2D::new(self.detections.clone())
+                    .with_radii([2.5])
+                    .with_colors([Color::from_rgb(220, 30, 30)]),
+            );
+            self.keep(r);
+        }
+        // The EEG of the last 62.5 ms, sample by sample.
+        let n = f.fcz_cz[0].len();
+        let fs = n as f64 / crate::epuck_task::WINDOW_STEP_SECS;
+        for (name, samples) in ["eeg/FCz", "eeg/Cz"].iter().zip(&f.fcz_cz) {
+            for (k, v) in samples.iter().enumerate() {
+                self.at(f.time_secs - (n - 1 - k) as f64 / fs);
+                let r = self.rec.log(*name, &Scalars::single(*v));
+                self.keep(r);
+            }
+        }
+    }
+
+    fn on_event(&mut self, time_secs: f64, text: &str, warn: bool) {
+        self.at(time_secs);
+        let r = self.rec.log(
+            "log",
+            &TextLog::new(text).with_level(if warn { "WARN" } else { "INFO" }),
+        );
+        self.keep(r);
+    }
+}
