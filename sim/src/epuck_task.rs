@@ -155,6 +155,11 @@ pub struct WindowFrame {
 /// Watches an episode as it runs. Every method does nothing by default, and
 /// `()` watches nothing, so runs without a recording pay nothing.
 pub trait EpuckObserver {
+    /// Whether frames and events are wanted at all (`()` says no, so an
+    /// unrecorded run does not even build them).
+    fn watches(&self) -> bool {
+        true
+    }
     /// After each physics step.
     fn on_physics(&mut self, _frame: &PhysicsFrame) {}
     /// After each decoder window.
@@ -163,7 +168,11 @@ pub trait EpuckObserver {
     fn on_event(&mut self, _time_secs: f64, _text: &str, _warn: bool) {}
 }
 
-impl EpuckObserver for () {}
+impl EpuckObserver for () {
+    fn watches(&self) -> bool {
+        false
+    }
+}
 
 /// An episode: where the e-puck starts and which goal the user wants.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -235,13 +244,17 @@ pub fn run_epuck_episode(
         ContinuousController::new(params.control.clone(), layout.clone(), episode.start)?;
     let mut eeg = OnlineWindow::start(decoder, errp_bci::rng::derive_seed(seed, "epuck/eeg", 0))?;
 
-    let goal_name = &layout.goals()[episode.goal].name;
-    observer.on_event(0.0, &format!("the user wants {goal_name}"), false);
+    let watching = observer.watches();
+    if watching {
+        let goal_name = &layout.goals()[episode.goal].name;
+        observer.on_event(0.0, &format!("the user wants {goal_name}"), false);
+    }
 
     let mut time_secs = 0.0;
     let mut pose = world.pose();
     let mut tracked = tracker.observe(0.0, &pose);
     let mut errps: Vec<(f64, bool)> = Vec::new(); // (time zero, during motion)
+    let mut recent = 0; // first ErrP that can still fall in a window
     let mut detections: Vec<f64> = Vec::new();
     let mut detected_at = Vec::new();
     let (mut hits, mut n_err_windows, mut false_alarms, mut n_clean_windows) = (0, 0, 0, 0);
@@ -261,7 +274,7 @@ pub fn run_epuck_episode(
                     onset_secs: WARM_UP_SECS + e.onset_secs,
                     kind: e.kind,
                 });
-                if e.kind == AssessmentKind::Error {
+                if watching && e.kind == AssessmentKind::Error {
                     observer.on_event(time_secs, "the user sees an error (ErrP)", false);
                 }
             }
@@ -285,12 +298,14 @@ pub fn run_epuck_episode(
             path_m += (dx * dx + dy * dy).sqrt();
             pose = next;
             tracked = tracker.observe(time_secs, &pose);
-            observer.on_physics(&PhysicsFrame {
-                time_secs,
-                pose,
-                tracked,
-                wheels: applied,
-            });
+            if watching {
+                observer.on_physics(&PhysicsFrame {
+                    time_secs,
+                    pose,
+                    tracked,
+                    wheels: applied,
+                });
+            }
         }
 
         let fresh = eeg.advance();
@@ -299,10 +314,15 @@ pub fn run_epuck_episode(
 
         // Scoring of this window against the ErrPs the user produced.
         let says_error = p_error >= params.control.t_e;
-        let has_errp = errps.iter().any(|&(o, _)| {
+        // ErrP time zeros only grow: skip those too old for any window span.
+        while recent < errps.len() && errps[recent].0 < time_secs - 1.0 {
+            recent += 1;
+        }
+        let errps_near = &errps[recent..];
+        let has_errp = errps_near.iter().any(|&(o, _)| {
             o >= time_secs - ERRP_IN_WINDOW_SECS.0 && o <= time_secs - ERRP_IN_WINDOW_SECS.1
         });
-        let near_errp = errps
+        let near_errp = errps_near
             .iter()
             .any(|&(o, _)| o >= time_secs - 1.0 && o <= time_secs);
         if has_errp {
@@ -315,20 +335,22 @@ pub fn run_epuck_episode(
         if obs.detected {
             detections.push(time_secs);
             detected_at.push([pose.x_m, pose.y_m]);
-            let real = errps.iter().any(|&(o, _)| {
+            let real = errps_near.iter().any(|&(o, _)| {
                 o >= time_secs - DETECTION_SPAN_SECS.0 && o <= time_secs - DETECTION_SPAN_SECS.1
             });
-            observer.on_event(
-                time_secs,
-                &format!(
-                    "error detected (p = {p_error:.2}){}: stop {:.0} s",
-                    if real { "" } else { ", a false positive" },
-                    params.control.stop_secs
-                ),
-                !real,
-            );
+            if watching {
+                observer.on_event(
+                    time_secs,
+                    &format!(
+                        "error detected (p = {p_error:.2}){}: stop {:.0} s",
+                        if real { "" } else { ", a false positive" },
+                        params.control.stop_secs
+                    ),
+                    !real,
+                );
+            }
         }
-        if controller.target() != last_target {
+        if watching && controller.target() != last_target {
             last_target = controller.target();
             observer.on_event(
                 time_secs,
@@ -336,18 +358,20 @@ pub fn run_epuck_episode(
                 false,
             );
         }
-        observer.on_window(&WindowFrame {
-            time_secs,
-            p_error,
-            belief: controller.belief().probabilities(),
-            target: controller.target(),
-            detected: obs.detected,
-            tracked,
-            fcz_cz: [
-                fresh.channel(eeg.fcz_cz[0]).to_vec(),
-                fresh.channel(eeg.fcz_cz[1]).to_vec(),
-            ],
-        });
+        if watching {
+            observer.on_window(&WindowFrame {
+                time_secs,
+                p_error,
+                belief: controller.belief().probabilities(),
+                target: controller.target(),
+                detected: obs.detected,
+                tracked,
+                fcz_cz: [
+                    fresh.channel(eeg.fcz_cz[0]).to_vec(),
+                    fresh.channel(eeg.fcz_cz[1]).to_vec(),
+                ],
+            });
+        }
         if let Some(j) = obs.converged {
             committed = Some(j);
             observer.on_event(
