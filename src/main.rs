@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
-use errp_bci::{EdfWriter, GoalSet, subject, subjects};
+use errp_bci::{EdfWriter, GoalSet, TargetingStep, subject, subjects};
 use errp_sim::{
     AnyScenario, EpuckRecorder, EpuckScenario, PAPER_EPUCK, epuck_recording, load_scenario,
     prepare_continuous_decoder, run_epuck_batch, run_epuck_once, summarise,
@@ -361,6 +361,19 @@ fn run(args: &RunArgs) -> Result<()> {
     }
 }
 
+/// Prints each accuracy-targeting step to stderr, unless `quiet`.
+fn calibration_progress(quiet: bool) -> impl FnMut(&TargetingStep) {
+    move |s| {
+        if !quiet {
+            eprintln!(
+                "  calibrating: ErrP-to-noise {:.4} -> mean {:.2} %",
+                s.ratio,
+                100.0 * s.accuracy.mean()
+            );
+        }
+    }
+}
+
 fn run_grid(args: &RunArgs, mut scenario: Scenario) -> Result<()> {
     if let Some(seed) = args.seed {
         scenario.seed = seed;
@@ -403,16 +416,8 @@ fn run_grid(args: &RunArgs, mut scenario: Scenario) -> Result<()> {
             scenario.seed
         );
     }
-    let (decoder, calibration) = prepare_decoder(&scenario, |s| {
-        if !quiet {
-            eprintln!(
-                "  calibrating: ErrP-to-noise {:.4} -> mean {:.2} %",
-                s.ratio,
-                100.0 * s.accuracy.mean()
-            );
-        }
-    })
-    .context("calibrating the decoder")?;
+    let (decoder, calibration) = prepare_decoder(&scenario, calibration_progress(quiet))
+        .context("calibrating the decoder")?;
     if let Some(c) = &calibration {
         println!(
             "Decoder calibrated on 400 actions: correct {:.2} %, error {:.2} %, mean {:.2} % (cross-validated)",
@@ -628,16 +633,8 @@ fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<()> {
             scenario.seed
         );
     }
-    let (decoder, report) = prepare_continuous_decoder(&scenario, |s| {
-        if !quiet {
-            eprintln!(
-                "  calibrating: ErrP-to-noise {:.4} -> mean {:.2} %",
-                s.ratio,
-                100.0 * s.accuracy.mean()
-            );
-        }
-    })
-    .context("calibrating the continuous decoder")?;
+    let (decoder, report) = prepare_continuous_decoder(&scenario, calibration_progress(quiet))
+        .context("calibrating the continuous decoder")?;
     let acc = report.calibrated.accuracy;
     println!(
         "SVM decoder calibrated on {} error + {} correct button-locked examples: correct {:.2} %, \

@@ -125,6 +125,29 @@ impl Accuracy {
     pub fn mean(&self) -> f64 {
         (self.correct + self.error) / 2.0
     }
+
+    /// The accuracy over all the trials of `parts` together: each class rate
+    /// weighted by its trial count (a part without trials of a class, whose
+    /// rate is undefined, adds nothing to it).
+    pub fn pooled<'a>(parts: impl IntoIterator<Item = &'a Accuracy>) -> Accuracy {
+        let (mut ch, mut cn, mut eh, mut en) = (0.0, 0, 0.0, 0);
+        for a in parts {
+            if a.n_correct > 0 {
+                ch += a.correct * a.n_correct as f64;
+                cn += a.n_correct;
+            }
+            if a.n_error > 0 {
+                eh += a.error * a.n_error as f64;
+                en += a.n_error;
+            }
+        }
+        Accuracy {
+            correct: ch / cn.max(1) as f64,
+            error: eh / en.max(1) as f64,
+            n_correct: cn,
+            n_error: en,
+        }
+    }
 }
 
 /// Averages of the preprocessed EEG around the action onsets, per class,

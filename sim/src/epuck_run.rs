@@ -103,13 +103,6 @@ pub struct EpuckSummary {
 pub fn summarise(results: &[EpuckEpisodeResult]) -> EpuckSummary {
     let ok: Vec<&EpuckEpisodeResult> = results.iter().filter(|r| r.reached()).collect();
     let col = |f: &dyn Fn(&EpuckEpisodeResult) -> f64| ok.iter().map(|r| f(r)).collect::<Vec<_>>();
-    let (mut ch, mut cn, mut eh, mut en) = (0.0, 0, 0.0, 0);
-    for r in results {
-        ch += r.online.correct * r.online.n_correct as f64;
-        cn += r.online.n_correct;
-        eh += r.online.error * r.online.n_error as f64;
-        en += r.online.n_error;
-    }
     EpuckSummary {
         runs: results.len(),
         reached: ok.len(),
@@ -120,11 +113,6 @@ pub fn summarise(results: &[EpuckEpisodeResult]) -> EpuckSummary {
         median_secs: median(&col(&|r| r.time_secs)),
         median_detected: median(&col(&|r| r.detected_errors as f64)),
         median_false: median(&col(&|r| r.false_detections as f64)),
-        online: Accuracy {
-            correct: ch / cn.max(1) as f64,
-            error: eh / en.max(1) as f64,
-            n_correct: cn,
-            n_error: en,
-        },
+        online: Accuracy::pooled(results.iter().map(|r| &r.online)),
     }
 }

@@ -12,7 +12,7 @@ use serde::Deserialize;
 
 use crate::epuck_task::{EpuckEpisode, EpuckTaskParams};
 use crate::error::{Result, SimError};
-use crate::scenario::Scenario;
+use crate::scenario::{Scenario, field_error, parse_toml, read_scenario, scenario_name};
 use crate::world::{ArenaSpec, Obstacle};
 
 /// A scenario of either task, as `errp run` takes it.
@@ -27,16 +27,12 @@ pub enum AnyScenario {
 /// Reads a scenario file and validates it according to its `task` field.
 pub fn load_scenario(path: impl AsRef<Path>) -> Result<AnyScenario> {
     let path = path.as_ref();
-    let text = std::fs::read_to_string(path).map_err(|e| {
-        SimError::Scenario(format!("{}: cannot read the scenario: {e}", path.display()))
-    })?;
+    let text = read_scenario(path)?;
     #[derive(Deserialize)]
     struct Task {
         task: Option<String>,
     }
-    let task: Task = toml::from_str(&text).map_err(|e| {
-        SimError::Scenario(format!("{}: {}", path.display(), e.to_string().trim_end()))
-    })?;
+    let task: Task = parse_toml(&text, path)?;
     match task.task.as_deref() {
         Some("epuck") => Ok(AnyScenario::Epuck(Box::new(EpuckScenario::parse(
             &text, path,
@@ -180,23 +176,14 @@ impl EpuckScenario {
     /// Reads and validates an e-puck scenario file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|e| {
-            SimError::Scenario(format!("{}: cannot read the scenario: {e}", path.display()))
-        })?;
-        Self::parse(&text, path)
+        Self::parse(&read_scenario(path)?, path)
     }
 
     /// Validates scenario text; `path` names it in errors.
     pub fn parse(text: &str, path: &Path) -> Result<Self> {
-        let file: EpuckFile = toml::from_str(text).map_err(|e| {
-            SimError::Scenario(format!("{}: {}", path.display(), e.to_string().trim_end()))
-        })?;
-        let bad = |field: &str, value: String, expected: &str| {
-            SimError::Scenario(format!(
-                "{}: field `{field}` = {value} is invalid: expected {expected}",
-                path.display()
-            ))
-        };
+        let file: EpuckFile = parse_toml(text, path)?;
+        let bad =
+            |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
         if file.task != "epuck" {
             return Err(bad("task", format!("{:?}", file.task), "\"epuck\""));
         }
@@ -435,10 +422,7 @@ impl EpuckScenario {
 
         Ok(Self {
             path: path.to_path_buf(),
-            name: file.name.unwrap_or_else(|| {
-                path.file_stem()
-                    .map_or("scenario".into(), |s| s.to_string_lossy().into())
-            }),
+            name: scenario_name(file.name, path),
             description: file.description.unwrap_or_default(),
             seed: file.seed,
             accuracy: file.user.accuracy,

@@ -73,7 +73,7 @@ impl AvoidanceParams {
         let away = if right >= left { 1.0 } else { -1.0 };
         let turn = (1.0 - k) * twist.angular_rad_per_s + k * away * self.turn_rate_rad_per_s;
         errp_robot::Twist {
-            linear_m_per_s: forward.min(twist.linear_m_per_s.max(0.0)),
+            linear_m_per_s: forward,
             angular_rad_per_s: turn,
         }
         .to_wheels(epuck)

@@ -19,7 +19,7 @@ use rerun::{
 use crate::epuck_task::{EpuckObserver, PhysicsFrame, WindowFrame};
 use crate::error::{Result, SimError};
 use crate::grid_view::SIM_TIME;
-use crate::record::{RrdFile, record_error};
+use crate::record::{RrdFile, log_decoder_series, record_error};
 use crate::world::{ArenaSpec, Obstacle};
 
 /// Pause between runs on the timeline (s).
@@ -147,20 +147,7 @@ impl<'a> EpuckRecorder<'a> {
             )
             .map_err(&err)?;
         }
-        rec.log_static(
-            "decoder/p_error",
-            &SeriesLines::new()
-                .with_names(["p(error)"])
-                .with_colors([Color::from_rgb(200, 40, 40)]),
-        )
-        .map_err(&err)?;
-        rec.log_static(
-            "decoder/threshold",
-            &SeriesLines::new()
-                .with_names(["T_e"])
-                .with_colors([Color::from_rgb(120, 120, 120)]),
-        )
-        .map_err(&err)?;
+        log_decoder_series(rec, "T_e").map_err(&err)?;
         for g in layout.goals() {
             rec.log_static(
                 format!("belief/city/{}", g.name),

@@ -46,23 +46,7 @@ impl GridRunReport {
 
 /// The decoder's accuracy pooled over every action of `episodes`.
 pub fn pooled_accuracy(episodes: &[GridEpisodeResult]) -> Accuracy {
-    let (mut ch, mut cn, mut eh, mut en) = (0.0, 0, 0.0, 0);
-    for r in episodes {
-        if r.online.n_correct > 0 {
-            ch += r.online.correct * r.online.n_correct as f64;
-            cn += r.online.n_correct;
-        }
-        if r.online.n_error > 0 {
-            eh += r.online.error * r.online.n_error as f64;
-            en += r.online.n_error;
-        }
-    }
-    Accuracy {
-        correct: ch / cn.max(1) as f64,
-        error: eh / en.max(1) as f64,
-        n_correct: cn,
-        n_error: en,
-    }
+    Accuracy::pooled(episodes.iter().map(|r| &r.online))
 }
 
 /// Builds the scenario's decoder: for the EEG decoder, a calibration session

@@ -10,7 +10,7 @@ use rerun::{Boxes2D, Color, Image, Points2D, Scalars, SeriesLines, TextLog};
 
 use crate::error::Result;
 use crate::grid_run::GridRunReport;
-use crate::record::{RrdFile, record_error};
+use crate::record::{RrdFile, log_decoder_series, record_error};
 
 /// The simulation timeline (s).
 pub const SIM_TIME: &str = "sim_time";
@@ -84,20 +84,7 @@ pub fn record_grid_run(file: RrdFile, report: &GridRunReport) -> Result<PathBuf>
             .with_colors([Color::from_rgb(160, 160, 160)]),
     )
     .map_err(&err)?;
-    rec.log_static(
-        "decoder/p_error",
-        &SeriesLines::new()
-            .with_names(["p(error)"])
-            .with_colors([Color::from_rgb(200, 40, 40)]),
-    )
-    .map_err(&err)?;
-    rec.log_static(
-        "decoder/threshold",
-        &SeriesLines::new()
-            .with_names(["0.5"])
-            .with_colors([Color::from_rgb(120, 120, 120)]),
-    )
-    .map_err(&err)?;
+    log_decoder_series(rec, "0.5").map_err(&err)?;
     rec.log_static(
         "belief/true_goal",
         &SeriesLines::new().with_names(["p(true goal)"]),

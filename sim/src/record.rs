@@ -58,6 +58,28 @@ impl RrdFile {
     }
 }
 
+/// Styles the decoder's two series: p(error) in red under `decoder/p_error`
+/// and the decision threshold, named `threshold_name`, in grey under
+/// `decoder/threshold`.
+pub(crate) fn log_decoder_series(
+    rec: &rerun::RecordingStream,
+    threshold_name: &str,
+) -> std::result::Result<(), rerun::RecordingStreamError> {
+    use rerun::{Color, SeriesLines};
+    rec.log_static(
+        "decoder/p_error",
+        &SeriesLines::new()
+            .with_names(["p(error)"])
+            .with_colors([Color::from_rgb(200, 40, 40)]),
+    )?;
+    rec.log_static(
+        "decoder/threshold",
+        &SeriesLines::new()
+            .with_names([threshold_name])
+            .with_colors([Color::from_rgb(120, 120, 120)]),
+    )
+}
+
 /// Maps a Rerun SDK error to a [`SimError`] about `path`.
 pub(crate) fn record_error(path: &Path) -> impl Fn(rerun::RecordingStreamError) -> SimError + '_ {
     move |e| SimError::Record {

@@ -11,6 +11,7 @@ use errp_bci::{GoalSet, subject};
 use errp_robot::{Cell, Grid, GridControlParams, QParams};
 use rand::Rng;
 use serde::Deserialize;
+use serde::de::DeserializeOwned;
 
 use crate::error::{Result, SimError};
 use crate::grid_task::GridTaskParams;
@@ -176,27 +177,48 @@ pub struct Scenario {
     pub params: GridTaskParams,
 }
 
+/// The text of the scenario file at `path`.
+pub(crate) fn read_scenario(path: &Path) -> Result<String> {
+    std::fs::read_to_string(path).map_err(|e| {
+        SimError::Scenario(format!("{}: cannot read the scenario: {e}", path.display()))
+    })
+}
+
+/// Scenario text parsed as TOML into `T`; errors name `path`.
+pub(crate) fn parse_toml<T: DeserializeOwned>(text: &str, path: &Path) -> Result<T> {
+    toml::from_str(text).map_err(|e| {
+        SimError::Scenario(format!("{}: {}", path.display(), e.to_string().trim_end()))
+    })
+}
+
+/// The error for a bad `field` of the scenario at `path`.
+pub(crate) fn field_error(path: &Path, field: &str, value: String, expected: &str) -> SimError {
+    SimError::Scenario(format!(
+        "{}: field `{field}` = {value} is invalid: expected {expected}",
+        path.display()
+    ))
+}
+
+/// The scenario's `name`, or its file name without the extension.
+pub(crate) fn scenario_name(name: Option<String>, path: &Path) -> String {
+    name.unwrap_or_else(|| {
+        path.file_stem()
+            .map_or("scenario".into(), |s| s.to_string_lossy().into())
+    })
+}
+
 impl Scenario {
     /// Reads and validates a scenario file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|e| {
-            SimError::Scenario(format!("{}: cannot read the scenario: {e}", path.display()))
-        })?;
-        Self::parse(&text, path)
+        Self::parse(&read_scenario(path)?, path)
     }
 
     /// Validates scenario text; `path` names it in errors.
     pub fn parse(text: &str, path: &Path) -> Result<Self> {
-        let file: ScenarioFile = toml::from_str(text).map_err(|e| {
-            SimError::Scenario(format!("{}: {}", path.display(), e.to_string().trim_end()))
-        })?;
-        let bad = |field: &str, value: String, expected: &str| {
-            SimError::Scenario(format!(
-                "{}: field `{field}` = {value} is invalid: expected {expected}",
-                path.display()
-            ))
-        };
+        let file: ScenarioFile = parse_toml(text, path)?;
+        let bad =
+            |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
         if file.task != "grid" {
             return Err(bad(
                 "task",
@@ -384,10 +406,7 @@ impl Scenario {
             .collect();
         Ok(Self {
             path: path.to_path_buf(),
-            name: file.name.unwrap_or_else(|| {
-                path.file_stem()
-                    .map_or("scenario".into(), |s| s.to_string_lossy().into())
-            }),
+            name: scenario_name(file.name, path),
             description: file.description.unwrap_or_default(),
             seed: file.seed,
             decoder: file.decoder,
