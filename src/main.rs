@@ -2,6 +2,8 @@
 //!
 //! Thin glue: parse arguments, call the libraries, print, write files.
 
+mod sweep_cmd;
+
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -46,6 +48,14 @@ enum Command {
     Table1(Table1Args),
     /// List the subjects of Table 1 of the paper and their accuracies.
     Subjects,
+    /// Monte Carlo sweep over decoder accuracy (and any scenario parameter):
+    /// episodes in parallel, streamed to DIR/episodes.csv (a rerun resumes),
+    /// then DIR/summary.csv, a printed table, DIR/sweep.svg and .png, and
+    /// DIR/sweep.json to rerun it exactly.
+    Sweep(sweep_cmd::SweepArgs),
+    /// Merge the directories of a sharded sweep (`errp sweep --shard K/N`)
+    /// into the files one unsharded run writes.
+    Merge(sweep_cmd::MergeArgs),
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -189,6 +199,12 @@ fn main() -> ExitCode {
             print_subjects();
             Ok(())
         }
+        Command::Merge(args) => sweep_cmd::merge(&args),
+        Command::Sweep(args) => match sweep_cmd::sweep(&args) {
+            Ok(true) => Ok(()),
+            Ok(false) => return ExitCode::from(130),
+            Err(e) => Err(e),
+        },
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

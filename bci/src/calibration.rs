@@ -488,11 +488,24 @@ pub fn calibrate<C: Classifier>(
     options: SessionOptions<'_>,
 ) -> Result<Calibrated<C::Model>> {
     let session = simulate_session(setup, seed, options)?;
+    calibrate_session(classifier, session, setup.calibration.folds, seed)
+}
+
+/// The second half of [`calibrate`], on a session already simulated (e.g.
+/// by [`SessionParts::session_at`](crate::SessionParts::session_at)): scores
+/// the decoder by `folds`-fold cross-validation and trains it on every trial,
+/// with the folds and the fit seeded from the session's `seed`.
+pub fn calibrate_session<C: Classifier>(
+    classifier: &C,
+    session: CalibrationSession,
+    folds: usize,
+    seed: u64,
+) -> Result<Calibrated<C::Model>> {
     let decisions = out_of_fold_decisions(
         classifier,
         &session.features,
         &session.labels,
-        setup.calibration.folds,
+        folds,
         cv_seed(seed),
     )?;
     let predicted: Vec<bool> = decisions.iter().map(|&d| d >= 0.0).collect();

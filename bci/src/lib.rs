@@ -44,7 +44,7 @@ mod targeting;
 
 pub use calibration::{
     Accuracy, Calibrated, CalibrationParams, CalibrationSession, CalibrationSetup, GrandAverage,
-    RawSink, SessionOptions, calibrate, cross_validate, cv_seed, eog_session,
+    RawSink, SessionOptions, calibrate, calibrate_session, cross_validate, cv_seed, eog_session,
     out_of_fold_decisions, schedule, simulate_session, simulate_session_with, stratified_folds,
 };
 pub use classify::{Classifier, ErrorModel, Features, sigmoid};
@@ -68,6 +68,7 @@ pub use psd::ThetaPsd;
 pub use subjects::{GoalSet, Subject, subject, subjects};
 pub use svm::{SvmDecoder, SvmModel};
 pub use targeting::{
-    TargetingParams, TargetingResult, TargetingStep, check_requested_accuracy, inverse_normal_cdf,
-    search_ratio, target_accuracy, target_continuous_accuracy,
+    SessionParts, TargetingParams, TargetingResult, TargetingStep, check_requested_accuracy,
+    inverse_normal_cdf, search_ratio, target_accuracy, target_accuracy_on,
+    target_continuous_accuracy,
 };

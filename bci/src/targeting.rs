@@ -4,7 +4,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::calibration::{
-    Accuracy, CalibrationSetup, SessionOptions, cross_validate, cv_seed, simulate_session,
+    Accuracy, CalibrationSession, CalibrationSetup, SessionOptions, cross_validate, cv_seed,
+    simulate_session,
 };
 use crate::classify::{Classifier, Features};
 use crate::continuous_calibration::{ContinuousSetup, simulate_continuous_session};
@@ -86,44 +87,102 @@ pub fn target_accuracy<C: Classifier>(
     progress: impl FnMut(&TargetingStep),
 ) -> Result<TargetingResult> {
     check_requested_accuracy(requested)?;
-    let unit = CalibrationSetup {
-        generator: GeneratorParams {
-            errp_to_noise: 1.0,
-            ..setup.generator.clone()
-        },
-        ..setup.clone()
-    };
-    let part = |components| {
-        simulate_session(
-            &unit,
-            seed,
-            SessionOptions {
-                components,
-                ..SessionOptions::default()
-            },
-        )
-    };
-    let noise = part(Components {
-        background: true,
-        artifacts: true,
-        erp: false,
-    })?;
-    let erp = part(Components {
-        background: false,
-        artifacts: false,
-        erp: true,
-    })?;
-    let labels = noise.labels.clone();
+    let parts = SessionParts::simulate(setup, seed)?;
+    target_accuracy_on(&parts, requested, classifier, setup, search, seed, progress)
+}
+
+/// [`target_accuracy`] on a session already simulated as its parts (e.g.
+/// shared by every level of a sweep).
+pub fn target_accuracy_on<C: Classifier>(
+    parts: &SessionParts,
+    requested: f64,
+    classifier: &C,
+    setup: &CalibrationSetup,
+    search: &TargetingParams,
+    seed: u64,
+    progress: impl FnMut(&TargetingStep),
+) -> Result<TargetingResult> {
+    check_requested_accuracy(requested)?;
+    let labels = &parts.noise.labels;
     let cv_seed = cv_seed(seed);
     search_ratio(
         requested,
         search,
         |ratio| {
-            let x: Features = &noise.features + &erp.features * ratio;
-            cross_validate(classifier, &x, &labels, setup.calibration.folds, cv_seed)
+            cross_validate(
+                classifier,
+                &parts.features_at(ratio),
+                labels,
+                setup.calibration.folds,
+                cv_seed,
+            )
         },
         progress,
     )
+}
+
+/// A discrete calibration session simulated once, in two parts that add up
+/// to the session at any ErrP-to-noise ratio r: background + artifacts, and
+/// the ERPs at ratio 1. The preprocessing and the features are linear in the
+/// signal and the generator's parts add up exactly, so the session's
+/// features at r are `noise + r * erp` (to rounding), and the preprocessor
+/// (fitted on an EOG recording without ERPs) does not depend on r.
+#[derive(Debug, Clone)]
+pub struct SessionParts {
+    noise: CalibrationSession,
+    erp: Features,
+}
+
+impl SessionParts {
+    /// Simulates both parts of the session of `setup` (whose ratio is
+    /// ignored) from `seed`.
+    pub fn simulate(setup: &CalibrationSetup, seed: u64) -> Result<Self> {
+        let unit = CalibrationSetup {
+            generator: GeneratorParams {
+                errp_to_noise: 1.0,
+                ..setup.generator.clone()
+            },
+            ..setup.clone()
+        };
+        let part = |components| {
+            simulate_session(
+                &unit,
+                seed,
+                SessionOptions {
+                    components,
+                    ..SessionOptions::default()
+                },
+            )
+        };
+        let noise = part(Components {
+            background: true,
+            artifacts: true,
+            erp: false,
+        })?;
+        let erp = part(Components {
+            background: false,
+            artifacts: false,
+            erp: true,
+        })?;
+        Ok(Self {
+            noise,
+            erp: erp.features,
+        })
+    }
+
+    /// The session's features at `ratio`, `(n_actions, n_features)`.
+    pub fn features_at(&self, ratio: f64) -> Features {
+        &self.noise.features + &self.erp * ratio
+    }
+
+    /// The whole session at `ratio`, as [`simulate_session`] gives it (to
+    /// rounding; no grand averages).
+    pub fn session_at(&self, ratio: f64) -> CalibrationSession {
+        CalibrationSession {
+            features: self.features_at(ratio),
+            ..self.noise.clone()
+        }
+    }
 }
 
 /// The continuous decoder's [`target_accuracy`]: the ErrP-to-noise ratio at

@@ -5,8 +5,9 @@
 
 use errp_bci::{
     AssessmentKind, CalibrationParams, CalibrationSetup, Classifier, Components, ErrorModel,
-    Features, GeneratorParams, LdaDecoder, SessionOptions, Shrinkage, SvmDecoder, TargetingParams,
-    calibrate, cross_validate, rng::stream, simulate_session, target_accuracy,
+    Features, GeneratorParams, LdaDecoder, SessionOptions, SessionParts, Shrinkage, SvmDecoder,
+    TargetingParams, calibrate, calibrate_session, cross_validate, rng::stream, simulate_session,
+    target_accuracy,
 };
 use rand::seq::SliceRandom;
 
@@ -127,6 +128,32 @@ fn features_are_linear_in_the_errp_to_noise_ratio() {
     let combined = &noise + &erp * 0.7;
     let worst = (&whole - &combined).abs().max();
     assert!(worst < 1e-6, "largest difference {worst}");
+}
+
+#[test]
+fn session_parts_give_the_session_and_the_calibration_at_any_ratio() {
+    // Sweeps simulate a session once and calibrate every level from it.
+    let setup = CalibrationSetup {
+        calibration: CalibrationParams {
+            n_actions: 120,
+            ..CalibrationParams::default()
+        },
+        ..setup_at(0.6)
+    };
+    let parts = SessionParts::simulate(&setup, 8).unwrap();
+    let direct = simulate_session(&setup, 8, SessionOptions::default()).unwrap();
+    let from_parts = parts.session_at(0.6);
+    assert_eq!(from_parts.labels, direct.labels);
+    assert_eq!(from_parts.assessments, direct.assessments);
+    let worst = (&from_parts.features - &direct.features).abs().max();
+    assert!(worst < 1e-6, "largest difference {worst}");
+    let lda = LdaDecoder::default();
+    let a = calibrate(&lda, &setup, 8, SessionOptions::default()).unwrap();
+    let b = calibrate_session(&lda, from_parts, setup.calibration.folds, 8).unwrap();
+    assert_eq!(a.accuracy, b.accuracy);
+    let x = direct.features.row(0).iter().copied().collect::<Vec<_>>();
+    let (da, db) = (a.model.decision(&x), b.model.decision(&x));
+    assert!((da - db).abs() < 1e-6 * (1.0 + da.abs()), "{da} {db}");
 }
 
 fn lands_within_1_5_points(requested: f64, seed: u64) {

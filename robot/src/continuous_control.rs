@@ -22,11 +22,15 @@
 //!   belief (the caller still decodes them).
 //! - **Goals under the robot.** A goal within `goal_radius_m` of the robot
 //!   has no defined bearing; it gets likelihood 1 in turn and linear steps.
-//! - **Goal choice** is greedy: the most probable goal, ties broken by the
-//!   goal nearest the robot, then by the lowest index. With the uniform
-//!   belief of the start, a robot placed on a goal therefore starts "stopped
-//!   on" it; the user judges that stop as wrong, which is how the start goal
-//!   gets rejected.
+//! - **Goal choice** is greedy ([`Strategy::Greedy`]): the most probable
+//!   goal, ties broken by the goal nearest the robot, then by the lowest
+//!   index. With the uniform belief of the start, a robot placed on a goal
+//!   therefore starts "stopped on" it; the user judges that stop as wrong,
+//!   which is how the start goal gets rejected.
+//! - **Goal choice by information gain** ([`Strategy::InfoGain`], not in the
+//!   paper) heads for the goal whose heading the user's next assessment is
+//!   expected to say most about; see
+//!   [`next_target`](ContinuousController::next_target).
 //! - **The target is kept until the next stop**, as in sec. 5.1 ("the robot
 //!   stopped ... Then, it moved towards a new goal"): the belief changes
 //!   while the robot moves, the target does not.
@@ -47,6 +51,7 @@ use crate::error::{Result, RobotError};
 use crate::layout::GoalLayout;
 use crate::pose::{Pose, wrap_angle};
 use crate::potential::QuadraticPotential;
+use crate::strategy::{Strategy, expected_information_gain};
 
 /// Why the robot is stopped.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -206,11 +211,19 @@ impl ContinuousController {
     /// The greedy goal choice: the most probable goal, ties broken by the
     /// nearest to `pose`, then by the lowest index.
     pub fn most_probable_goal(&self, pose: &Pose) -> usize {
-        let p = self.belief.probabilities();
-        let top = p.iter().copied().fold(0.0, f64::max);
+        self.most_probable_of(pose, &self.belief.probabilities(), |_| true)
+    }
+
+    /// The most probable of the goals that `candidate` accepts (0 if none),
+    /// ties broken by the nearest to `pose`, then by the lowest index.
+    fn most_probable_of(&self, pose: &Pose, p: &[f64], candidate: impl Fn(usize) -> bool) -> usize {
+        let top = (0..p.len())
+            .filter(|&i| candidate(i))
+            .map(|i| p[i])
+            .fold(0.0, f64::max);
         let mut best: Option<(usize, f64)> = None;
         for (i, g) in self.layout.goals().iter().enumerate() {
-            if p[i] < top * (1.0 - 1e-12) {
+            if !candidate(i) || p[i] < top * (1.0 - 1e-12) {
                 continue;
             }
             let d = pose.distance_to(g.x_m, g.y_m);
@@ -221,9 +234,105 @@ impl ContinuousController {
         best.map_or(0, |(i, _)| i)
     }
 
+    /// The goal to head for from `pose`, by the strategy.
+    ///
+    /// [`Strategy::Greedy`]: [`most_probable_goal`](Self::most_probable_goal).
+    ///
+    /// [`Strategy::InfoGain`]: if the most probable goal has probability
+    /// p_c or more, that goal, as greedy: the run only ends after a full
+    /// stop on a goal at p_c, so the robot has to go there and stop for the
+    /// user to confirm or reject it; exploring elsewhere could only delay
+    /// that. Otherwise the goal g of
+    /// largest [`target_information_gain`](Self::target_information_gain):
+    /// the one whose heading the next decoder window is expected to say
+    /// most about; gains within 1e-12 of the largest tie, and ties go to the
+    /// most probable goal, then to the nearest, then to the lowest index.
+    pub fn next_target(&self, pose: &Pose) -> usize {
+        let greedy = self.most_probable_goal(pose);
+        if self.params.strategy == Strategy::Greedy
+            || self.belief.probability(greedy) >= self.params.p_c
+        {
+            return greedy;
+        }
+        let p = self.belief.probabilities();
+        let gains: Vec<f64> = (0..self.layout.len())
+            .map(|g| self.gain(&p, pose, g))
+            .collect();
+        let best = gains.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        self.most_probable_of(pose, &p, |g| gains[g] >= best - 1e-12)
+    }
+
+    /// The expected information gain, nats, of one decoder window spent
+    /// heading for goal `g` from `pose`
+    /// ([`expected_information_gain`](crate::expected_information_gain)).
+    ///
+    /// If the robot is not on g, the window is a linear step along g's
+    /// greedy heading (eq. 5). For each goal i, with Delta_i the angle
+    /// between the greedy headings to i and to g: the user judges the step
+    /// an error with probability 1 - exp(-Delta_i^2 / (2 sigma^2)) (the
+    /// Gaussian field of view of eq. 7) and the belief would be updated by
+    /// eq. (7) at bearing Delta_i, as [`likelihoods`](Self::likelihoods)
+    /// does for a linear step; a goal under the robot gets likelihood 1 and
+    /// is always judged an error (the robot drives off it).
+    ///
+    /// If the robot is on g, heading for g is a stop on it: the user judges
+    /// it an error unless g is the goal, and only g's probability changes
+    /// (eq. 7 at bearing 0, as for [`StepKind::StopOnGoal`]).
+    ///
+    /// Outcomes: the decoder detects an error (p(error) >= T_e) with the
+    /// assumed accuracy alpha if the user judges one, and with 1 - alpha if
+    /// not. Eq. (7) depends on p(error) only through p(error) >= T_e, so a
+    /// detection is evaluated at p(error) = 1 and no detection at 0 (taking
+    /// alpha and 1 - alpha themselves would make both outcomes alike
+    /// whenever alpha < T_e, as with the defaults 0.75 and 0.8).
+    pub fn target_information_gain(&self, pose: &Pose, g: usize) -> f64 {
+        self.gain(&self.belief.probabilities(), pose, g)
+    }
+
+    fn gain(&self, p: &[f64], pose: &Pose, g: usize) -> f64 {
+        let alpha = self.params.assumed_accuracy;
+        let p_error = |says_error: bool| if says_error { 1.0 } else { 0.0 };
+        if self.on_goal(pose, g) {
+            return expected_information_gain(
+                p,
+                alpha,
+                |i| if i == g { 0.0 } else { 1.0 },
+                |i, says_error| {
+                    if i == g {
+                        linear_likelihood(&self.params, p_error(says_error), 0.0)
+                    } else {
+                        1.0
+                    }
+                },
+            );
+        }
+        let heading = |i: usize| self.potentials[i].greedy_heading_rad(pose.x_m, pose.y_m);
+        let heading_g = heading(g);
+        let delta = |i: usize| wrap_angle(heading(i) - heading_g);
+        let two_var = 2.0 * self.params.sigma_rad().powi(2);
+        expected_information_gain(
+            p,
+            alpha,
+            |i| {
+                if self.on_goal(pose, i) {
+                    1.0
+                } else {
+                    1.0 - (-delta(i).powi(2) / two_var).exp()
+                }
+            },
+            |i, says_error| {
+                if self.on_goal(pose, i) {
+                    1.0
+                } else {
+                    linear_likelihood(&self.params, p_error(says_error), delta(i))
+                }
+            },
+        )
+    }
+
     /// Picks the next target and starts towards it (or stays stopped on it).
     fn choose_next(&mut self, pose: &Pose, time_secs: f64) {
-        self.target = self.most_probable_goal(pose);
+        self.target = self.next_target(pose);
         self.phase = if self.on_goal(pose, self.target) {
             self.stop(time_secs, StopReason::OnGoal(self.target))
         } else {
@@ -377,6 +486,7 @@ impl ContinuousController {
 mod tests {
     use super::*;
     use crate::epuck::EpuckParams;
+    use crate::strategy::Strategy;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
     use std::f64::consts::PI;
@@ -521,5 +631,93 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("goal_radius_m"), "{e}");
+    }
+
+    /// A controller with the robot on Mexico (bottom left) and a belief of
+    /// `mass[k]` on goal `goals[k]`, the rest spread evenly over the others.
+    fn info_gain_on_mexico(goals: &[&str], mass: &[f64]) -> (ContinuousController, Pose) {
+        let l = GoalLayout::cities();
+        let start = on(&l, "Mexico", 0.0);
+        let params = ContinuousControlParams {
+            strategy: Strategy::InfoGain,
+            ..params()
+        };
+        let mut c = ContinuousController::new(params, l.clone(), start).unwrap();
+        let idx: Vec<usize> = goals.iter().map(|g| l.index_of(g).unwrap()).collect();
+        let rest = (1.0 - mass.iter().sum::<f64>()) / (l.len() - goals.len()) as f64;
+        let w: Vec<f64> = (0..l.len())
+            .map(|i| idx.iter().position(|&j| j == i).map_or(rest, |k| mass[k]))
+            .collect();
+        c.belief = Belief::uniform(l.len());
+        c.belief.update(&w).unwrap();
+        (c, start)
+    }
+
+    #[test]
+    fn info_gain_heads_where_the_belief_splits_in_half() {
+        // From Mexico: Bangkok due east is the most probable goal, but the
+        // diagonal towards Pisa holds two modes (Athens, Pisa), and Lisbon is
+        // due north. Heading for Bangkok asks "Bangkok or not?" (0.24 against
+        // the rest); heading along the diagonal asks "the diagonal or not?"
+        // (0.44 against the rest), which is closer to a half split.
+        let (c, pose) = info_gain_on_mexico(
+            &["Bangkok", "Athens", "Pisa", "Lisbon"],
+            &[0.24, 0.22, 0.22, 0.22],
+        );
+        let l = c.layout();
+        let bangkok = l.index_of("Bangkok").unwrap();
+        assert_eq!(c.most_probable_goal(&pose), bangkok);
+        let target = c.next_target(&pose);
+        let diagonal = ["Lima", "Athens", "Berlin", "Pisa"].map(|n| l.index_of(n).unwrap());
+        assert!(
+            diagonal.contains(&target),
+            "{}: gains {:?}",
+            l.goal(target).name,
+            (0..l.len())
+                .map(|g| (l.goal(g).name.clone(), c.target_information_gain(&pose, g)))
+                .collect::<Vec<_>>()
+        );
+        let gain = |n: &str| c.target_information_gain(&pose, l.index_of(n).unwrap());
+        assert!(gain("Athens") > gain("Bangkok") && gain("Bangkok") > 0.0);
+        // A heading between two modes (Rio de Janeiro, 63 deg, between the
+        // diagonal and Lisbon) tells less than one through them.
+        assert!(gain("Rio de Janeiro") < gain("Athens"));
+        // Greedy with the same belief heads for Bangkok.
+        let mut greedy = c.clone();
+        greedy.params.strategy = Strategy::Greedy;
+        assert_eq!(greedy.next_target(&pose), bangkok);
+    }
+
+    #[test]
+    fn info_gain_goes_for_a_goal_at_p_c_like_greedy() {
+        // Bangkok above p_c = 0.4: the robot has to go and stop there, even
+        // though the diagonal would split the belief better.
+        let (c, pose) = info_gain_on_mexico(&["Bangkok", "Athens", "Pisa"], &[0.41, 0.2, 0.2]);
+        let l = c.layout();
+        let bangkok = l.index_of("Bangkok").unwrap();
+        let athens = l.index_of("Athens").unwrap();
+        assert!(
+            c.target_information_gain(&pose, athens) > c.target_information_gain(&pose, bangkok)
+        );
+        assert_eq!(c.next_target(&pose), bangkok);
+        let (c, pose) = info_gain_on_mexico(&["Bangkok", "Athens", "Pisa"], &[0.39, 0.2, 0.2]);
+        assert_ne!(c.next_target(&pose), bangkok, "just below p_c it explores");
+    }
+
+    #[test]
+    fn info_gain_with_a_certain_or_uniform_belief() {
+        // Certain of Pisa (far above p_c): Pisa.
+        let (c, pose) = info_gain_on_mexico(&["Pisa"], &[1.0]);
+        let pisa = c.layout().index_of("Pisa").unwrap();
+        assert_eq!(c.next_target(&pose), pisa);
+        // Uniform: every gain is finite and >= 0 (no posterior has more
+        // entropy), and the choice is some goal other than Mexico, or the
+        // stop on it.
+        let (c, pose) = info_gain_on_mexico(&[], &[]);
+        for g in 0..c.layout().len() {
+            let v = c.target_information_gain(&pose, g);
+            assert!(v.is_finite() && v >= -1e-12, "{g}: {v}");
+        }
+        assert!(c.next_target(&pose) < c.layout().len());
     }
 }

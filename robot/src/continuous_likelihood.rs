@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use crate::epuck::EpuckParams;
 use crate::error::{Result, RobotError};
 use crate::pose::wrap_angle;
+use crate::strategy::Strategy;
 
 /// Parameters of the continuous strategy (sec. 5.2) and of the motion
 /// (sec. 5.1).
@@ -51,6 +52,14 @@ pub struct ContinuousControlParams {
     pub goal_radius_m: f64,
     /// The robot's constants (top speed, axle length).
     pub epuck: EpuckParams,
+    /// How the next goal to head for is chosen after a stop (the paper:
+    /// greedy, the most probable goal).
+    pub strategy: Strategy,
+    /// The decoder accuracy the device assumes when it predicts the
+    /// decoder's outcomes for [`Strategy::InfoGain`]: the probability of a
+    /// detection (p(error) >= T_e) when the user judges the motion wrong, and
+    /// of none when the user judges it right. In (0.5, 1].
+    pub assumed_accuracy: f64,
 }
 
 impl Default for ContinuousControlParams {
@@ -69,6 +78,8 @@ impl Default for ContinuousControlParams {
             heading_gain: 2.0,
             goal_radius_m: 0.02,
             epuck: EpuckParams::default(),
+            strategy: Strategy::Greedy,
+            assumed_accuracy: 0.75,
         }
     }
 }
@@ -133,6 +144,12 @@ impl ContinuousControlParams {
             "goal_radius_m",
             self.goal_radius_m,
             "> 0",
+        )?;
+        check(
+            self.assumed_accuracy > 0.5 && self.assumed_accuracy <= 1.0,
+            "assumed_accuracy",
+            self.assumed_accuracy,
+            "in (0.5, 1]",
         )?;
         self.epuck.validate()
     }
@@ -347,6 +364,20 @@ mod tests {
                     ..d.clone()
                 },
                 "goal_radius_m",
+            ),
+            (
+                ContinuousControlParams {
+                    assumed_accuracy: 0.5,
+                    ..d.clone()
+                },
+                "assumed_accuracy",
+            ),
+            (
+                ContinuousControlParams {
+                    assumed_accuracy: 1.01,
+                    ..d.clone()
+                },
+                "assumed_accuracy",
             ),
         ] {
             let e = p.validate().unwrap_err().to_string();

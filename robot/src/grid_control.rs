@@ -8,6 +8,7 @@ use crate::belief::Belief;
 use crate::error::{Result, RobotError};
 use crate::grid::{Cell, Grid, GridAction};
 use crate::qvalues::{QParams, QTable};
+use crate::strategy::{Strategy, gain_from_logs};
 
 /// Parameters of the grid strategy.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -23,6 +24,11 @@ pub struct GridControlParams {
     pub p_c: f64,
     /// Reward model of the Q-values.
     pub q: QParams,
+    /// How the non-random actions are chosen (the paper: greedy).
+    pub strategy: Strategy,
+    /// The decoder accuracy the device assumes when it predicts the
+    /// decoder's outcomes for [`Strategy::InfoGain`]. In (0.5, 1].
+    pub assumed_accuracy: f64,
 }
 
 impl Default for GridControlParams {
@@ -32,6 +38,8 @@ impl Default for GridControlParams {
             epsilon: 0.1,
             p_c: 0.9,
             q: QParams::default(),
+            strategy: Strategy::Greedy,
+            assumed_accuracy: 0.75,
         }
     }
 }
@@ -49,6 +57,10 @@ impl GridControlParams {
         if !(self.p_c.is_finite() && self.p_c > 0.0 && self.p_c < 1.0) {
             return bad(format!("p_c = {} must be in (0, 1)", self.p_c));
         }
+        let a = self.assumed_accuracy;
+        if !(a.is_finite() && a > 0.5 && a <= 1.0) {
+            return bad(format!("assumed_accuracy = {a} must be in (0.5, 1]"));
+        }
         self.q.validate()
     }
 }
@@ -60,12 +72,19 @@ pub fn policy_likelihood(q_hat: f64, p_error: f64) -> f64 {
 }
 
 /// The device's side of the grid task: a belief over the 25 candidate goals
-/// (every cell), updated after each action by eq. (4), and an epsilon-greedy
-/// choice of the next action towards the most probable goal.
+/// (every cell), updated after each action by eq. (4), and an
+/// epsilon-randomised choice of the next action by the [`Strategy`]: towards
+/// the most probable goal (greedy), or the most informative one.
 #[derive(Debug, Clone)]
 pub struct GridController {
     params: GridControlParams,
     table: QTable,
+    /// Eq. (3) at `params.tau`: `softmax[goal_index * n_cells + cell_index]`.
+    softmax: Vec<[f64; 5]>,
+    /// For info gain (empty for greedy), indexed like `softmax`: ln of
+    /// eq. (4) for each action when the decoder says error (p(error) =
+    /// alpha) and says correct (1 - alpha).
+    ln_likelihood: Vec<[[f64; 2]; 5]>,
     belief: Belief,
 }
 
@@ -78,14 +97,44 @@ impl GridController {
     }
 
     /// A controller reusing precomputed Q-values (they depend only on the
-    /// grid and the reward model).
+    /// grid and the reward model). Computes the soft-max (eq. 3) of every
+    /// goal and cell once.
     pub fn with_table(table: QTable, params: GridControlParams) -> Self {
-        let n = table.grid().n_cells();
+        let grid = *table.grid();
+        let n = grid.n_cells();
+        let mut softmax = Vec::with_capacity(n * n);
+        for goal in grid.cells() {
+            for cell in grid.cells() {
+                softmax.push(table.softmax(goal, cell, params.tau));
+            }
+        }
+        let alpha = params.assumed_accuracy;
+        let ln_likelihood = match params.strategy {
+            Strategy::Greedy => Vec::new(),
+            Strategy::InfoGain => softmax
+                .iter()
+                .map(|q| {
+                    q.map(|q| {
+                        [
+                            policy_likelihood(q, alpha).ln(),
+                            policy_likelihood(q, 1.0 - alpha).ln(),
+                        ]
+                    })
+                })
+                .collect(),
+        };
         Self {
             params,
             table,
+            softmax,
+            ln_likelihood,
             belief: Belief::uniform(n),
         }
+    }
+
+    /// Eq. (3): Q^_goal(cell, .), from the table made at construction.
+    fn q_hat(&self, goal_index: usize, cell_index: usize) -> &[f64; 5] {
+        &self.softmax[goal_index * self.table.grid().n_cells() + cell_index]
     }
 
     /// The parameters in force.
@@ -115,14 +164,78 @@ impl GridController {
         (p >= self.params.p_c).then_some(cell)
     }
 
-    /// Epsilon-greedy: with probability epsilon a uniformly random action,
-    /// otherwise the optimal action for the most probable goal.
+    /// With probability epsilon a uniformly random action; otherwise, by
+    /// the strategy, the optimal action for the most probable goal
+    /// ([`Strategy::Greedy`], the paper's epsilon-greedy) or the action of
+    /// largest [`information_gain`](Self::information_gain)
+    /// ([`Strategy::InfoGain`]); gains within 1e-12 of the largest tie, and
+    /// ties go to the greedy action, then to the first in
+    /// [`GridAction::ALL`]. Both strategies draw the same random numbers.
     pub fn choose(&self, cell: Cell, rng: &mut impl Rng) -> GridAction {
         if self.params.epsilon > 0.0 && rng.random::<f64>() < self.params.epsilon {
-            GridAction::ALL[rng.random_range(0..GridAction::ALL.len())]
-        } else {
-            self.table.greedy(self.most_probable().0, cell)
+            return GridAction::ALL[rng.random_range(0..GridAction::ALL.len())];
         }
+        let greedy = self.table.greedy(self.most_probable().0, cell);
+        match self.params.strategy {
+            Strategy::Greedy => greedy,
+            Strategy::InfoGain => {
+                let b = self.belief.probabilities();
+                let ln_b: Vec<f64> = b.iter().map(|v| v.ln()).collect();
+                let gains = GridAction::ALL.map(|a| self.gain(&b, &ln_b, cell, a));
+                let best = gains.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                let tied = |a: GridAction| gains[a.index()] >= best - 1e-12;
+                if tied(greedy) {
+                    greedy
+                } else {
+                    GridAction::ALL
+                        .into_iter()
+                        .find(|&a| tied(a))
+                        .unwrap_or(greedy)
+                }
+            }
+        }
+    }
+
+    /// The expected information gain of `action` at `cell`, nats
+    /// ([`expected_information_gain`](crate::expected_information_gain)): the
+    /// user judges it an error for goal i iff `!grid.is_correct(cell, action,
+    /// i)`, the decoder reports that judgement with the assumed accuracy
+    /// alpha, as p(error) = alpha when it says error and 1 - alpha when it
+    /// says correct, and the belief would be updated by eq. (4).
+    pub fn information_gain(&self, cell: Cell, action: GridAction) -> f64 {
+        let b = self.belief.probabilities();
+        let ln_b: Vec<f64> = b.iter().map(|v| v.ln()).collect();
+        self.gain(&b, &ln_b, cell, action)
+    }
+
+    /// [`expected_information_gain`](crate::expected_information_gain) with
+    /// the logarithms looked up rather than computed (the same value within
+    /// rounding).
+    fn gain(&self, belief: &[f64], ln_belief: &[f64], cell: Cell, action: GridAction) -> f64 {
+        let grid = self.table.grid();
+        let n = grid.n_cells();
+        let (c, a) = (grid.index(cell), action.index());
+        let alpha = self.params.assumed_accuracy;
+        let ln_l = |i: usize, says_error: bool| match self.ln_likelihood.get(i * n + c) {
+            Some(t) => t[a][usize::from(!says_error)],
+            None => {
+                let p = if says_error { alpha } else { 1.0 - alpha };
+                policy_likelihood(self.q_hat(i, c)[a], p).ln()
+            }
+        };
+        gain_from_logs(
+            belief,
+            |i| ln_belief[i],
+            alpha,
+            |i| f64::from(u8::from(!grid.is_correct(cell, action, grid.cell(i)))),
+            |i, says_error| {
+                let p = if says_error { alpha } else { 1.0 - alpha };
+                (
+                    policy_likelihood(self.q_hat(i, c)[a], p),
+                    ln_l(i, says_error),
+                )
+            },
+        )
     }
 
     /// Updates the belief after `action` at `cell`, given the decoder's
@@ -139,12 +252,9 @@ impl GridController {
 
     /// Eq. (4) for every goal, indexed like the grid's cells.
     pub fn likelihoods(&self, cell: Cell, action: GridAction, p_error: f64) -> Vec<f64> {
-        let grid = *self.table.grid();
-        grid.cells()
-            .map(|goal| {
-                let q_hat = self.table.softmax(goal, cell, self.params.tau)[action.index()];
-                policy_likelihood(q_hat, p_error)
-            })
+        let c = self.table.grid().index(cell);
+        (0..self.table.grid().n_cells())
+            .map(|goal| policy_likelihood(self.q_hat(goal, c)[action.index()], p_error))
             .collect()
     }
 }
@@ -319,9 +429,189 @@ mod tests {
                 },
                 "p_c",
             ),
+            (
+                GridControlParams {
+                    assumed_accuracy: 0.5,
+                    ..Default::default()
+                },
+                "assumed_accuracy",
+            ),
+            (
+                GridControlParams {
+                    assumed_accuracy: f64::NAN,
+                    ..Default::default()
+                },
+                "assumed_accuracy",
+            ),
         ] {
             let e = p.validate().unwrap_err().to_string();
             assert!(e.contains(field), "{e}");
+        }
+    }
+
+    fn info_gain() -> GridControlParams {
+        GridControlParams {
+            strategy: Strategy::InfoGain,
+            ..GridControlParams::default()
+        }
+    }
+
+    /// A belief with `mass` spread evenly over `goals`, the rest over the
+    /// other cells.
+    fn set_belief(c: &mut GridController, goals: &[Cell], mass: f64) {
+        let g = *c.table().grid();
+        let rest = (1.0 - mass) / (g.n_cells() - goals.len()) as f64;
+        let w: Vec<f64> = g
+            .cells()
+            .map(|cell| {
+                if goals.contains(&cell) {
+                    mass / goals.len() as f64
+                } else {
+                    rest
+                }
+            })
+            .collect();
+        c.belief = Belief::uniform(g.n_cells());
+        c.belief.update(&w).unwrap();
+    }
+
+    #[test]
+    fn info_gain_splits_two_goals_the_greedy_action_cannot_tell_apart() {
+        // Goals (1, 4) and (3, 4) seen from (2, 2): up is right for both,
+        // so it tells nothing; left and right each split them.
+        let mut c = GridController::new(
+            Grid::paper(),
+            GridControlParams {
+                epsilon: 0.0,
+                ..info_gain()
+            },
+        )
+        .unwrap();
+        let (a, b) = (Cell::new(1, 4), Cell::new(3, 4));
+        let here = Cell::new(2, 2);
+        set_belief(&mut c, &[a, b], 1.0);
+        assert_eq!(c.table().greedy(c.most_probable().0, here), GridAction::Up);
+        assert!(c.information_gain(here, GridAction::Up).abs() < 1e-12);
+        let left = c.information_gain(here, GridAction::Left);
+        assert!(left > 1e-3, "{left}");
+        let mut rng = ChaCha8Rng::seed_from_u64(0);
+        assert_eq!(
+            c.choose(here, &mut rng),
+            GridAction::Left,
+            "tie: lower index"
+        );
+        // Certain: every gain is 0, the greedy action wins the tie.
+        set_belief(&mut c, &[a], 1.0);
+        assert_eq!(c.choose(here, &mut rng), GridAction::Up);
+        // Uniform: no posterior has more entropy, so no gain is negative.
+        c.belief = Belief::uniform(25);
+        let gains = GridAction::ALL.map(|a| c.information_gain(here, a));
+        assert!(
+            gains.iter().all(|g| g.is_finite() && *g >= -1e-12),
+            "{gains:?}"
+        );
+    }
+
+    /// The epsilon-greedy choice as it was before strategies existed.
+    fn old_choose(c: &GridController, cell: Cell, rng: &mut impl Rng) -> GridAction {
+        let p = c.params();
+        if p.epsilon > 0.0 && rng.random::<f64>() < p.epsilon {
+            GridAction::ALL[rng.random_range(0..GridAction::ALL.len())]
+        } else {
+            c.table().greedy(c.most_probable().0, cell)
+        }
+    }
+
+    /// Eq. (4) as it was computed before the soft-max table.
+    fn old_likelihoods(c: &GridController, cell: Cell, action: GridAction, p: f64) -> Vec<f64> {
+        let grid = *c.table().grid();
+        grid.cells()
+            .map(|goal| {
+                let q_hat = c.table().softmax(goal, cell, c.params().tau)[action.index()];
+                policy_likelihood(q_hat, p)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn greedy_is_unchanged_by_the_strategy_machinery() {
+        let g = Grid::paper();
+        for tau in [0.3, 0.05] {
+            let params = GridControlParams {
+                tau,
+                ..GridControlParams::default()
+            };
+            let mut c = GridController::new(g, params).unwrap();
+            let mut rng = ChaCha8Rng::seed_from_u64(21);
+            let mut old_rng = rng.clone();
+            let mut world = ChaCha8Rng::seed_from_u64(22);
+            let mut cell = Cell::new(0, 0);
+            for _ in 0..2000 {
+                let a = c.choose(cell, &mut rng);
+                assert_eq!(a, old_choose(&c, cell, &mut old_rng));
+                let p = world.random::<f64>();
+                let l = c.likelihoods(cell, a, p);
+                let old = old_likelihoods(&c, cell, a, p);
+                assert!(l.iter().zip(&old).all(|(x, y)| x.to_bits() == y.to_bits()));
+                c.observe(cell, a, p).unwrap();
+                cell = g.step(cell, a);
+                if c.converged().is_some() {
+                    c.belief = Belief::uniform(25);
+                }
+            }
+            assert_eq!(rng, old_rng, "same draws");
+        }
+    }
+
+    #[test]
+    fn info_gain_draws_the_same_random_numbers_as_greedy() {
+        let g = Grid::paper();
+        let greedy = controller();
+        let info = GridController::new(g, info_gain()).unwrap();
+        let mut r1 = ChaCha8Rng::seed_from_u64(5);
+        let mut r2 = r1.clone();
+        for k in 0..500 {
+            let cell = g.cell(k % 25);
+            greedy.choose(cell, &mut r1);
+            info.choose(cell, &mut r2);
+        }
+        assert_eq!(r1, r2);
+    }
+
+    #[test]
+    fn the_precomputed_gain_is_the_formula() {
+        // The table lookups agree with expected_information_gain on eq. (4)
+        // computed afresh, for an info-gain controller (logarithm table) and
+        // a greedy one (no table).
+        let g = Grid::paper();
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        let mut info = GridController::new(g, info_gain()).unwrap();
+        let mut greedy = controller();
+        let alpha = info.params().assumed_accuracy;
+        for _ in 0..300 {
+            let (cell, action) = (
+                g.cell(rng.random_range(0..25)),
+                GridAction::ALL[rng.random_range(0..5)],
+            );
+            let p = rng.random::<f64>();
+            info.observe(cell, action, p).unwrap();
+            greedy.observe(cell, action, p).unwrap();
+            let b = info.belief().probabilities();
+            for a in GridAction::ALL {
+                let (le, lc) = (
+                    info.likelihoods(cell, a, alpha),
+                    info.likelihoods(cell, a, 1.0 - alpha),
+                );
+                let want = crate::strategy::expected_information_gain(
+                    &b,
+                    alpha,
+                    |i| f64::from(u8::from(!g.is_correct(cell, a, g.cell(i)))),
+                    |i, says_error| if says_error { le[i] } else { lc[i] },
+                );
+                let got = info.information_gain(cell, a);
+                assert!((got - want).abs() < 1e-12, "{got} vs {want}");
+                assert!((greedy.information_gain(cell, a) - want).abs() < 1e-12);
+            }
         }
     }
 }

@@ -13,6 +13,10 @@
 //! the potentials of eq. (5) ([`QuadraticPotential`]), the likelihoods of
 //! eq. (6) and (7) ([`turn_likelihood`], [`linear_likelihood`]) and the
 //! [`ContinuousController`] that turns, drives and stops the robot.
+//!
+//! Both controllers choose their actions by a [`Strategy`]: the paper's
+//! greedy one, or the [`expected_information_gain`] of the decoder's next
+//! assessment.
 
 mod belief;
 mod continuous_control;
@@ -25,6 +29,7 @@ mod layout;
 mod pose;
 mod potential;
 mod qvalues;
+mod strategy;
 
 pub use belief::{Belief, log_sum_exp};
 pub use continuous_control::{ContinuousController, Observation, Phase, StepKind, StopReason};
@@ -37,3 +42,4 @@ pub use layout::{Goal, GoalLayout, LAYOUT_GRID_CELLS};
 pub use pose::{Pose, wrap_angle};
 pub use potential::QuadraticPotential;
 pub use qvalues::{QParams, QTable, softmax};
+pub use strategy::{Strategy, entropy_nats, expected_information_gain};

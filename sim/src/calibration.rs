@@ -66,6 +66,18 @@ pub fn run_calibration(
         request.seed,
         progress,
     )?;
+    calibrate_at(request, targeting, raw_sink)
+}
+
+/// The second half of [`run_calibration`], for a ratio already found (by
+/// an earlier search with the same request, e.g. from a sweep's cache):
+/// simulates the session at `targeting.ratio`, scores it and trains on it.
+pub fn calibrate_at(
+    request: &CalibrationRequest,
+    targeting: TargetingResult,
+    raw_sink: Option<RawSink<'_>>,
+) -> Result<CalibrationReport> {
+    let decoder = LdaDecoder::default();
     let generator = GeneratorParams {
         errp_to_noise: targeting.ratio,
         ..request.setup.generator.clone()

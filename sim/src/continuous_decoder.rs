@@ -62,6 +62,17 @@ pub fn run_continuous_calibration(
         request.seed,
         progress,
     )?;
+    calibrate_continuous_at(request, targeting)
+}
+
+/// The second half of [`run_continuous_calibration`], for a ratio already
+/// found (e.g. from a sweep's cache): re-runs the session at
+/// `targeting.ratio`, scores it and trains on it.
+pub fn calibrate_continuous_at(
+    request: &ContinuousRequest,
+    targeting: TargetingResult,
+) -> Result<ContinuousReport> {
+    let svm = SvmDecoder::default();
     let generator = GeneratorParams {
         errp_to_noise: targeting.ratio,
         ..request.setup.generator.clone()

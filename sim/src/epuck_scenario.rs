@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 
 use errp_bci::check_requested_accuracy;
-use errp_robot::{GoalLayout, Pose};
+use errp_robot::{GoalLayout, Pose, Strategy};
 use serde::Deserialize;
 
 use crate::epuck_task::{EpuckEpisode, EpuckTaskParams};
@@ -27,17 +27,21 @@ pub enum AnyScenario {
 /// Reads a scenario file and validates it according to its `task` field.
 pub fn load_scenario(path: impl AsRef<Path>) -> Result<AnyScenario> {
     let path = path.as_ref();
-    let text = read_scenario(path)?;
+    parse_scenario(&read_scenario(path)?, path)
+}
+
+/// Validates scenario text of either task; `path` names it in errors.
+pub(crate) fn parse_scenario(text: &str, path: &Path) -> Result<AnyScenario> {
     #[derive(Deserialize)]
     struct Task {
         task: Option<String>,
     }
-    let task: Task = parse_toml(&text, path)?;
+    let task: Task = parse_toml(text, path)?;
     match task.task.as_deref() {
         Some("epuck") => Ok(AnyScenario::Epuck(Box::new(EpuckScenario::parse(
-            &text, path,
+            text, path,
         )?))),
-        _ => Ok(AnyScenario::Grid(Box::new(Scenario::parse(&text, path)?))),
+        _ => Ok(AnyScenario::Grid(Box::new(Scenario::parse(text, path)?))),
     }
 }
 
@@ -111,6 +115,7 @@ struct ControlFile {
     stop_secs: Option<f64>,
     drive_speed_fraction: Option<f64>,
     turn_speed_fraction: Option<f64>,
+    strategy: Option<Strategy>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -286,7 +291,12 @@ impl EpuckScenario {
             set(&mut p.stop_secs, c.stop_secs);
             set(&mut p.drive_speed_fraction, c.drive_speed_fraction);
             set(&mut p.turn_speed_fraction, c.turn_speed_fraction);
+            if let Some(strategy) = c.strategy {
+                p.strategy = strategy;
+            }
         }
+        // The device knows its decoder's accuracy from the calibration.
+        params.control.assumed_accuracy = file.user.accuracy;
         params
             .control
             .validate()

@@ -16,6 +16,18 @@ pub enum SimError {
     /// A scenario is invalid.
     #[error("{0}")]
     Scenario(String),
+    /// A sweep cannot run as asked (bad levels, a resume that does not
+    /// match, shards that do not merge).
+    #[error("{0}")]
+    Sweep(String),
+    /// An input file cannot be read.
+    #[error("cannot read {path}: {source}")]
+    Input {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
     /// An output file cannot be created or written.
     #[error("cannot write {path}: {source}")]
     Output {

@@ -5,7 +5,7 @@ use errp_bci::{Accuracy, TargetingStep, rng::derive_seed};
 use errp_robot::{Grid, QTable};
 
 use crate::calibration::{CalibrationReport, CalibrationRequest, run_calibration};
-use crate::error::Result;
+use crate::error::{Result, SimError};
 use crate::grid_task::{
     AssessmentDecoder, EegDecoder, EpochBank, GridEpisodeResult, run_grid_episode,
 };
@@ -56,28 +56,47 @@ pub fn prepare_decoder(
     progress: impl FnMut(&TargetingStep),
 ) -> Result<(AssessmentDecoder, Option<CalibrationReport>)> {
     match scenario.decoder {
-        DecoderChoice::Oracle => Ok((
-            AssessmentDecoder::Oracle {
-                accuracy: scenario.accuracy,
-            },
-            None,
-        )),
+        DecoderChoice::Oracle => Ok((decoder_from_calibration(scenario, None)?, None)),
         DecoderChoice::Eeg => {
             let request = CalibrationRequest::new(scenario.accuracy, scenario.seed);
             let report = run_calibration(&request, progress, None)?;
-            let eeg = EegDecoder::from_report(&report, scenario.p_error);
-            let decoder = match scenario.eeg {
-                EegMode::Stream => AssessmentDecoder::Eeg(Box::new(eeg)),
-                EegMode::Bank => AssessmentDecoder::EegBank(Box::new(EpochBank::build(
-                    eeg,
-                    &scenario.params,
-                    scenario.bank_per_class,
-                    scenario.seed,
-                )?)),
-            };
-            Ok((decoder, Some(report)))
+            Ok((
+                decoder_from_calibration(scenario, Some(&report))?,
+                Some(report),
+            ))
         }
     }
+}
+
+/// The scenario's decoder from its calibration (none for the oracle): the
+/// online EEG decoder, streamed or with its epoch bank built.
+pub fn decoder_from_calibration(
+    scenario: &Scenario,
+    report: Option<&CalibrationReport>,
+) -> Result<AssessmentDecoder> {
+    let report = match (scenario.decoder, report) {
+        (DecoderChoice::Oracle, _) => {
+            return Ok(AssessmentDecoder::Oracle {
+                accuracy: scenario.accuracy,
+            });
+        }
+        (DecoderChoice::Eeg, Some(report)) => report,
+        (DecoderChoice::Eeg, None) => {
+            return Err(SimError::Scenario(
+                "the EEG decoder needs a calibration".into(),
+            ));
+        }
+    };
+    let eeg = EegDecoder::from_report(report, scenario.p_error);
+    Ok(match scenario.eeg {
+        EegMode::Stream => AssessmentDecoder::Eeg(Box::new(eeg)),
+        EegMode::Bank => AssessmentDecoder::EegBank(Box::new(EpochBank::build(
+            eeg,
+            &scenario.params,
+            scenario.bank_per_class,
+            scenario.seed,
+        )?)),
+    })
 }
 
 /// Runs every episode of `scenario` with `decoder`. Episode k uses the seed

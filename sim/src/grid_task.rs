@@ -3,8 +3,8 @@
 //! the decoder gives p(error), the controller updates its belief and acts.
 
 use errp_bci::{
-    Accuracy, Assessment, AssessmentKind, EegGenerator, EpochWindow, ErrorModel, GeneratorParams,
-    LdaModel, Montage, PlattScaling, Preprocessor, rng::derive_seed, rng::stream,
+    Accuracy, Assessment, AssessmentKind, Components, EegGenerator, EpochWindow, ErrorModel,
+    GeneratorParams, LdaModel, Montage, PlattScaling, Preprocessor, rng::derive_seed, rng::stream,
 };
 use errp_robot::{Cell, Grid, GridAction, GridControlParams, GridController, QTable};
 use rand::Rng;
@@ -84,36 +84,24 @@ impl EpochBank {
         per_class: usize,
         seed: u64,
     ) -> Result<Self> {
-        if per_class == 0 {
-            return Err(SimError::Scenario(
-                "an epoch bank needs at least one epoch per class".into(),
-            ));
-        }
-        let mut stream_eeg = OnlineEeg::start(&decoder, derive_seed(seed, "grid/bank", 0))?;
-        let mut rng = stream(seed, "grid/bank/order");
-        let mut error = Vec::with_capacity(per_class);
-        let mut correct = Vec::with_capacity(per_class);
-        while error.len() < per_class || correct.len() < per_class {
-            let want_error = if error.len() == per_class {
-                false
-            } else if correct.len() == per_class {
-                true
-            } else {
-                rng.random_bool(0.5)
-            };
-            let interval = rng.random_range(params.interval_min_secs..=params.interval_max_secs);
-            let epoch = stream_eeg.epoch(want_error, interval, true);
-            if want_error {
-                error.push(epoch);
-            } else {
-                correct.push(epoch);
-            }
-        }
+        let (error, correct) =
+            stream_pools(&decoder, params, per_class, seed, Components::default())?;
         Ok(Self {
             decoder,
             error,
             correct,
         })
+    }
+
+    /// Epochs per class.
+    /// Epoch `i` of a class: its features and its FCz trace.
+    pub fn epoch(&self, error: bool, i: usize) -> (&[f64], &[f64]) {
+        let (x, fcz) = if error {
+            &self.error[i]
+        } else {
+            &self.correct[i]
+        };
+        (x, fcz)
     }
 
     /// Epochs per class.
@@ -125,6 +113,130 @@ impl EpochBank {
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
+}
+
+/// Preprocessed epochs of both classes.
+type Pools = (Vec<(Vec<f64>, Vec<f64>)>, Vec<(Vec<f64>, Vec<f64>)>);
+
+/// The epochs of [`EpochBank::build`] streamed once in two parts that add up
+/// to the bank at any ErrP-to-noise ratio r: background + artifacts, and the
+/// ERPs at ratio 1 (the preprocessing and the features are linear). For
+/// sweeps, whose levels share a calibration session and so the preprocessor,
+/// and differ only in r.
+#[derive(Debug, Clone)]
+pub struct EpochBankParts {
+    noise: Pools,
+    erp: Pools,
+}
+
+impl EpochBankParts {
+    /// Streams both parts with `decoder`'s generator, montage and
+    /// preprocessor (its ratio and model are not used).
+    pub fn build(
+        decoder: &EegDecoder,
+        params: &GridTaskParams,
+        per_class: usize,
+        seed: u64,
+    ) -> Result<Self> {
+        let unit = EegDecoder {
+            generator: GeneratorParams {
+                errp_to_noise: 1.0,
+                ..decoder.generator.clone()
+            },
+            ..decoder.clone()
+        };
+        let (noise, erp) = rayon::join(
+            || {
+                stream_pools(
+                    &unit,
+                    params,
+                    per_class,
+                    seed,
+                    Components {
+                        erp: false,
+                        ..Components::default()
+                    },
+                )
+            },
+            || {
+                stream_pools(
+                    &unit,
+                    params,
+                    per_class,
+                    seed,
+                    Components {
+                        background: false,
+                        artifacts: false,
+                        erp: true,
+                    },
+                )
+            },
+        );
+        Ok(Self {
+            noise: noise?,
+            erp: erp?,
+        })
+    }
+
+    /// The bank `decoder` reads, at its generator's ratio: what
+    /// [`EpochBank::build`] gives (to rounding) if `decoder`'s preprocessor is
+    /// the one the parts were streamed with.
+    pub fn bank(&self, decoder: EegDecoder) -> EpochBank {
+        let r = decoder.generator.errp_to_noise;
+        let mix = |noise: &[(Vec<f64>, Vec<f64>)], erp: &[(Vec<f64>, Vec<f64>)]| {
+            noise
+                .iter()
+                .zip(erp)
+                .map(|((xn, fn_), (xe, fe))| {
+                    (
+                        xn.iter().zip(xe).map(|(a, b)| a + r * b).collect(),
+                        fn_.iter().zip(fe).map(|(a, b)| a + r * b).collect(),
+                    )
+                })
+                .collect()
+        };
+        EpochBank {
+            error: mix(&self.noise.0, &self.erp.0),
+            correct: mix(&self.noise.1, &self.erp.1),
+            decoder,
+        }
+    }
+}
+
+/// Streams the epochs of a bank with the generator's `components`.
+fn stream_pools(
+    decoder: &EegDecoder,
+    params: &GridTaskParams,
+    per_class: usize,
+    seed: u64,
+    components: Components,
+) -> Result<Pools> {
+    if per_class == 0 {
+        return Err(SimError::Scenario(
+            "an epoch bank needs at least one epoch per class".into(),
+        ));
+    }
+    let mut stream_eeg = OnlineEeg::start(decoder, derive_seed(seed, "grid/bank", 0), components)?;
+    let mut rng = stream(seed, "grid/bank/order");
+    let mut error = Vec::with_capacity(per_class);
+    let mut correct = Vec::with_capacity(per_class);
+    while error.len() < per_class || correct.len() < per_class {
+        let want_error = if error.len() == per_class {
+            false
+        } else if correct.len() == per_class {
+            true
+        } else {
+            rng.random_bool(0.5)
+        };
+        let interval = rng.random_range(params.interval_min_secs..=params.interval_max_secs);
+        let epoch = stream_eeg.epoch(want_error, interval, true);
+        if want_error {
+            error.push(epoch);
+        } else {
+            correct.push(epoch);
+        }
+    }
+    Ok((error, correct))
 }
 
 /// The calibrated EEG pipeline used online.
@@ -252,7 +364,11 @@ pub fn run_grid_episode(
     let mut rng_oracle = stream(seed, "grid/oracle");
     let mut rng_bank = stream(seed, "grid/bank/draw");
     let mut online = match decoder {
-        AssessmentDecoder::Eeg(d) => Some(OnlineEeg::start(d, derive_seed(seed, "grid/eeg", 0))?),
+        AssessmentDecoder::Eeg(d) => Some(OnlineEeg::start(
+            d,
+            derive_seed(seed, "grid/eeg", 0),
+            Components::default(),
+        )?),
         _ => None,
     };
 
@@ -359,9 +475,10 @@ struct OnlineEeg {
 
 impl OnlineEeg {
     /// Starts a stream and lets the filters settle.
-    fn start(d: &EegDecoder, seed: u64) -> Result<Self> {
+    fn start(d: &EegDecoder, seed: u64, components: Components) -> Result<Self> {
         let fs = d.generator.sfreq_hz;
-        let mut generator = EegGenerator::new(d.generator.clone(), &d.montage, seed)?;
+        let mut generator =
+            EegGenerator::new(d.generator.clone(), &d.montage, seed)?.with_components(components);
         let mut preprocessor = d.preprocessor.clone();
         preprocessor.reset();
         preprocessor.process(&generator.generate((WARM_UP_SECS * fs) as usize));

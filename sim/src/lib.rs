@@ -19,15 +19,16 @@ mod output;
 mod record;
 mod scenario;
 mod stats;
+mod sweep;
 mod table1;
 mod tracker;
 mod user;
 mod world;
 
-pub use calibration::{CalibrationReport, CalibrationRequest, run_calibration};
+pub use calibration::{CalibrationReport, CalibrationRequest, calibrate_at, run_calibration};
 pub use calibration_view::{LATENCY_TIMELINE, calibration_recording, record_calibration};
 pub use continuous_decoder::{
-    ContinuousDecoder, ContinuousReport, ContinuousRequest, WARM_UP_SECS,
+    ContinuousDecoder, ContinuousReport, ContinuousRequest, WARM_UP_SECS, calibrate_continuous_at,
     run_continuous_calibration,
 };
 pub use epuck_run::{
@@ -41,16 +42,26 @@ pub use epuck_task::{
 };
 pub use epuck_view::{EpuckRecorder, RUN_GAP_SECS, epuck_recording};
 pub use error::{Result, SimError};
-pub use grid_run::{GridRunReport, mean_sd, pooled_accuracy, prepare_decoder, run_grid_scenario};
+pub use grid_run::{
+    GridRunReport, decoder_from_calibration, mean_sd, pooled_accuracy, prepare_decoder,
+    run_grid_scenario,
+};
 pub use grid_task::{
-    AssessmentDecoder, EegDecoder, EpochBank, GridEpisodeResult, GridStep, GridTaskParams,
-    PErrorMapping, run_grid_episode,
+    AssessmentDecoder, EegDecoder, EpochBank, EpochBankParts, GridEpisodeResult, GridStep,
+    GridTaskParams, PErrorMapping, run_grid_episode,
 };
 pub use grid_view::{SIM_TIME, grid_recording, record_grid_run};
 pub use output::PendingFile;
 pub use record::RrdFile;
 pub use scenario::{DecoderChoice, EegMode, PErrorChoice, Scenario, free_pairs};
-pub use stats::{incomplete_beta, pearson};
+pub use stats::{StreamingPearson, correlation_p_value, incomplete_beta, pearson, wilson_interval};
+pub use sweep::{
+    Axis, DecoderInfo, EPISODES, Level, LevelPoint, LevelSummary, MANIFEST, Manifest, PaperPoint,
+    PlotError, Series, Shard, SweepObserver, SweepOptions, SweepOutcome, SweepPlot, SweepReport,
+    SweepSpec, SweepTask, TargetCache, cost_column, episodes_header, finish_dir, merge_sweeps,
+    parse_accuracies, parse_axis, parse_values, read_task, run_sweep, summarise_dir, summary_csv,
+    sweep_plot,
+};
 pub use table1::{
     FIXED_PAIRS, PAPER, PAPER_POOLED, Table1Cell, Table1Options, accuracy_time_correlation,
     run_table1,

@@ -8,7 +8,7 @@
 use std::path::{Path, PathBuf};
 
 use errp_bci::{GoalSet, subject};
-use errp_robot::{Cell, Grid, GridControlParams, QParams};
+use errp_robot::{Cell, Grid, GridControlParams, QParams, Strategy};
 use rand::Rng;
 use serde::Deserialize;
 use serde::de::DeserializeOwned;
@@ -137,6 +137,7 @@ struct ControlFile {
     discount: Option<f64>,
     goal_reward: Option<f64>,
     wrong_goal_reward: Option<f64>,
+    strategy: Option<Strategy>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -283,8 +284,12 @@ impl Scenario {
                     goal_reward: c.goal_reward.unwrap_or(q.goal_reward),
                     wrong_goal_reward: c.wrong_goal_reward.unwrap_or(q.wrong_goal_reward),
                 },
+                strategy: c.strategy.unwrap_or(d.strategy),
+                assumed_accuracy: d.assumed_accuracy,
             };
         }
+        // The device knows its decoder's accuracy from the calibration.
+        params.control.assumed_accuracy = accuracy;
         let c = &params.control;
         if !(c.tau.is_finite() && c.tau > 0.0) {
             return Err(bad(

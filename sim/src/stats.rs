@@ -20,14 +20,84 @@ pub fn pearson(x: &[f64], y: &[f64]) -> (f64, f64) {
         return (f64::NAN, f64::NAN);
     }
     let r = (sxy / (sxx * syy).sqrt()).clamp(-1.0, 1.0);
-    let df = nf - 2.0;
+    (r, correlation_p_value(r, n))
+}
+
+/// The two-sided p-value of Pearson's `r` over `n` pairs under r = 0
+/// (Student's t with n - 2 degrees of freedom).
+pub fn correlation_p_value(r: f64, n: usize) -> f64 {
+    if n < 3 || !r.is_finite() {
+        return f64::NAN;
+    }
+    let df = n as f64 - 2.0;
     if (1.0 - r * r) <= 0.0 {
-        return (r, 0.0);
+        return 0.0;
     }
     let t = r * (df / (1.0 - r * r)).sqrt();
     // Two-sided p = I_{df/(df+t^2)}(df/2, 1/2).
-    let p = incomplete_beta(df / 2.0, 0.5, df / (df + t * t));
-    (r, p)
+    incomplete_beta(df / 2.0, 0.5, df / (df + t * t))
+}
+
+/// Pearson's r accumulated one pair at a time (Welford's co-moments), for
+/// data streamed from disk: constant memory, whatever the number of pairs.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StreamingPearson {
+    n: usize,
+    mean_x: f64,
+    mean_y: f64,
+    sxx: f64,
+    syy: f64,
+    sxy: f64,
+}
+
+impl StreamingPearson {
+    /// Adds the pair (x, y).
+    pub fn push(&mut self, x: f64, y: f64) {
+        self.n += 1;
+        let n = self.n as f64;
+        let dx = x - self.mean_x;
+        self.mean_x += dx / n;
+        let dy = y - self.mean_y;
+        self.mean_y += dy / n;
+        self.sxx += dx * (x - self.mean_x);
+        self.syy += dy * (y - self.mean_y);
+        self.sxy += dx * (y - self.mean_y);
+    }
+
+    /// Pairs so far.
+    pub fn len(&self) -> usize {
+        self.n
+    }
+
+    /// True before the first pair.
+    pub fn is_empty(&self) -> bool {
+        self.n == 0
+    }
+
+    /// r and its two-sided p-value, as [`pearson`] gives them (NaN when
+    /// undefined).
+    pub fn r_p(&self) -> (f64, f64) {
+        if self.n < 3 || self.sxx <= 0.0 || self.syy <= 0.0 {
+            return (f64::NAN, f64::NAN);
+        }
+        let r = (self.sxy / (self.sxx * self.syy).sqrt()).clamp(-1.0, 1.0);
+        (r, correlation_p_value(r, self.n))
+    }
+}
+
+/// The 95 % Wilson score interval of a proportion of `successes` out of `n`
+/// ((NaN, NaN) for n = 0).
+pub fn wilson_interval(successes: usize, n: usize) -> (f64, f64) {
+    if n == 0 {
+        return (f64::NAN, f64::NAN);
+    }
+    let z = 1.959_963_984_540_054_f64;
+    let nf = n as f64;
+    let p = successes as f64 / nf;
+    let denom = 1.0 + z * z / nf;
+    let centre = (p + z * z / (2.0 * nf)) / denom;
+    let half = z * (p * (1.0 - p) / nf + z * z / (4.0 * nf * nf)).sqrt() / denom;
+    ((centre - half).max(0.0), (centre + half).min(1.0))
 }
 
 /// Regularised incomplete beta function I_x(a, b) (continued fraction,
@@ -125,6 +195,36 @@ mod tests {
         let p = incomplete_beta(9.0, 0.5, 18.0 / (18.0 + t * t));
         assert!((p - 0.0365).abs() < 0.002, "{p}");
         assert!(pearson(&[1.0, 1.0, 1.0], &[1.0, 2.0, 3.0]).0.is_nan());
+    }
+
+    #[test]
+    fn streaming_pearson_equals_the_two_pass_one() {
+        let x: Vec<f64> = (0..50).map(|i| (i as f64 * 0.37).sin() + 3.0).collect();
+        let y: Vec<f64> = (0..50)
+            .map(|i| (i as f64 * 0.11).cos() * 40.0 + x[i])
+            .collect();
+        let mut s = StreamingPearson::default();
+        for i in 0..50 {
+            s.push(x[i], y[i]);
+        }
+        let (r, p) = s.r_p();
+        let (r2, p2) = pearson(&x, &y);
+        assert!(
+            (r - r2).abs() < 1e-12 && (p - p2).abs() < 1e-10,
+            "{r} {r2} {p} {p2}"
+        );
+        assert!(StreamingPearson::default().r_p().0.is_nan());
+    }
+
+    #[test]
+    fn wilson_interval_matches_known_values() {
+        // statsmodels proportion_confint(8, 10, method="wilson")
+        // = (0.4901624, 0.9433178).
+        let (lo, hi) = wilson_interval(8, 10);
+        assert!((lo - 0.490_162_4).abs() < 1e-6 && (hi - 0.943_317_8).abs() < 1e-6);
+        let (lo, hi) = wilson_interval(0, 20);
+        assert!(lo == 0.0 && hi > 0.1 && hi < 0.2);
+        assert!(wilson_interval(0, 0).0.is_nan());
     }
 
     #[test]

@@ -149,3 +149,27 @@ fn a_decoder_without_errps_converges_to_the_right_goal_only_by_chance() {
     // 1 in 25 by chance (2 expected in 50); 8 or more would be p < 0.001.
     assert!(right < 8, "{right}/50 right goals with a chance decoder");
 }
+
+#[test]
+fn an_epoch_bank_from_parts_equals_the_bank_streamed_at_its_ratio() {
+    // Sweeps stream a bank's noise and ERP parts once and mix them per level.
+    let report = run_calibration(&CalibrationRequest::new(0.75, 2), |_| {}, None).unwrap();
+    let eeg = EegDecoder::from_report(&report, PErrorChoice::Platt);
+    let params = GridTaskParams::default();
+    let direct = errp_sim::EpochBank::build(eeg.clone(), &params, 12, 2).unwrap();
+    let parts = errp_sim::EpochBankParts::build(&eeg, &params, 12, 2).unwrap();
+    let mixed = parts.bank(eeg);
+    assert_eq!(mixed.len(), 12);
+    let mut worst = 0.0f64;
+    for error in [true, false] {
+        for i in 0..12 {
+            let (a, fa) = direct.epoch(error, i);
+            let (b, fb) = mixed.epoch(error, i);
+            assert_eq!((a.len(), fa.len()), (b.len(), fb.len()));
+            for (x, y) in a.iter().zip(b).chain(fa.iter().zip(fb)) {
+                worst = worst.max((x - y).abs() / (1.0 + x.abs()));
+            }
+        }
+    }
+    assert!(worst < 1e-9, "largest relative difference {worst}");
+}

@@ -1,0 +1,115 @@
+//! An on-disk cache of accuracy targeting: the ErrP-to-noise ratio found for
+//! a (decoder, protocol, EEG model, accuracy, seed), so that a sweep rerun,
+//! resumed or sharded does not search it again.
+//!
+//! A cache entry is a small JSON file named by a hash of the full request,
+//! which it also stores and compares on read: an entry for another request
+//! is never used. An unreadable entry is searched again and rewritten.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use errp_bci::TargetingResult;
+use serde::{Deserialize, Serialize};
+
+use crate::error::Result;
+use crate::output::PendingFile;
+
+/// Where targeting results are kept (or nowhere).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct TargetCache {
+    dir: Option<PathBuf>,
+}
+
+#[derive(Serialize, Deserialize)]
+struct Entry {
+    request: String,
+    result: TargetingResult,
+}
+
+/// 64-bit FNV-1a of `text`.
+fn fnv1a(text: &str) -> u64 {
+    text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
+impl TargetCache {
+    /// A cache in `dir` (created when first written).
+    pub fn new(dir: impl Into<PathBuf>) -> Self {
+        Self {
+            dir: Some(dir.into()),
+        }
+    }
+
+    /// No cache: every targeting is searched.
+    pub fn disabled() -> Self {
+        Self { dir: None }
+    }
+
+    /// The default place: `$ERRP_CACHE_DIR`, else `$XDG_CACHE_HOME/errp`,
+    /// else `~/.cache/errp`, else none.
+    pub fn default_location() -> Self {
+        let env = |k: &str| {
+            std::env::var_os(k)
+                .filter(|v| !v.is_empty())
+                .map(PathBuf::from)
+        };
+        let dir = env("ERRP_CACHE_DIR")
+            .or_else(|| env("XDG_CACHE_HOME").map(|d| d.join("errp")))
+            .or_else(|| env("HOME").map(|d| d.join(".cache").join("errp")));
+        Self { dir }
+    }
+
+    /// The cache directory, if any.
+    pub fn dir(&self) -> Option<&Path> {
+        self.dir.as_deref()
+    }
+
+    /// The result for `request` (a complete description of the search, e.g.
+    /// the Debug form of its setup, accuracy and seed) from the cache, or
+    /// from `search`, which is then stored. The flag is true on a hit.
+    pub fn get_or_search(
+        &self,
+        kind: &str,
+        request: &str,
+        search: impl FnOnce() -> Result<TargetingResult>,
+    ) -> Result<(TargetingResult, bool)> {
+        let Some(dir) = &self.dir else {
+            return Ok((search()?, false));
+        };
+        let request = format!("{kind} v1 {request}");
+        let path = dir.join(format!("{kind}-{:016x}.json", fnv1a(&request)));
+        if let Ok(text) = std::fs::read_to_string(&path)
+            && let Ok(entry) = serde_json::from_str::<Entry>(&text)
+            && entry.request == request
+        {
+            return Ok((entry.result, true));
+        }
+        let result = search()?;
+        // A cache that cannot be written is not an error: the sweep goes on.
+        // (serde_json's `float_roundtrip` makes a stored ratio read back bit
+        // for bit, so a hit gives what this miss gives.)
+        let entry = Entry { request, result };
+        let _ = Self::store(&path, &entry);
+        Ok((entry.result, false))
+    }
+
+    fn store(path: &Path, entry: &Entry) -> Result<()> {
+        if let Some(parent) = path.parent() {
+            std::fs::create_dir_all(parent).map_err(|source| crate::SimError::Output {
+                path: parent.to_path_buf(),
+                source,
+            })?;
+        }
+        let (pending, mut file) = PendingFile::create(path)?;
+        let text = serde_json::to_string(entry).expect("a targeting result serialises");
+        file.write_all(text.as_bytes())
+            .map_err(|source| crate::SimError::Output {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        pending.commit()?;
+        Ok(())
+    }
+}

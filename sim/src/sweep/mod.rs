@@ -1,0 +1,28 @@
+//! Monte Carlo sweeps: how goal inference degrades with decoder accuracy,
+//! and how strategies and parameters change that.
+//!
+//! A sweep runs `episodes` episodes at every level (an accuracy and one value
+//! of every swept parameter). Each episode's seed derives from the sweep seed,
+//! its accuracy and its index, so results do not depend on threads, shards or
+//! interruptions. Rows stream to `episodes.csv` as they finish; a rerun of the
+//! same sweep resumes; `summary.csv`, `sweep.svg`, `sweep.png` and
+//! `sweep.json` are written whole at the end.
+
+mod cache;
+mod merge;
+mod plot;
+mod run;
+mod spec;
+mod summary;
+
+pub use cache::TargetCache;
+pub use merge::merge_sweeps;
+pub use plot::{LevelPoint, PaperPoint, PlotError, Series, SweepPlot};
+pub use run::{
+    DecoderInfo, EPISODES, MANIFEST, Manifest, SweepObserver, SweepOptions, SweepOutcome,
+    cost_column, episodes_header, run_sweep,
+};
+pub use spec::{
+    Axis, Level, Shard, SweepSpec, SweepTask, parse_accuracies, parse_axis, parse_values, read_task,
+};
+pub use summary::{LevelSummary, SweepReport, finish_dir, summarise_dir, summary_csv, sweep_plot};

@@ -1,0 +1,739 @@
+//! Running a sweep: prepare every level's decoder, then stream episodes to
+//! `episodes.csv` chunk by chunk, resuming where an earlier run stopped.
+
+use std::collections::HashMap;
+use std::fs::{File, OpenOptions};
+use std::io::{BufRead, BufReader, Seek, SeekFrom, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, OnceLock};
+
+use errp_bci::{
+    GeneratorParams, LdaDecoder, SessionParts, SvmDecoder, calibrate_session, target_accuracy_on,
+    target_continuous_accuracy,
+};
+use errp_robot::{Cell, Grid, QTable};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::calibration::{CalibrationReport, CalibrationRequest};
+use crate::continuous_decoder::{ContinuousDecoder, ContinuousRequest, calibrate_continuous_at};
+use crate::epuck_scenario::{AnyScenario, EpuckScenario};
+use crate::epuck_task::run_epuck_episode;
+use crate::error::{Result, SimError};
+use crate::grid_run::decoder_from_calibration;
+use crate::grid_task::{AssessmentDecoder, EegDecoder, EpochBankParts, run_grid_episode};
+use crate::output::PendingFile;
+use crate::scenario::{DecoderChoice, EegMode, Scenario};
+
+use super::cache::TargetCache;
+use super::spec::{Level, Shard, SweepSpec, SweepTask, format_number, value_text};
+
+/// The calibrated decoder behind one or more levels, as `sweep.json` lists it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DecoderInfo {
+    /// Requested accuracy.
+    pub accuracy: f64,
+    /// `lda` (grid EEG), `svm` (e-puck) or `oracle`.
+    pub kind: String,
+    /// Seed of its calibration session.
+    pub calibration_seed: u64,
+    /// ErrP-to-noise ratio found by targeting.
+    pub errp_to_noise: Option<f64>,
+    /// Cross-validated correct-class rate of the calibration session.
+    pub cv_correct: Option<f64>,
+    /// Cross-validated error-class rate.
+    pub cv_error: Option<f64>,
+    /// Their mean: the accuracy reached.
+    pub cv_mean: Option<f64>,
+    /// True if the targeting came from the cache (not written to disk).
+    #[serde(skip)]
+    pub cached: bool,
+}
+
+/// The contents of `sweep.json`: enough to rerun the sweep exactly.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    /// Format of the sweep directory.
+    pub format: u32,
+    /// Version of errp that wrote it.
+    pub errp_version: String,
+    /// What was swept.
+    pub spec: SweepSpec,
+    /// The slice this directory holds (none: the whole sweep).
+    pub shard: Option<Shard>,
+    /// Every calibrated decoder, in level order (empty until calibrated).
+    pub decoders: Vec<DecoderInfo>,
+}
+
+/// Version of the sweep directory layout.
+pub const FORMAT: u32 = 1;
+
+impl Manifest {
+    /// A manifest with no decoders yet.
+    pub fn new(spec: &SweepSpec, shard: Shard) -> Self {
+        Self {
+            format: FORMAT,
+            errp_version: env!("CARGO_PKG_VERSION").to_string(),
+            spec: spec.clone(),
+            shard: (!shard.is_all()).then_some(shard),
+            decoders: Vec::new(),
+        }
+    }
+
+    /// Reads `dir/sweep.json`.
+    pub fn read(dir: &Path) -> Result<Self> {
+        let path = dir.join(MANIFEST);
+        let text = std::fs::read_to_string(&path).map_err(|source| SimError::Input {
+            path: path.clone(),
+            source,
+        })?;
+        serde_json::from_str(&text).map_err(|e| {
+            SimError::Sweep(format!(
+                "{}: not a sweep manifest ({e}); was it written by `errp sweep`?",
+                path.display()
+            ))
+        })
+    }
+
+    /// Writes `dir/sweep.json` atomically.
+    pub fn write(&self, dir: &Path) -> Result<()> {
+        let text = serde_json::to_string_pretty(self).expect("a manifest serialises") + "\n";
+        write_atomic(&dir.join(MANIFEST), text.as_bytes())
+    }
+}
+
+/// The manifest's file name.
+pub const MANIFEST: &str = "sweep.json";
+/// The episodes' file name.
+pub const EPISODES: &str = "episodes.csv";
+
+/// Writes `bytes` to `path` through a temporary file renamed into place.
+pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let (pending, mut file) = PendingFile::create(path)?;
+    file.write_all(bytes)
+        .and_then(|()| file.sync_all())
+        .map_err(|source| SimError::Output {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    pending.commit()?;
+    Ok(())
+}
+
+/// What a sweep reports as it goes. Every method defaults to nothing;
+/// `()` watches nothing.
+pub trait SweepObserver: Sync {
+    /// A decoder is calibrated (`done` of `total`).
+    fn decoder_ready(&self, _info: &DecoderInfo, _done: usize, _total: usize) {}
+    /// `done` of this run's `total` episodes are on disk.
+    fn episodes_done(&self, _done: usize, _total: usize) {}
+}
+
+impl SweepObserver for () {}
+
+/// How a sweep runs (none of it changes the results).
+#[derive(Debug, Clone)]
+pub struct SweepOptions {
+    /// Output directory.
+    pub out: PathBuf,
+    /// Targeting cache.
+    pub cache: TargetCache,
+    /// The slice to run.
+    pub shard: Shard,
+    /// Episodes run in parallel before each write to disk (0: a default by
+    /// task).
+    pub chunk: usize,
+}
+
+/// How a call to [`run_sweep`] ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SweepOutcome {
+    /// Every episode of the slice is on disk.
+    Complete {
+        /// Episodes run by this call (the rest were already on disk).
+        ran: usize,
+        /// Episodes of the slice.
+        total: usize,
+    },
+    /// Stopped by the cancel flag; rerunning resumes.
+    Interrupted {
+        /// Episodes on disk.
+        done: usize,
+        /// Episodes of the slice.
+        total: usize,
+    },
+}
+
+/// One level, ready to run episodes.
+enum Runner {
+    Grid {
+        scenario: Box<Scenario>,
+        decoder: Arc<AssessmentDecoder>,
+        table: Arc<QTable>,
+    },
+    Epuck {
+        scenario: Box<EpuckScenario>,
+        decoder: Arc<ContinuousDecoder>,
+    },
+}
+
+/// The decoder a level needs, before calibration; equal keys share one.
+fn decoder_key(level: &Level) -> String {
+    match &level.scenario {
+        AnyScenario::Grid(s) => format!(
+            "{:?}",
+            (
+                s.accuracy,
+                s.seed,
+                s.decoder,
+                s.p_error,
+                s.eeg,
+                s.bank_per_class,
+                s.params.interval_min_secs,
+                s.params.interval_max_secs
+            )
+        ),
+        AnyScenario::Epuck(s) => format!("{:?}", (s.accuracy, s.seed)),
+    }
+}
+
+enum Prepared {
+    Grid(Arc<AssessmentDecoder>),
+    Epuck(Arc<ContinuousDecoder>),
+}
+
+/// What levels share while their decoders are prepared in parallel: the
+/// grid's calibration session (every level uses the same one, at its own
+/// ratio) and epoch banks, each simulated once by the first level that needs
+/// it.
+#[derive(Default)]
+struct Shared {
+    sessions: HashMap<u64, OnceLock<std::result::Result<Arc<SessionParts>, String>>>,
+    banks: HashMap<String, OnceLock<std::result::Result<Arc<EpochBankParts>, String>>>,
+}
+
+/// The key of a grid level's epoch bank: what its epochs depend on.
+fn bank_key(s: &Scenario) -> String {
+    format!(
+        "{:?}",
+        (
+            s.seed,
+            s.bank_per_class,
+            s.params.interval_min_secs,
+            s.params.interval_max_secs
+        )
+    )
+}
+
+impl Shared {
+    fn new(levels: &[Level]) -> Self {
+        let mut shared = Shared::default();
+        for level in levels {
+            if let AnyScenario::Grid(s) = &level.scenario {
+                shared.sessions.entry(s.seed).or_default();
+                shared.banks.entry(bank_key(s)).or_default();
+            }
+        }
+        shared
+    }
+}
+
+/// Runs `init` once per cell; every caller gets its result (errors as text,
+/// so they can be shared).
+fn once<T>(
+    cell: &OnceLock<std::result::Result<Arc<T>, String>>,
+    init: impl FnOnce() -> Result<T>,
+) -> Result<Arc<T>> {
+    cell.get_or_init(|| init().map(Arc::new).map_err(|e| e.to_string()))
+        .clone()
+        .map_err(SimError::Sweep)
+}
+
+/// Calibrates the decoder `level` needs, using the cache for the targeting.
+fn prepare(level: &Level, cache: &TargetCache, shared: &Shared) -> Result<(Prepared, DecoderInfo)> {
+    match &level.scenario {
+        AnyScenario::Grid(s) => {
+            let mut info = DecoderInfo {
+                accuracy: s.accuracy,
+                kind: "oracle".into(),
+                calibration_seed: s.seed,
+                errp_to_noise: None,
+                cv_correct: None,
+                cv_error: None,
+                cv_mean: None,
+                cached: false,
+            };
+            if s.decoder == DecoderChoice::Oracle {
+                let decoder = decoder_from_calibration(s, None)?;
+                return Ok((Prepared::Grid(Arc::new(decoder)), info));
+            }
+            // The level's calibration: the shared session at the ratio
+            // targeted for its accuracy.
+            let request = CalibrationRequest::new(s.accuracy, s.seed);
+            let parts = once(&shared.sessions[&s.seed], || {
+                Ok(SessionParts::simulate(&request.setup, request.seed)?)
+            })?;
+            let key = format!(
+                "{:?} {:?} accuracy={:?} seed={}",
+                request.setup, request.search, request.accuracy, request.seed
+            );
+            let lda = LdaDecoder::default();
+            let (targeting, hit) = cache.get_or_search("grid-lda", &key, || {
+                Ok(target_accuracy_on(
+                    &parts,
+                    request.accuracy,
+                    &lda,
+                    &request.setup,
+                    &request.search,
+                    request.seed,
+                    |_| {},
+                )?)
+            })?;
+            let calibrated = calibrate_session(
+                &lda,
+                parts.session_at(targeting.ratio),
+                request.setup.calibration.folds,
+                request.seed,
+            )?;
+            let report = CalibrationReport {
+                generator: GeneratorParams {
+                    errp_to_noise: targeting.ratio,
+                    ..request.setup.generator.clone()
+                },
+                targeting,
+                calibrated,
+            };
+            let a = report.calibrated.accuracy;
+            info.kind = "lda".into();
+            info.errp_to_noise = Some(report.targeting.ratio);
+            info.cv_correct = Some(a.correct);
+            info.cv_error = Some(a.error);
+            info.cv_mean = Some(a.mean());
+            info.cached = hit;
+            let eeg = EegDecoder::from_report(&report, s.p_error);
+            let decoder = match s.eeg {
+                EegMode::Stream => AssessmentDecoder::Eeg(Box::new(eeg)),
+                EegMode::Bank => {
+                    let bank = once(&shared.banks[&bank_key(s)], || {
+                        EpochBankParts::build(&eeg, &s.params, s.bank_per_class, s.seed)
+                    })?;
+                    AssessmentDecoder::EegBank(Box::new(bank.bank(eeg)))
+                }
+            };
+            Ok((Prepared::Grid(Arc::new(decoder)), info))
+        }
+        AnyScenario::Epuck(s) => {
+            let request = ContinuousRequest::new(s.accuracy, s.seed);
+            let key = format!(
+                "{:?} {:?} accuracy={:?} seed={}",
+                request.setup, request.search, request.accuracy, request.seed
+            );
+            let (targeting, hit) = cache.get_or_search("epuck-svm", &key, || {
+                Ok(target_continuous_accuracy(
+                    request.accuracy,
+                    &SvmDecoder::default(),
+                    &request.setup,
+                    &request.search,
+                    request.seed,
+                    |_| {},
+                )?)
+            })?;
+            let report = calibrate_continuous_at(&request, targeting)?;
+            let a = report.calibrated.accuracy;
+            let info = DecoderInfo {
+                accuracy: s.accuracy,
+                kind: "svm".into(),
+                calibration_seed: s.seed,
+                errp_to_noise: Some(report.targeting.ratio),
+                cv_correct: Some(a.correct),
+                cv_error: Some(a.error),
+                cv_mean: Some(a.mean()),
+                cached: hit,
+            };
+            Ok((
+                Prepared::Epuck(Arc::new(ContinuousDecoder::from_report(&report))),
+                info,
+            ))
+        }
+    }
+}
+
+/// The header of `episodes.csv` for `spec`.
+pub fn episodes_header(spec: &SweepSpec) -> String {
+    let mut cols = vec!["level".to_string(), "accuracy".into()];
+    cols.extend(spec.axes.iter().map(|a| a.name.clone()));
+    cols.extend(["episode", "seed", "success"].map(String::from));
+    let task_cols: &[&str] = match spec.task {
+        SweepTask::Grid => &[
+            "start_x",
+            "start_y",
+            "goal_x",
+            "goal_y",
+            "committed_x",
+            "committed_y",
+            "actions",
+            "net_secs",
+            "total_secs",
+            "errors",
+            "detected",
+            "false_alarms",
+            "missed",
+        ],
+        SweepTask::Epuck => &[
+            "goal",
+            "committed",
+            "time_secs",
+            "path_m",
+            "errps",
+            "detected",
+            "false_alarms",
+            "missed",
+        ],
+    };
+    cols.extend(task_cols.iter().map(|s| s.to_string()));
+    cols.extend(["acc_correct", "acc_error", "online_accuracy"].map(String::from));
+    cols.join(",")
+}
+
+/// The name of the cost column (what the sweep minimises) of `task`.
+pub fn cost_column(task: SweepTask) -> &'static str {
+    match task {
+        SweepTask::Grid => "actions",
+        SweepTask::Epuck => "time_secs",
+    }
+}
+
+/// A rate as a CSV field: empty when undefined.
+fn rate(x: f64) -> String {
+    if x.is_finite() {
+        format_number(x)
+    } else {
+        String::new()
+    }
+}
+
+/// Correct decisions over all decisions of an accuracy's two classes.
+fn overall(a: &errp_bci::Accuracy) -> (usize, usize, f64) {
+    let hits_error = (a.error * a.n_error as f64).round() as usize;
+    let hits_correct = (a.correct * a.n_correct as f64).round() as usize;
+    let n = a.n_error + a.n_correct;
+    let acc = if n == 0 {
+        f64::NAN
+    } else {
+        (hits_error + hits_correct) as f64 / n as f64
+    };
+    (hits_error, hits_correct, acc)
+}
+
+/// Runs episode `k` of `level` and formats its CSV row.
+fn run_row(spec: &SweepSpec, level: &Level, runner: &Runner, k: usize) -> Result<String> {
+    let seed = spec.episode_seed(level.accuracy, k);
+    let mut f = vec![level.index.to_string(), format_number(level.accuracy)];
+    f.extend(level.values.iter().map(value_text));
+    f.extend([k.to_string(), seed.to_string()]);
+    let cell = |c: Option<Cell>| match c {
+        Some(c) => [c.x.to_string(), c.y.to_string()],
+        None => [String::new(), String::new()],
+    };
+    let online = match runner {
+        Runner::Grid {
+            scenario,
+            decoder,
+            table,
+        } => {
+            let (start, goal) = scenario.episodes[k % scenario.episodes.len()];
+            let r = run_grid_episode(start, goal, table, &scenario.params, decoder, seed, false)?;
+            let (detected, hits_correct, _) = overall(&r.online);
+            f.push(u8::from(r.reached()).to_string());
+            f.extend(cell(Some(start)));
+            f.extend(cell(Some(goal)));
+            f.extend(cell(r.committed));
+            f.extend([
+                r.actions.to_string(),
+                format_number(r.net_secs),
+                format_number(r.total_secs),
+                r.online.n_error.to_string(),
+                detected.to_string(),
+                (r.online.n_correct - hits_correct).to_string(),
+                (r.online.n_error - detected).to_string(),
+            ]);
+            r.online
+        }
+        Runner::Epuck { scenario, decoder } => {
+            let r = run_epuck_episode(
+                &scenario.params,
+                &scenario.arena,
+                &scenario.layout,
+                scenario.episode,
+                decoder,
+                seed,
+                &mut (),
+            )?;
+            let names = scenario.layout.names();
+            f.push(u8::from(r.reached()).to_string());
+            f.push(names[r.goal].to_string());
+            f.push(r.committed.map_or(String::new(), |c| names[c].to_string()));
+            f.extend([
+                format_number(r.time_secs),
+                format_number(r.path_m),
+                r.errps.to_string(),
+                r.detected_errors.to_string(),
+                r.false_detections.to_string(),
+                r.missed_errors.to_string(),
+            ]);
+            r.online
+        }
+    };
+    let (_, _, acc) = overall(&online);
+    f.extend([rate(online.correct), rate(online.error), rate(acc)]);
+    Ok(f.join(","))
+}
+
+/// The (level, episode) of sweep episode `g`.
+fn split(spec: &SweepSpec, g: usize) -> (usize, usize) {
+    (g / spec.episodes, g % spec.episodes)
+}
+
+/// Checks the rows already in `path` against the slice and drops a last
+/// line cut short by a crash. Returns how many complete rows it holds.
+fn resume_rows(path: &Path, header: &str, spec: &SweepSpec, items: &[usize]) -> Result<usize> {
+    let file = File::open(path).map_err(|source| SimError::Input {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let mut reader = BufReader::new(file);
+    let mut line = String::new();
+    let mut good_bytes = 0u64;
+    let mut rows = 0usize;
+    let mut first = true;
+    let bad = |why: String| {
+        SimError::Sweep(format!(
+            "{}: {why}; it does not belong to this sweep: choose another --out or delete it",
+            path.display()
+        ))
+    };
+    loop {
+        line.clear();
+        let n = reader
+            .read_line(&mut line)
+            .map_err(|source| SimError::Input {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        if n == 0 || !line.ends_with('\n') {
+            break; // end, or a row cut short: dropped below
+        }
+        let text = line.trim_end_matches('\n');
+        if first {
+            if text != header {
+                return Err(bad("its header differs".into()));
+            }
+            first = false;
+        } else {
+            let Some(&g) = items.get(rows) else {
+                return Err(bad("it has more rows than the sweep".into()));
+            };
+            let (level, k) = split(spec, g);
+            let mut cols = text.split(',');
+            let lv = cols.next().and_then(|c| c.parse::<usize>().ok());
+            let ep = cols
+                .nth(1 + spec.axes.len())
+                .and_then(|c| c.parse::<usize>().ok());
+            if lv != Some(level) || ep != Some(k) {
+                return Err(bad(format!(
+                    "row {} should be level {level} episode {k}",
+                    rows + 1
+                )));
+            }
+            rows += 1;
+        }
+        good_bytes += n as u64;
+    }
+    drop(reader);
+    let file = OpenOptions::new()
+        .write(true)
+        .open(path)
+        .map_err(|source| SimError::Output {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    file.set_len(good_bytes)
+        .map_err(|source| SimError::Output {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    Ok(if first { usize::MAX } else { rows })
+}
+
+/// Runs (or resumes) a sweep's slice into `opts.out`. `cancel` is polled
+/// between chunks: when it is set the rows written so far stay, and the same
+/// call later resumes. Results do not depend on the thread count (run it
+/// inside a rayon pool to choose one), on `opts.chunk`, or on interruptions.
+pub fn run_sweep(
+    spec: &SweepSpec,
+    opts: &SweepOptions,
+    cancel: &AtomicBool,
+    observer: &dyn SweepObserver,
+) -> Result<SweepOutcome> {
+    if spec.episodes == 0 {
+        return Err(SimError::Sweep("--episodes must be at least 1".into()));
+    }
+    if spec.accuracies.is_empty() {
+        return Err(SimError::Sweep("--accuracy gives no level".into()));
+    }
+    let levels = spec.levels()?;
+    let out = &opts.out;
+    let fresh = Manifest::new(spec, opts.shard);
+    let manifest_path = out.join(MANIFEST);
+    let episodes_path = out.join(EPISODES);
+    if manifest_path.exists() {
+        let old = Manifest::read(out)?;
+        if old.spec != fresh.spec || old.shard != fresh.shard {
+            return Err(SimError::Sweep(format!(
+                "{} holds a different sweep (its {MANIFEST} has other parameters, scenario or \
+                 shard); choose another --out, or delete the directory to start over",
+                out.display()
+            )));
+        }
+    } else {
+        if episodes_path.exists() {
+            return Err(SimError::Sweep(format!(
+                "{} has an {EPISODES} but no {MANIFEST}; choose another --out",
+                out.display()
+            )));
+        }
+        std::fs::create_dir_all(out).map_err(|source| SimError::Output {
+            path: out.clone(),
+            source,
+        })?;
+        fresh.write(out)?;
+    }
+
+    // Decoders: one per distinct calibration, in parallel.
+    let mut keys: Vec<String> = Vec::new();
+    let mut first_level: Vec<usize> = Vec::new();
+    let mut key_of = Vec::with_capacity(levels.len());
+    let mut index: HashMap<String, usize> = HashMap::new();
+    for level in &levels {
+        let key = decoder_key(level);
+        let i = *index.entry(key.clone()).or_insert_with(|| {
+            keys.push(key);
+            first_level.push(level.index);
+            keys.len() - 1
+        });
+        key_of.push(i);
+    }
+    let ready = AtomicUsize::new(0);
+    let shared = Shared::new(&levels);
+    let prepared: Vec<(Prepared, DecoderInfo)> = first_level
+        .par_iter()
+        .map(|&l| {
+            let p = prepare(&levels[l], &opts.cache, &shared)?;
+            let done = ready.fetch_add(1, Ordering::SeqCst) + 1;
+            observer.decoder_ready(&p.1, done, first_level.len());
+            Ok(p)
+        })
+        .collect::<Result<_>>()?;
+    let manifest = Manifest {
+        decoders: prepared.iter().map(|(_, i)| i.clone()).collect(),
+        ..fresh
+    };
+    manifest.write(out)?;
+
+    let mut tables: HashMap<String, Arc<QTable>> = HashMap::new();
+    let runners: Vec<Runner> = levels
+        .iter()
+        .zip(&key_of)
+        .map(|(level, &d)| {
+            Ok(match (&level.scenario, &prepared[d].0) {
+                (AnyScenario::Grid(s), Prepared::Grid(decoder)) => {
+                    let q = &s.params.control.q;
+                    let table = match tables.get(&format!("{q:?}")) {
+                        Some(t) => t.clone(),
+                        None => {
+                            let t = Arc::new(QTable::compute(Grid::paper(), q)?);
+                            tables.insert(format!("{q:?}"), t.clone());
+                            t
+                        }
+                    };
+                    Runner::Grid {
+                        scenario: s.clone(),
+                        decoder: decoder.clone(),
+                        table,
+                    }
+                }
+                (AnyScenario::Epuck(s), Prepared::Epuck(decoder)) => Runner::Epuck {
+                    scenario: s.clone(),
+                    decoder: decoder.clone(),
+                },
+                _ => unreachable!("a level's decoder is of its task"),
+            })
+        })
+        .collect::<Result<_>>()?;
+
+    // Episodes of this slice, in sweep order.
+    let items: Vec<usize> = (0..spec.total_episodes())
+        .filter(|&g| opts.shard.owns(g))
+        .collect();
+    let header = episodes_header(spec);
+    let mut done = if episodes_path.exists() {
+        resume_rows(&episodes_path, &header, spec, &items)?
+    } else {
+        usize::MAX
+    };
+    let mut file = OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(&episodes_path)
+        .map_err(|source| SimError::Output {
+            path: episodes_path.clone(),
+            source,
+        })?;
+    let io = |source| SimError::Output {
+        path: episodes_path.clone(),
+        source,
+    };
+    if done == usize::MAX {
+        // A new file (or one cut inside its header).
+        file.seek(SeekFrom::End(0)).map_err(io)?;
+        writeln!(file, "{header}").map_err(io)?;
+        done = 0;
+    }
+    let already = done;
+    observer.episodes_done(done, items.len());
+    let chunk = if opts.chunk > 0 {
+        opts.chunk
+    } else {
+        match spec.task {
+            SweepTask::Grid => 256,
+            SweepTask::Epuck => 32,
+        }
+    };
+    while done < items.len() {
+        if cancel.load(Ordering::SeqCst) {
+            return Ok(SweepOutcome::Interrupted {
+                done,
+                total: items.len(),
+            });
+        }
+        let end = (done + chunk).min(items.len());
+        let rows: Vec<String> = items[done..end]
+            .par_iter()
+            .map(|&g| {
+                let (l, k) = split(spec, g);
+                run_row(spec, &levels[l], &runners[l], k)
+            })
+            .collect::<Result<_>>()?;
+        let mut text = rows.join("\n");
+        text.push('\n');
+        file.write_all(text.as_bytes()).map_err(io)?;
+        file.sync_data().map_err(io)?;
+        done = end;
+        observer.episodes_done(done, items.len());
+    }
+    Ok(SweepOutcome::Complete {
+        ran: done - already,
+        total: items.len(),
+    })
+}

@@ -1,0 +1,582 @@
+//! What a sweep runs: a scenario, the accuracy levels, the swept parameters,
+//! and how every level's scenario is derived from the file.
+//!
+//! A swept value is written into the scenario's TOML before the scenario is
+//! validated, so every scenario field can be swept and a bad value gets the
+//! same error as in a scenario file.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use toml::{Table, Value};
+
+use crate::epuck_scenario::{AnyScenario, parse_scenario};
+use crate::error::{Result, SimError};
+use crate::scenario::{parse_toml, read_scenario};
+
+/// The two tasks a sweep can run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SweepTask {
+    /// The discrete 5x5 grid (sec. 4): the cost is actions to convergence.
+    Grid,
+    /// The continuous e-puck (sec. 5): the cost is seconds to convergence.
+    Epuck,
+}
+
+impl fmt::Display for SweepTask {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            SweepTask::Grid => "grid",
+            SweepTask::Epuck => "epuck",
+        })
+    }
+}
+
+/// A slice of a sweep: episode `g` of the sweep (counted over all levels)
+/// belongs to shard `g % count + 1`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Shard {
+    /// 1-based index of this shard.
+    pub index: usize,
+    /// Number of shards.
+    pub count: usize,
+}
+
+impl Shard {
+    /// The whole sweep.
+    pub const ALL: Shard = Shard { index: 1, count: 1 };
+
+    /// Parses `K/N` with 1 <= K <= N.
+    pub fn parse(text: &str) -> Result<Self> {
+        let bad = || {
+            SimError::Sweep(format!(
+                "--shard {text:?} is invalid: expected K/N with 1 <= K <= N, e.g. 3/8"
+            ))
+        };
+        let (k, n) = text.split_once('/').ok_or_else(bad)?;
+        let index: usize = k.trim().parse().map_err(|_| bad())?;
+        let count: usize = n.trim().parse().map_err(|_| bad())?;
+        if count == 0 || index == 0 || index > count {
+            return Err(bad());
+        }
+        Ok(Self { index, count })
+    }
+
+    /// True if episode `g` of the sweep is this shard's.
+    pub fn owns(&self, g: usize) -> bool {
+        g % self.count == self.index - 1
+    }
+
+    /// True for the whole sweep.
+    pub fn is_all(&self) -> bool {
+        self.count == 1
+    }
+}
+
+impl fmt::Display for Shard {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+/// One swept scenario parameter.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Axis {
+    /// The name as given (`tau`), used for the CSV column.
+    pub name: String,
+    /// Where it goes in the scenario file (`control.tau`).
+    pub key: String,
+    /// Its values, in sweep order.
+    pub values: Vec<Value>,
+}
+
+/// Everything that defines a sweep's results. Two sweeps with equal specs
+/// write equal files.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SweepSpec {
+    /// Which task the scenario is.
+    pub task: SweepTask,
+    /// The scenario file, as given.
+    pub scenario_path: PathBuf,
+    /// The scenario file's text: what was run, even if the file changes.
+    pub scenario_toml: String,
+    /// Decoder accuracy levels (mean of the per-class rates).
+    pub accuracies: Vec<f64>,
+    /// Swept scenario parameters; every combination is run at every accuracy.
+    pub axes: Vec<Axis>,
+    /// Scenario values set for every level (e.g. `eeg = "bank"`).
+    pub fixed: Vec<(String, Value)>,
+    /// Episodes per level.
+    pub episodes: usize,
+    /// The sweep seed: every calibration and episode seed derives from it.
+    pub seed: u64,
+}
+
+/// One level of a sweep: an accuracy and one value of every axis, with the
+/// validated scenario that results.
+#[derive(Debug, Clone)]
+pub struct Level {
+    /// Position in the sweep (accuracy varies fastest).
+    pub index: usize,
+    /// The decoder's accuracy.
+    pub accuracy: f64,
+    /// One value per axis.
+    pub values: Vec<Value>,
+    /// The scenario with the level's values written in.
+    pub scenario: AnyScenario,
+}
+
+impl Level {
+    /// `tau=0.3, strategy=greedy` (empty when no axis is swept).
+    pub fn series_label(&self, axes: &[Axis]) -> String {
+        axes.iter()
+            .zip(&self.values)
+            .map(|(a, v)| format!("{}={}", a.name, value_text(v)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+/// A value as written in the CSV files and labels.
+pub fn value_text(v: &Value) -> String {
+    match v {
+        Value::String(s) => s.clone(),
+        Value::Float(x) => format_number(*x),
+        other => other.to_string(),
+    }
+}
+
+/// A float in its shortest exact form (`0.3`, `1`, `0.7438`).
+pub fn format_number(x: f64) -> String {
+    format!("{x}")
+}
+
+/// Rounds away the binary noise of `a + k * step` (`0.30000000000000004`).
+fn tidy(x: f64) -> f64 {
+    let r = (x * 1e12).round() / 1e12;
+    if r == 0.0 { 0.0 } else { r }
+}
+
+/// Parses `start:stop:step` (stop included), `a,b,c` or a single value.
+/// Numbers stay numbers (integers if every part is one); anything else is a
+/// string. `what` names the flag in errors.
+pub fn parse_values(text: &str, what: &str) -> Result<Vec<Value>> {
+    let bad = |why: &str| SimError::Sweep(format!("{what} {text:?} is invalid: {why}"));
+    let text = text.trim();
+    if text.is_empty() {
+        return Err(bad("no values"));
+    }
+    let parts: Vec<&str> = text.split(':').map(str::trim).collect();
+    if parts.len() == 3 {
+        let ints: Option<Vec<i64>> = parts.iter().map(|p| p.parse::<i64>().ok()).collect();
+        if let Some([a, b, step]) = ints.as_deref() {
+            if *step <= 0 || b < a {
+                return Err(bad(
+                    "a range start:stop:step needs step > 0 and stop >= start",
+                ));
+            }
+            let n = ((b - a) / step + 1) as usize;
+            if n > 10_000 {
+                return Err(bad("more than 10000 values"));
+            }
+            return Ok((0..n as i64)
+                .map(|k| Value::Integer(a + k * step))
+                .collect());
+        }
+        let nums: Option<Vec<f64>> = parts.iter().map(|p| p.parse::<f64>().ok()).collect();
+        let Some([a, b, step]) = nums.as_deref() else {
+            return Err(bad(
+                "a range start:stop:step takes three numbers, e.g. 0.55:0.95:0.05",
+            ));
+        };
+        if !(a.is_finite() && b.is_finite() && step.is_finite() && *step > 0.0 && b >= a) {
+            return Err(bad(
+                "a range start:stop:step needs finite numbers, step > 0 and stop >= start",
+            ));
+        }
+        let n = ((b - a) / step + 1e-9).floor() as usize + 1;
+        if n > 10_000 {
+            return Err(bad("more than 10000 values"));
+        }
+        return Ok((0..n)
+            .map(|k| Value::Float(tidy(a + k as f64 * step)))
+            .collect());
+    }
+    if parts.len() != 1 {
+        return Err(bad("expected start:stop:step, a list a,b,c or one value"));
+    }
+    text.split(',')
+        .map(str::trim)
+        .map(|s| {
+            if s.is_empty() {
+                Err(bad("an empty item in the list"))
+            } else if let Ok(i) = s.parse::<i64>() {
+                Ok(Value::Integer(i))
+            } else if let Ok(x) = s.parse::<f64>() {
+                if x.is_finite() {
+                    Ok(Value::Float(x))
+                } else {
+                    Err(bad("values must be finite"))
+                }
+            } else if s == "true" || s == "false" {
+                Ok(Value::Boolean(s == "true"))
+            } else {
+                Ok(Value::String(s.to_string()))
+            }
+        })
+        .collect()
+}
+
+/// Parses the `--accuracy` levels: numbers in (0.5, 1), 1 allowed for the
+/// grid's oracle decoder.
+pub fn parse_accuracies(text: &str) -> Result<Vec<f64>> {
+    let values = parse_values(text, "--accuracy")?;
+    let mut out = Vec::with_capacity(values.len());
+    for v in values {
+        let a = match v {
+            Value::Float(x) => x,
+            Value::Integer(i) => i as f64,
+            other => {
+                return Err(SimError::Sweep(format!(
+                    "--accuracy {text:?} is invalid: {} is not a number",
+                    value_text(&other)
+                )));
+            }
+        };
+        if !(a > 0.5 && a <= 1.0) {
+            return Err(SimError::Sweep(format!(
+                "--accuracy {text:?} is invalid: {a} is not a mean accuracy in (0.5, 1) \
+                 (e.g. 0.55:0.95:0.05)"
+            )));
+        }
+        out.push(a);
+    }
+    Ok(out)
+}
+
+/// Short names of the sweepable parameters of each task, and where they live
+/// in the scenario file. Any other parameter is named by its dotted path.
+fn alias(task: SweepTask, name: &str) -> Option<&'static str> {
+    let grid: &[(&str, &str)] = &[
+        ("tau", "control.tau"),
+        ("epsilon", "control.epsilon"),
+        ("p_c", "control.p_c"),
+        ("discount", "control.discount"),
+        ("goal_reward", "control.goal_reward"),
+        ("wrong_goal_reward", "control.wrong_goal_reward"),
+        ("strategy", "control.strategy"),
+        ("interval_min_secs", "timing.interval_min_secs"),
+        ("interval_max_secs", "timing.interval_max_secs"),
+        ("epoch_secs", "timing.epoch_secs"),
+        ("max_actions", "timing.max_actions"),
+        ("decoder", "decoder"),
+        ("p_error", "p_error"),
+        ("eeg", "eeg"),
+        ("bank_per_class", "bank_per_class"),
+    ];
+    let epuck: &[(&str, &str)] = &[
+        ("t_e", "control.t_e"),
+        ("k_turn", "control.k_turn"),
+        ("k_p", "control.k_p"),
+        ("k_n", "control.k_n"),
+        ("sigma_deg", "control.sigma_deg"),
+        ("p_c", "control.p_c"),
+        ("stop_secs", "control.stop_secs"),
+        ("drive_speed_fraction", "control.drive_speed_fraction"),
+        ("turn_speed_fraction", "control.turn_speed_fraction"),
+        ("strategy", "control.strategy"),
+        ("fov_deg", "user.fov_deg"),
+        ("reaction_latency_ms", "user.reaction_latency_ms"),
+        ("reelicit_secs", "user.reelicit_secs"),
+        ("max_secs", "max_secs"),
+        ("rate_hz", "tracker.rate_hz"),
+        ("position_noise_cm", "tracker.position_noise_cm"),
+        ("heading_noise_deg", "tracker.heading_noise_deg"),
+    ];
+    let table = match task {
+        SweepTask::Grid => grid,
+        SweepTask::Epuck => epuck,
+    };
+    table.iter().find(|(n, _)| *n == name).map(|(_, k)| *k)
+}
+
+/// The short names accepted for `task`, for error messages.
+fn aliases(task: SweepTask) -> &'static str {
+    match task {
+        SweepTask::Grid => {
+            "tau, epsilon, p_c, discount, goal_reward, wrong_goal_reward, strategy, \
+             interval_min_secs, interval_max_secs, epoch_secs, max_actions, decoder, p_error, \
+             eeg, bank_per_class"
+        }
+        SweepTask::Epuck => {
+            "t_e, k_turn, k_p, k_n, sigma_deg, p_c, stop_secs, drive_speed_fraction, \
+             turn_speed_fraction, strategy, fov_deg, reaction_latency_ms, reelicit_secs, \
+             max_secs, rate_hz, position_noise_cm, heading_noise_deg"
+        }
+    }
+}
+
+/// Parses one `--param NAME=VALUES` for `task`.
+pub fn parse_axis(task: SweepTask, text: &str) -> Result<Axis> {
+    let (name, values) = text.split_once('=').ok_or_else(|| {
+        SimError::Sweep(format!(
+            "--param {text:?} is invalid: expected NAME=VALUES, e.g. tau=0.1:0.5:0.1 or \
+             strategy=greedy,info_gain"
+        ))
+    })?;
+    let name = name.trim();
+    let key = if name.contains('.') {
+        name.to_string()
+    } else {
+        alias(task, name)
+            .ok_or_else(|| {
+                SimError::Sweep(format!(
+                    "--param {name}: not a {task} scenario parameter; use one of {} or a \
+                     dotted path into the scenario file (e.g. control.tau)",
+                    aliases(task)
+                ))
+            })?
+            .to_string()
+    };
+    if matches!(
+        key.as_str(),
+        "seed" | "task" | "user.accuracy" | "user.subject"
+    ) {
+        return Err(SimError::Sweep(format!(
+            "--param {name}: sweep the accuracy with --accuracy and set the seed with --seed"
+        )));
+    }
+    Ok(Axis {
+        name: name.to_string(),
+        key,
+        values: parse_values(values, &format!("--param {name}"))?,
+    })
+}
+
+/// The task of the scenario file at `path` and its text.
+pub fn read_task(path: &Path) -> Result<(SweepTask, String)> {
+    let text = read_scenario(path)?;
+    #[derive(Deserialize)]
+    struct Task {
+        task: Option<String>,
+    }
+    let task: Task = parse_toml(&text, path)?;
+    let task = match task.task.as_deref() {
+        Some("epuck") => SweepTask::Epuck,
+        _ => SweepTask::Grid,
+    };
+    Ok((task, text))
+}
+
+/// Sets `key` (dotted) in `table` to `value`, creating tables on the way.
+fn set_key(table: &mut Table, key: &str, value: Value) -> std::result::Result<(), String> {
+    let mut parts = key.split('.').peekable();
+    let mut t = table;
+    while let Some(part) = parts.next() {
+        if parts.peek().is_none() {
+            t.insert(part.to_string(), value);
+            return Ok(());
+        }
+        let entry = t
+            .entry(part.to_string())
+            .or_insert_with(|| Value::Table(Table::new()));
+        t = entry
+            .as_table_mut()
+            .ok_or_else(|| format!("`{part}` in `{key}` is not a table in the scenario"))?;
+    }
+    Err(format!("`{key}` is empty"))
+}
+
+impl SweepSpec {
+    /// Episodes over all levels.
+    pub fn total_episodes(&self) -> usize {
+        self.n_levels() * self.episodes
+    }
+
+    /// Levels: every combination of the axes' values, at every accuracy.
+    pub fn n_levels(&self) -> usize {
+        self.accuracies.len() * self.axes.iter().map(|a| a.values.len()).product::<usize>()
+    }
+
+    /// The accuracy and axis values of level `index` (accuracy fastest, then
+    /// the last axis).
+    pub fn level_values(&self, index: usize) -> (f64, Vec<Value>) {
+        let mut rest = index;
+        let accuracy = self.accuracies[rest % self.accuracies.len()];
+        rest /= self.accuracies.len();
+        let mut values = vec![Value::Boolean(false); self.axes.len()];
+        for (i, axis) in self.axes.iter().enumerate().rev() {
+            values[i] = axis.values[rest % axis.values.len()].clone();
+            rest /= axis.values.len();
+        }
+        (accuracy, values)
+    }
+
+    /// The seed of the calibration sessions. Every level uses the same
+    /// session (the same background EEG, artifacts and schedule) with the
+    /// ErrP amplitude targeted at its accuracy, so decoders differ only in
+    /// how much ErrP there is to find, and accuracy levels stay ordered.
+    pub fn calibration_seed(&self) -> u64 {
+        // Scenario files hold seeds as TOML integers (i64).
+        errp_bci::rng::derive_seed(self.seed, "sweep/calibration", 0) & i64::MAX as u64
+    }
+
+    /// The seed of episode `k` at `accuracy`. It does not depend on the swept
+    /// parameters (common random numbers: strategies at one accuracy face the
+    /// same users, goals and noise), nor on threads, shards or order.
+    pub fn episode_seed(&self, accuracy: f64, k: usize) -> u64 {
+        let level = errp_bci::rng::derive_seed(self.seed, "sweep/accuracy", accuracy.to_bits());
+        errp_bci::rng::derive_seed(level, "sweep/episode", k as u64)
+    }
+
+    /// Builds and validates every level's scenario. An invalid swept value
+    /// is reported with the level and the scenario's own field error.
+    pub fn levels(&self) -> Result<Vec<Level>> {
+        let base: Table = parse_toml(&self.scenario_toml, &self.scenario_path)?;
+        (0..self.n_levels())
+            .map(|index| {
+                let (accuracy, values) = self.level_values(index);
+                let mut t = base.clone();
+                let context = |why: String| {
+                    let mut label = format!("accuracy={}", format_number(accuracy));
+                    for (a, v) in self.axes.iter().zip(&values) {
+                        label.push_str(&format!(", {}={}", a.name, value_text(v)));
+                    }
+                    SimError::Sweep(format!("sweep level {label}: {why}"))
+                };
+                if let Some(user) = t.get_mut("user").and_then(Value::as_table_mut) {
+                    user.remove("subject");
+                    user.remove("goals");
+                }
+                let mut sets: Vec<(&str, Value)> = vec![
+                    ("user.accuracy", Value::Float(accuracy)),
+                    ("seed", Value::Integer(self.calibration_seed() as i64)),
+                ];
+                for (k, v) in &self.fixed {
+                    sets.push((k, v.clone()));
+                }
+                for (a, v) in self.axes.iter().zip(&values) {
+                    sets.push((&a.key, v.clone()));
+                }
+                for (k, v) in sets {
+                    set_key(&mut t, k, v).map_err(context)?;
+                }
+                let text = toml::to_string(&t).map_err(|e| context(e.to_string()))?;
+                let scenario = parse_scenario(&text, &self.scenario_path)
+                    .map_err(|e| context(e.to_string()))?;
+                Ok(Level {
+                    index,
+                    accuracy,
+                    values,
+                    scenario,
+                })
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ranges_include_the_stop_without_binary_noise() {
+        let v = parse_values("0.55:0.95:0.05", "--accuracy").unwrap();
+        let x: Vec<f64> = v.iter().map(|v| v.as_float().unwrap()).collect();
+        assert_eq!(x.len(), 9);
+        assert_eq!(x[1], 0.6);
+        assert_eq!(x[8], 0.95);
+        assert_eq!(parse_values("0.1:0.5:0.1", "t").unwrap().len(), 5);
+        assert_eq!(
+            parse_values("2:10:4", "t").unwrap(),
+            vec![Value::Integer(2), Value::Integer(6), Value::Integer(10)]
+        );
+        assert_eq!(
+            parse_values("greedy,info_gain", "t").unwrap(),
+            vec![
+                Value::String("greedy".into()),
+                Value::String("info_gain".into())
+            ]
+        );
+    }
+
+    #[test]
+    fn bad_ranges_and_accuracies_say_what_is_expected() {
+        for (text, needle) in [
+            ("0.9:0.5:0.1", "stop >= start"),
+            ("0.5:0.9:0", "step > 0"),
+            ("a:b:c", "three numbers"),
+            ("1:2", "start:stop:step"),
+            ("0.6,,0.7", "empty item"),
+        ] {
+            let e = parse_values(text, "--accuracy").unwrap_err().to_string();
+            assert!(e.contains(needle), "{text}: {e}");
+        }
+        let e = parse_accuracies("1.7").unwrap_err().to_string();
+        assert!(e.contains("1.7") && e.contains("(0.5, 1)"), "{e}");
+        assert!(parse_accuracies("0.5").is_err());
+        assert!(parse_accuracies("NaN").is_err());
+    }
+
+    #[test]
+    fn params_resolve_short_names_and_refuse_the_accuracy() {
+        let a = parse_axis(SweepTask::Grid, "tau=0.1:0.3:0.1").unwrap();
+        assert_eq!(a.key, "control.tau");
+        assert_eq!(a.values.len(), 3);
+        assert_eq!(
+            parse_axis(SweepTask::Epuck, "t_e=0.7,0.8").unwrap().key,
+            "control.t_e"
+        );
+        assert_eq!(
+            parse_axis(SweepTask::Grid, "timing.max_actions=50")
+                .unwrap()
+                .key,
+            "timing.max_actions"
+        );
+        let e = parse_axis(SweepTask::Grid, "t_e=0.8")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("not a grid scenario parameter") && e.contains("tau"),
+            "{e}"
+        );
+        assert!(parse_axis(SweepTask::Grid, "user.accuracy=0.7").is_err());
+        assert!(parse_axis(SweepTask::Grid, "tau").is_err());
+    }
+
+    #[test]
+    fn shards_partition_the_episodes() {
+        let shards: Vec<Shard> = (1..=3)
+            .map(|k| Shard::parse(&format!("{k}/3")).unwrap())
+            .collect();
+        for g in 0..30 {
+            assert_eq!(shards.iter().filter(|s| s.owns(g)).count(), 1);
+        }
+        for bad in ["0/3", "4/3", "1/0", "x", "1/2/3"] {
+            assert!(Shard::parse(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn levels_vary_accuracy_fastest() {
+        let spec = SweepSpec {
+            task: SweepTask::Grid,
+            scenario_path: "x.toml".into(),
+            scenario_toml: String::new(),
+            accuracies: vec![0.6, 0.8],
+            axes: vec![parse_axis(SweepTask::Grid, "tau=0.1,0.3,0.5").unwrap()],
+            fixed: vec![],
+            episodes: 10,
+            seed: 1,
+        };
+        assert_eq!(spec.n_levels(), 6);
+        assert_eq!(spec.total_episodes(), 60);
+        assert_eq!(spec.level_values(0), (0.6, vec![Value::Float(0.1)]));
+        assert_eq!(spec.level_values(1), (0.8, vec![Value::Float(0.1)]));
+        assert_eq!(spec.level_values(5), (0.8, vec![Value::Float(0.5)]));
+        assert_eq!(spec.episode_seed(0.6, 3), spec.episode_seed(0.6, 3));
+        assert_ne!(spec.episode_seed(0.6, 3), spec.episode_seed(0.8, 3));
+    }
+}

@@ -1,0 +1,283 @@
+//! Sweeps: sharded + merged equals unsharded, 1 thread equals 2, a resumed
+//! sweep equals an uninterrupted one, and the numbers move the right way.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use errp_sim::{
+    Manifest, Shard, SweepObserver, SweepOptions, SweepOutcome, SweepSpec, SweepTask, TargetCache,
+    finish_dir, merge_sweeps, parse_accuracies, parse_axis, run_sweep,
+};
+
+/// A grid scenario with the EEG decoder on a small epoch bank.
+const GRID_EEG: &str = r#"
+task = "grid"
+decoder = "eeg"
+eeg = "bank"
+bank_per_class = 150
+[user]
+accuracy = 0.8
+[[episode]]
+start = [0, 0]
+goal = [4, 4]
+[[episode]]
+start = [4, 0]
+goal = [1, 3]
+[[episode]]
+start = [2, 2]
+goal = [0, 4]
+"#;
+
+/// The same with the oracle decoder (no EEG): fast enough for many episodes.
+const GRID_ORACLE: &str = r#"
+task = "grid"
+decoder = "oracle"
+[user]
+accuracy = 0.8
+[free_goals]
+count = 50
+"#;
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("errp-sweep-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+/// A cache shared by the tests of this binary, so each level's targeting is
+/// searched once.
+fn cache() -> TargetCache {
+    TargetCache::new(std::env::temp_dir().join(format!("errp-sweep-cache-{}", std::process::id())))
+}
+
+fn spec(text: &str, accuracy: &str, params: &[&str], episodes: usize) -> SweepSpec {
+    SweepSpec {
+        task: SweepTask::Grid,
+        scenario_path: "test.toml".into(),
+        scenario_toml: text.into(),
+        accuracies: parse_accuracies(accuracy).unwrap(),
+        axes: params
+            .iter()
+            .map(|p| parse_axis(SweepTask::Grid, p).unwrap())
+            .collect(),
+        fixed: vec![],
+        episodes,
+        seed: 5,
+    }
+}
+
+fn options(out: &Path, shard: Shard, chunk: usize) -> SweepOptions {
+    SweepOptions {
+        out: out.to_path_buf(),
+        cache: cache(),
+        shard,
+        chunk,
+    }
+}
+
+/// Runs a sweep to the end on `threads` threads and writes its summary.
+fn complete(spec: &SweepSpec, out: &Path, shard: Shard, threads: usize) {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    let outcome = pool
+        .install(|| run_sweep(spec, &options(out, shard, 7), &AtomicBool::new(false), &()))
+        .unwrap();
+    assert!(
+        matches!(outcome, SweepOutcome::Complete { .. }),
+        "{outcome:?}"
+    );
+    if shard.is_all() {
+        finish_dir(out, &Manifest::read(out).unwrap()).unwrap();
+    }
+}
+
+fn read(dir: &Path, name: &str) -> Vec<u8> {
+    std::fs::read(dir.join(name)).unwrap_or_else(|e| panic!("{}: {e}", dir.join(name).display()))
+}
+
+fn assert_same_files(a: &Path, b: &Path) {
+    for name in ["episodes.csv", "summary.csv", "sweep.json"] {
+        assert!(
+            read(a, name) == read(b, name),
+            "{name} differs between {} and {}",
+            a.display(),
+            b.display()
+        );
+    }
+}
+
+#[test]
+fn sharded_and_merged_equals_unsharded_and_threads_do_not_matter() {
+    let spec = spec(GRID_EEG, "0.7,0.9", &["tau=0.3,0.6"], 12);
+    let whole = temp_dir("whole");
+    complete(&spec, &whole, Shard::ALL, 2);
+    let episodes = String::from_utf8(read(&whole, "episodes.csv")).unwrap();
+    assert_eq!(episodes.lines().count(), 1 + 4 * 12);
+    for f in ["summary.csv", "sweep.svg", "sweep.png", "sweep.json"] {
+        assert!(whole.join(f).is_file(), "{f}");
+    }
+
+    let one = temp_dir("one-thread");
+    complete(&spec, &one, Shard::ALL, 1);
+    assert_same_files(&whole, &one);
+
+    let shards: Vec<PathBuf> = (1..=3)
+        .map(|k| {
+            let d = temp_dir(&format!("shard{k}"));
+            complete(&spec, &d, Shard { index: k, count: 3 }, 2);
+            d
+        })
+        .collect();
+    let merged = temp_dir("merged");
+    // Any order of the shard directories.
+    let order = vec![shards[2].clone(), shards[0].clone(), shards[1].clone()];
+    merge_sweeps(&order, &merged).unwrap();
+    assert_same_files(&whole, &merged);
+    assert!(read(&whole, "sweep.svg") == read(&merged, "sweep.svg"));
+
+    // A missing shard or a shard given twice is refused, naming it.
+    let e = merge_sweeps(&shards[..2], &temp_dir("merged-missing"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("missing shard(s) 3/3"), "{e}");
+    let twice = vec![shards[0].clone(), shards[0].clone(), shards[1].clone()];
+    let e = merge_sweeps(&twice, &temp_dir("merged-twice"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("given twice"), "{e}");
+    for d in [whole, one, merged].iter().chain(&shards) {
+        let _ = std::fs::remove_dir_all(d);
+    }
+}
+
+/// Sets the cancel flag once `after` episodes are on disk.
+struct CancelAfter<'a> {
+    after: usize,
+    cancel: &'a AtomicBool,
+}
+
+impl SweepObserver for CancelAfter<'_> {
+    fn episodes_done(&self, done: usize, _total: usize) {
+        if done >= self.after {
+            self.cancel.store(true, Ordering::SeqCst);
+        }
+    }
+}
+
+#[test]
+fn an_interrupted_or_crashed_sweep_resumes_to_the_same_files() {
+    let spec = spec(GRID_ORACLE, "0.6:0.9:0.1", &[], 40);
+    let whole = temp_dir("uninterrupted");
+    complete(&spec, &whole, Shard::ALL, 2);
+
+    // Ctrl-C after the first chunks: the rows so far stay on disk.
+    let resumed = temp_dir("resumed");
+    let cancel = AtomicBool::new(false);
+    let stop = CancelAfter {
+        after: 30,
+        cancel: &cancel,
+    };
+    let outcome = run_sweep(&spec, &options(&resumed, Shard::ALL, 7), &cancel, &stop).unwrap();
+    let SweepOutcome::Interrupted { done, total } = outcome else {
+        panic!("{outcome:?}")
+    };
+    assert!((30..40).contains(&done) && total == 160, "{done} {total}");
+    let partial = String::from_utf8(read(&resumed, "episodes.csv")).unwrap();
+    assert_eq!(partial.lines().count(), 1 + done);
+    assert!(!resumed.join("summary.csv").exists());
+
+    // A crash in the middle of a row: the cut row is dropped and rerun.
+    let cut = partial.len() - 9;
+    std::fs::write(resumed.join("episodes.csv"), &partial.as_bytes()[..cut]).unwrap();
+
+    // Resume with another chunk size and thread count.
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let outcome = pool
+        .install(|| {
+            run_sweep(
+                &spec,
+                &options(&resumed, Shard::ALL, 50),
+                &AtomicBool::new(false),
+                &(),
+            )
+        })
+        .unwrap();
+    assert_eq!(
+        outcome,
+        SweepOutcome::Complete {
+            ran: 160 - done + 1,
+            total: 160
+        }
+    );
+    finish_dir(&resumed, &Manifest::read(&resumed).unwrap()).unwrap();
+    assert_same_files(&whole, &resumed);
+
+    // The same directory with other parameters is refused, untouched.
+    let other = spec_with_seed(&spec, 6);
+    let e = run_sweep(
+        &other,
+        &options(&resumed, Shard::ALL, 7),
+        &AtomicBool::new(false),
+        &(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("holds a different sweep"), "{e}");
+    assert_same_files(&whole, &resumed);
+    let _ = std::fs::remove_dir_all(&whole);
+    let _ = std::fs::remove_dir_all(&resumed);
+}
+
+fn spec_with_seed(spec: &SweepSpec, seed: u64) -> SweepSpec {
+    SweepSpec {
+        seed,
+        ..spec.clone()
+    }
+}
+
+/// The summary rows of a finished sweep: (accuracy, success rate, mean cost).
+fn summary_rows(dir: &Path) -> Vec<(f64, f64, f64)> {
+    let text = String::from_utf8(read(dir, "summary.csv")).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |n: &str| header.iter().position(|h| *h == n).unwrap();
+    let (a, s, m) = (col("accuracy"), col("success_rate"), col("actions_mean"));
+    lines
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (
+                f[a].parse().unwrap(),
+                f[s].parse().unwrap(),
+                f[m].parse().unwrap(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn inference_degrades_as_the_decoder_gets_worse() {
+    // 300 oracle episodes per level. A sweep that mixed up levels or seeds,
+    // or summarised the wrong column, would break the ordering or the bounds.
+    let spec = spec(GRID_ORACLE, "0.6,0.75,0.9", &[], 300);
+    let out = temp_dir("degrades");
+    complete(&spec, &out, Shard::ALL, 2);
+    let rows = summary_rows(&out);
+    assert_eq!(rows.len(), 3);
+    let (lo, mid, hi) = (rows[0], rows[1], rows[2]);
+    assert!(hi.1 > 0.95, "success at 0.9: {}", hi.1);
+    assert!(lo.1 < mid.1 && mid.1 < hi.1 + 0.02, "{rows:?}");
+    assert!(
+        lo.2 > 1.5 * mid.2 && mid.2 > 1.3 * hi.2,
+        "mean actions {rows:?}"
+    );
+    // Measured (seed 5): 0.6 -> 48 % in 213 actions, 0.75 -> 100 % in 65,
+    // 0.9 -> 100 % in 21.
+    assert!(lo.1 > 0.3 && lo.1 < 0.65, "success at 0.6: {}", lo.1);
+    assert!(hi.2 > 14.0 && hi.2 < 30.0, "mean actions at 0.9: {}", hi.2);
+    let _ = std::fs::remove_dir_all(&out);
+}

@@ -1,0 +1,371 @@
+//! `errp sweep` and `errp merge`: argument handling, progress and printing
+//! around `errp_sim`'s sweeps.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use clap::ValueEnum;
+use errp_sim::{
+    DecoderInfo, Manifest, Shard, SweepObserver, SweepOptions, SweepOutcome, SweepReport,
+    SweepSpec, SweepTask, TargetCache, finish_dir, merge_sweeps, parse_accuracies, parse_axis,
+    read_task, run_sweep,
+};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+/// The task of a sweep, as the flag takes it.
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum TaskArg {
+    /// The 5x5 grid.
+    Grid,
+    /// The e-puck.
+    Epuck,
+}
+
+/// How the grid's EEG reaches the decoder in a sweep.
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum SweepEeg {
+    /// A bank of epochs streamed in advance (fast; the default).
+    Bank,
+    /// Streamed per action (about 200 times slower).
+    Stream,
+}
+
+/// `errp sweep`.
+#[derive(clap::Args)]
+pub struct SweepArgs {
+    /// The task. Without --scenario, its built-in scenario is swept
+    /// (grid: the five fixed goals; e-puck: Mexico to Pisa); with it, it must
+    /// match the scenario's `task`.
+    #[arg(long, value_enum)]
+    task: Option<TaskArg>,
+    /// The scenario to sweep.
+    #[arg(long, value_name = "FILE.toml")]
+    scenario: Option<PathBuf>,
+    /// Decoder accuracy levels: start:stop:step (stop included), a list
+    /// a,b,c, or one value; each in (0.5, 1).
+    #[arg(long, default_value = "0.55:0.95:0.05", allow_negative_numbers = true)]
+    accuracy: String,
+    /// Also sweep a scenario parameter, NAME=start:stop:step or NAME=a,b,c
+    /// (repeatable; every combination runs). Grid: tau, epsilon, p_c,
+    /// strategy, max_actions, ...; e-puck: t_e, p_c, k_n, sigma_deg,
+    /// strategy, fov_deg, ...; or any dotted path into the scenario file.
+    #[arg(long = "param", value_name = "NAME=VALUES")]
+    params: Vec<String>,
+    /// Episodes per level.
+    #[arg(long, default_value_t = 200)]
+    episodes: usize,
+    /// Sweep seed: every calibration and episode seed derives from it.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Output directory (rerunning into it resumes).
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+    /// Grid only: how EEG reaches the decoder.
+    #[arg(long, value_enum)]
+    eeg: Option<SweepEeg>,
+    /// Run only slice K of N (1 <= K <= N); merge the N directories with
+    /// `errp merge`.
+    #[arg(long, value_name = "K/N")]
+    shard: Option<String>,
+    /// Worker threads (default: one per core). Results do not depend on it.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Where targeting results are cached (default: $ERRP_CACHE_DIR, else
+    /// $XDG_CACHE_HOME/errp, else ~/.cache/errp).
+    #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
+    cache: Option<PathBuf>,
+    /// Do not read or write the targeting cache.
+    #[arg(long)]
+    no_cache: bool,
+    /// No progress output.
+    #[arg(long)]
+    quiet: bool,
+}
+
+/// `errp merge`.
+#[derive(clap::Args)]
+pub struct MergeArgs {
+    /// The shard directories (all N of one sweep).
+    #[arg(required = true, value_name = "DIR")]
+    dirs: Vec<PathBuf>,
+    /// Where the merged sweep goes.
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+}
+
+const BUILT_IN_GRID: &str = include_str!("../scenarios/grid_fixed_goals.toml");
+const BUILT_IN_EPUCK: &str = include_str!("../scenarios/mexico_to_pisa.toml");
+
+/// Now, for the elapsed times the program prints. Only the command line
+/// reads the clock; nothing it computes depends on it.
+#[allow(clippy::disallowed_methods)]
+fn wall_clock() -> Instant {
+    Instant::now()
+}
+
+/// Progress on a terminal (a bar), plain lines in logs, or nothing.
+struct Progress {
+    bar: Option<ProgressBar>,
+    plain: bool,
+    started: Instant,
+}
+
+impl Progress {
+    fn new(quiet: bool) -> Self {
+        let ci = std::env::var_os("CI").is_some_and(|v| !v.is_empty() && v != "false");
+        let terminal = std::io::stderr().is_terminal();
+        if quiet {
+            return Self {
+                bar: None,
+                plain: false,
+                started: wall_clock(),
+            };
+        }
+        if !terminal || ci {
+            return Self {
+                bar: None,
+                plain: true,
+                started: wall_clock(),
+            };
+        }
+        let bar = ProgressBar::with_draw_target(Some(0), ProgressDrawTarget::stderr());
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{msg:>12} [{bar:40}] {pos}/{len} ({per_sec}, {eta} left)",
+            )
+            .expect("a valid template")
+            .progress_chars("=> "),
+        );
+        Self {
+            bar: Some(bar),
+            plain: false,
+            started: wall_clock(),
+        }
+    }
+
+    fn line(&self, text: &str) {
+        match &self.bar {
+            Some(bar) => bar.println(text),
+            None if self.plain => eprintln!("{text}"),
+            None => {}
+        }
+    }
+}
+
+impl SweepObserver for Progress {
+    fn decoder_ready(&self, info: &DecoderInfo, done: usize, total: usize) {
+        let reached = info.cv_mean.map_or("exact (oracle)".to_string(), |m| {
+            format!("{:.2} %", 100.0 * m)
+        });
+        self.line(&format!(
+            "  decoder {done}/{total}: accuracy {} -> {reached}{} [{:.1} s]",
+            info.accuracy,
+            if info.cached {
+                " (targeting cached)"
+            } else {
+                ""
+            },
+            self.started.elapsed().as_secs_f64()
+        ));
+        if let Some(bar) = &self.bar {
+            bar.set_message("calibrating");
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+        }
+    }
+
+    fn episodes_done(&self, done: usize, total: usize) {
+        if let Some(bar) = &self.bar {
+            if bar.message() != "episodes" {
+                bar.set_message("episodes");
+                bar.set_length(total as u64);
+                bar.reset_eta();
+            }
+            bar.set_position(done as u64);
+        }
+    }
+}
+
+/// Runs `errp sweep`. Returns false if interrupted (exit code 130).
+pub fn sweep(args: &SweepArgs) -> Result<bool> {
+    let (task, text, path) = match (&args.scenario, args.task) {
+        (Some(path), task) => {
+            let (t, text) = read_task(path)?;
+            if let Some(want) = task {
+                let want = match want {
+                    TaskArg::Grid => SweepTask::Grid,
+                    TaskArg::Epuck => SweepTask::Epuck,
+                };
+                if want != t {
+                    bail!(
+                        "--task {want} does not match {}, a {t} scenario (its `task` field)",
+                        path.display()
+                    );
+                }
+            }
+            (t, text, path.clone())
+        }
+        (None, Some(TaskArg::Grid)) => (
+            SweepTask::Grid,
+            BUILT_IN_GRID.to_string(),
+            PathBuf::from("scenarios/grid_fixed_goals.toml"),
+        ),
+        (None, Some(TaskArg::Epuck)) => (
+            SweepTask::Epuck,
+            BUILT_IN_EPUCK.to_string(),
+            PathBuf::from("scenarios/mexico_to_pisa.toml"),
+        ),
+        (None, None) => {
+            bail!("give --scenario FILE.toml, or --task grid|epuck for its built-in scenario")
+        }
+    };
+    let mut fixed = Vec::new();
+    match (task, args.eeg) {
+        (SweepTask::Grid, eeg) => fixed.push((
+            "eeg".to_string(),
+            toml::Value::String(
+                match eeg.unwrap_or(SweepEeg::Bank) {
+                    SweepEeg::Bank => "bank",
+                    SweepEeg::Stream => "stream",
+                }
+                .into(),
+            ),
+        )),
+        (SweepTask::Epuck, Some(_)) => {
+            bail!("--eeg applies to the grid; the e-puck always streams its EEG")
+        }
+        (SweepTask::Epuck, None) => {}
+    }
+    if args.episodes == 0 {
+        bail!("--episodes must be at least 1");
+    }
+    if args.threads == Some(0) {
+        bail!("--threads must be at least 1");
+    }
+    let spec = SweepSpec {
+        task,
+        scenario_path: path,
+        scenario_toml: text,
+        accuracies: parse_accuracies(&args.accuracy)?,
+        axes: args
+            .params
+            .iter()
+            .map(|p| parse_axis(task, p))
+            .collect::<errp_sim::Result<_>>()?,
+        fixed,
+        episodes: args.episodes,
+        seed: args.seed,
+    };
+    let shard = match &args.shard {
+        Some(s) => Shard::parse(s)?,
+        None => Shard::ALL,
+    };
+    let cache = match (&args.cache, args.no_cache) {
+        (_, true) => TargetCache::disabled(),
+        (Some(dir), false) => TargetCache::new(dir),
+        (None, false) => TargetCache::default_location(),
+    };
+    let opts = SweepOptions {
+        out: args.out.clone(),
+        cache,
+        shard,
+        chunk: 0,
+    };
+    // Validate every level before any work.
+    spec.levels()?;
+
+    let cancel = Arc::new(AtomicBool::new(false));
+    {
+        let cancel = cancel.clone();
+        // A second Ctrl-C stops at once; rows on disk are kept either way.
+        let _ = ctrlc::set_handler(move || {
+            if cancel.swap(true, Ordering::SeqCst) {
+                std::process::exit(130);
+            }
+        });
+    }
+    let progress = Progress::new(args.quiet);
+    progress.line(&format!(
+        "Sweeping {} ({}): {} levels x {} episodes{}, seed {}, into {}",
+        spec.scenario_path.display(),
+        spec.task,
+        spec.n_levels(),
+        spec.episodes,
+        if shard.is_all() {
+            String::new()
+        } else {
+            format!(", shard {shard}")
+        },
+        spec.seed,
+        opts.out.display()
+    ));
+    let started = wall_clock();
+    let run = || run_sweep(&spec, &opts, &cancel, &progress);
+    let outcome = match args.threads {
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .context("cannot start the worker threads")?
+            .install(run)?,
+        None => run()?,
+    };
+    if let Some(bar) = &progress.bar {
+        bar.finish_and_clear();
+    }
+    let secs = started.elapsed().as_secs_f64();
+    match outcome {
+        SweepOutcome::Interrupted { done, total } => {
+            eprintln!(
+                "Interrupted: {done} of {total} episodes are in {}. Run the same command again \
+                 to resume.",
+                opts.out.join("episodes.csv").display()
+            );
+            Ok(false)
+        }
+        SweepOutcome::Complete { ran, total } => {
+            if !args.quiet {
+                eprintln!(
+                    "{ran} episodes in {secs:.1} s ({:.0} per second){}",
+                    ran as f64 / secs.max(1e-9),
+                    if ran < total {
+                        format!("; {} were already on disk", total - ran)
+                    } else {
+                        String::new()
+                    }
+                );
+            }
+            if shard.is_all() {
+                let manifest = Manifest::read(&opts.out)?;
+                let report = finish_dir(&opts.out, &manifest)?;
+                print_report(&report);
+            } else {
+                println!(
+                    "Shard {shard} done: {total} episodes in {}. When all {} shards are done: \
+                     errp merge DIR... --out MERGED",
+                    opts.out.display(),
+                    shard.count
+                );
+            }
+            Ok(true)
+        }
+    }
+}
+
+fn print_report(report: &SweepReport) {
+    print!("{report}");
+    println!("Wrote:");
+    for f in &report.files {
+        println!("  {}", f.display());
+    }
+}
+
+/// Runs `errp merge`.
+pub fn merge(args: &MergeArgs) -> Result<()> {
+    let report = merge_sweeps(&args.dirs, Path::new(&args.out))?;
+    print_report(&report);
+    Ok(())
+}
