@@ -254,3 +254,136 @@ fn a_broken_epuck_scenario_is_exit_2_naming_file_field_and_fix() {
     assert!(stderr(&o).contains("--decoder"), "{}", stderr(&o));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A small oracle grid scenario for sweeps.
+const SWEEP_SCENARIO: &str =
+    "task = \"grid\"\ndecoder = \"oracle\"\n[user]\naccuracy = 0.8\n[free_goals]\ncount = 10\n";
+
+#[test]
+fn a_sweep_writes_its_files_and_shards_merge_to_the_same_bytes() {
+    let dir = temp_dir("sweep");
+    let scenario = dir.join("s.toml");
+    std::fs::write(&scenario, SWEEP_SCENARIO).unwrap();
+    let sweep = |out: &Path, extra: &[&str]| {
+        let mut args = vec![
+            "sweep",
+            "--scenario",
+            scenario.to_str().unwrap(),
+            "--accuracy",
+            "0.6:0.9:0.15",
+            "--param",
+            "strategy=greedy,info_gain",
+            "--episodes",
+            "30",
+            "--seed",
+            "3",
+            "--no-cache",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        errp(&args)
+    };
+    let whole = dir.join("whole");
+    let o = sweep(&whole, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let table = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        table.contains("strategy=info_gain") && table.contains("success"),
+        "{table}"
+    );
+    assert_eq!(
+        files_in(&whole),
+        [
+            "episodes.csv",
+            "summary.csv",
+            "sweep.json",
+            "sweep.png",
+            "sweep.svg"
+        ]
+    );
+    let summary = std::fs::read_to_string(whole.join("summary.csv")).unwrap();
+    assert_eq!(summary.lines().count(), 1 + 6, "{summary}");
+    assert!(
+        summary.starts_with("level,accuracy,strategy,episodes,success_rate"),
+        "{summary}"
+    );
+
+    let shards: Vec<PathBuf> = (1..=2).map(|k| dir.join(format!("shard{k}"))).collect();
+    for (k, d) in shards.iter().enumerate() {
+        let o = sweep(d, &["--shard", &format!("{}/2", k + 1), "--threads", "1"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert_eq!(files_in(d), ["episodes.csv", "sweep.json"]);
+    }
+    let merged = dir.join("merged");
+    let o = errp(&[
+        "merge",
+        shards[1].to_str().unwrap(),
+        shards[0].to_str().unwrap(),
+        "--out",
+        merged.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for f in ["episodes.csv", "summary.csv", "sweep.json"] {
+        assert!(
+            std::fs::read(whole.join(f)).unwrap() == std::fs::read(merged.join(f)).unwrap(),
+            "{f} differs"
+        );
+    }
+
+    // Rerunning a finished sweep resumes with nothing left to do.
+    let o = sweep(&whole, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("0 episodes in"), "{}", stderr(&o));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_sweep_input_is_exit_2_with_the_fix_and_no_output() {
+    let dir = temp_dir("sweep-bad");
+    let scenario = dir.join("s.toml");
+    std::fs::write(&scenario, SWEEP_SCENARIO).unwrap();
+    let out = dir.join("out");
+    let s = scenario.to_str().unwrap();
+    let o_ = out.to_str().unwrap();
+    for (args, needles) in [
+        (
+            vec!["--accuracy", "0.6,1.7"],
+            vec!["--accuracy", "1.7", "(0.5, 1)"],
+        ),
+        (vec!["--accuracy", "0.9:0.6:0.1"], vec!["stop >= start"]),
+        (
+            vec!["--param", "tau=-1,0.3"],
+            vec!["tau=-1", "control.tau", "s.toml"],
+        ),
+        (
+            vec!["--param", "t_e=0.8"],
+            vec!["not a grid scenario parameter"],
+        ),
+        (
+            vec!["--param", "strategy=clever"],
+            vec!["strategy", "greedy", "info_gain"],
+        ),
+        (vec!["--shard", "3/2"], vec!["--shard", "K/N"]),
+        (
+            vec!["--task", "epuck"],
+            vec!["does not match", "grid scenario"],
+        ),
+        (vec!["--episodes", "0"], vec!["--episodes"]),
+    ] {
+        let mut all = vec!["sweep", "--scenario", s, "--out", o_, "--no-cache"];
+        all.extend(args.iter());
+        let o = errp(&all);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {e}");
+        for n in needles {
+            assert!(e.contains(n), "{args:?}: `{n}` not in {e}");
+        }
+        assert!(!out.exists(), "{args:?} left {}", out.display());
+    }
+    // Merging a directory that is not a sweep names it.
+    let o = errp(&["merge", dir.to_str().unwrap(), "--out", o_]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("sweep.json"), "{}", stderr(&o));
+    let _ = std::fs::remove_dir_all(&dir);
+}

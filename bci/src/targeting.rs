@@ -137,6 +137,19 @@ impl SessionParts {
     /// Simulates both parts of the session of `setup` (whose ratio is
     /// ignored) from `seed`.
     pub fn simulate(setup: &CalibrationSetup, seed: u64) -> Result<Self> {
+        Self::from_parts(
+            Self::simulate_part(setup, seed, false)?,
+            Self::simulate_part(setup, seed, true)?,
+        )
+    }
+
+    /// One part of [`SessionParts::simulate`]: the ERPs at ratio 1 if
+    /// `erp`, else background + artifacts (the two can run in parallel).
+    pub fn simulate_part(
+        setup: &CalibrationSetup,
+        seed: u64,
+        erp: bool,
+    ) -> Result<CalibrationSession> {
         let unit = CalibrationSetup {
             generator: GeneratorParams {
                 errp_to_noise: 1.0,
@@ -144,30 +157,37 @@ impl SessionParts {
             },
             ..setup.clone()
         };
-        let part = |components| {
-            simulate_session(
-                &unit,
-                seed,
-                SessionOptions {
-                    components,
-                    ..SessionOptions::default()
+        simulate_session(
+            &unit,
+            seed,
+            SessionOptions {
+                components: Components {
+                    background: !erp,
+                    artifacts: !erp,
+                    erp,
                 },
-            )
-        };
-        let noise = part(Components {
-            background: true,
-            artifacts: true,
-            erp: false,
-        })?;
-        let erp = part(Components {
-            background: false,
-            artifacts: false,
-            erp: true,
-        })?;
+                ..SessionOptions::default()
+            },
+        )
+    }
+
+    /// Joins the two parts of one session (same setup and seed).
+    pub fn from_parts(noise: CalibrationSession, erp: CalibrationSession) -> Result<Self> {
+        if noise.labels != erp.labels || noise.features.shape() != erp.features.shape() {
+            return Err(BciError::Training(
+                "the noise and ERP parts are not of the same session".into(),
+            ));
+        }
         Ok(Self {
             noise,
             erp: erp.features,
         })
+    }
+
+    /// The preprocessor fitted on the session's EOG recording (the same at
+    /// every ratio).
+    pub fn preprocessor(&self) -> &crate::Preprocessor {
+        &self.noise.preprocessor
     }
 
     /// The session's features at `ratio`, `(n_actions, n_features)`.

@@ -31,6 +31,9 @@
 //!   paper) heads for the goal whose heading the user's next assessment is
 //!   expected to say most about; see
 //!   [`next_target`](ContinuousController::next_target).
+//! - **No Thompson sampling** ([`Strategy::Thompson`]): the controller is
+//!   deterministic (it has no random numbers), so
+//!   [`ContinuousControlParams::validate`] rejects that strategy.
 //! - **The target is kept until the next stop**, as in sec. 5.1 ("the robot
 //!   stopped ... Then, it moved towards a new goal"): the belief changes
 //!   while the robot moves, the target does not.
@@ -247,9 +250,12 @@ impl ContinuousController {
     /// the one whose heading the next decoder window is expected to say
     /// most about; gains within 1e-12 of the largest tie, and ties go to the
     /// most probable goal, then to the nearest, then to the lowest index.
+    ///
+    /// [`Strategy::Thompson`] never gets here (the parameters' validation
+    /// rejects it); it would be greedy.
     pub fn next_target(&self, pose: &Pose) -> usize {
         let greedy = self.most_probable_goal(pose);
-        if self.params.strategy == Strategy::Greedy
+        if self.params.strategy != Strategy::InfoGain
             || self.belief.probability(greedy) >= self.params.p_c
         {
             return greedy;

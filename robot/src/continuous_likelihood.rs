@@ -53,7 +53,9 @@ pub struct ContinuousControlParams {
     /// The robot's constants (top speed, axle length).
     pub epuck: EpuckParams,
     /// How the next goal to head for is chosen after a stop (the paper:
-    /// greedy, the most probable goal).
+    /// greedy, the most probable goal). Greedy or info gain:
+    /// [`Strategy::Thompson`] is grid-only (this controller draws no random
+    /// numbers).
     pub strategy: Strategy,
     /// The decoder accuracy the device assumes when it predicts the
     /// decoder's outcomes for [`Strategy::InfoGain`]: the probability of a
@@ -145,6 +147,13 @@ impl ContinuousControlParams {
             self.goal_radius_m,
             "> 0",
         )?;
+        if self.strategy == Strategy::Thompson {
+            return Err(RobotError::Parameter(format!(
+                "strategy = {} must be greedy or info_gain: thompson is grid-only \
+                 (the e-puck controller draws no random numbers)",
+                self.strategy
+            )));
+        }
         check(
             self.assumed_accuracy > 0.5 && self.assumed_accuracy <= 1.0,
             "assumed_accuracy",
@@ -379,9 +388,35 @@ mod tests {
                 },
                 "assumed_accuracy",
             ),
+            (
+                ContinuousControlParams {
+                    strategy: Strategy::Thompson,
+                    ..d.clone()
+                },
+                "strategy",
+            ),
         ] {
             let e = p.validate().unwrap_err().to_string();
             assert!(e.contains(field), "{e}");
+        }
+        let e = ContinuousControlParams {
+            strategy: Strategy::Thompson,
+            ..d.clone()
+        }
+        .validate()
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("grid-only") && e.contains("greedy") && e.contains("info_gain"),
+            "{e}"
+        );
+        for strategy in [Strategy::Greedy, Strategy::InfoGain] {
+            ContinuousControlParams {
+                strategy,
+                ..d.clone()
+            }
+            .validate()
+            .unwrap();
         }
     }
 }

@@ -16,7 +16,9 @@
 //!
 //! Both controllers choose their actions by a [`Strategy`]: the paper's
 //! greedy one, or the [`expected_information_gain`] of the decoder's next
-//! assessment.
+//! assessment; the grid controller also by Thompson sampling (greedy towards
+//! a goal drawn from the belief, kept until the user objects or the belief
+//! moves away from it).
 
 mod belief;
 mod continuous_control;

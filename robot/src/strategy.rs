@@ -1,7 +1,9 @@
 //! How a controller chooses its next action: greedily towards the most
-//! probable goal (the paper), or by the expected information gain of the
-//! decoder's next assessment (what the paper's conclusion asks for: "more
-//! intelligent exploration strategies than the greedy one").
+//! probable goal (the paper), by the expected information gain of the
+//! decoder's next assessment, or greedily towards a goal drawn from the
+//! belief and kept while the user does not object (Thompson sampling, grid
+//! only). The last two are what the paper's conclusion asks for: "more
+//! intelligent exploration strategies than the greedy one".
 
 use std::fmt;
 use std::str::FromStr;
@@ -22,18 +24,41 @@ pub enum Strategy {
     /// expected to report it, most reduces the entropy of the belief on
     /// average ([`expected_information_gain`]).
     InfoGain,
+    /// Posterior (Thompson) sampling, grid only: draw a goal from the belief
+    /// and act as its optimal policy would, keeping the draw until the user
+    /// objects to an action (p(error) >= 0.5) or the goal's probability falls
+    /// below half the most probable goal's, then draw again ("sticky"
+    /// sampling, as in posterior sampling with episodes; see
+    /// [`GridController::observe`](crate::GridController::observe)). Greedy
+    /// fixates on the current most probable goal, so a wrong early lead is
+    /// only corrected by the errors its actions provoke; sampling explores
+    /// the other goals in proportion to their probability, and becomes greedy
+    /// as the belief concentrates. Redrawing at every action instead makes
+    /// the cursor dither between candidates and rarely reach one, where
+    /// goal-reached can be judged.
+    ///
+    /// Measured in the closed loop (`tests/grid_strategies.rs`, an oracle
+    /// decoder, 200 episodes) it is still worse than greedy: at accuracy 0.8
+    /// every strategy finds the goal, greedy in 37.5 actions on average,
+    /// Thompson in 55.1 (84.2 redrawing every action); at 0.65 greedy finds
+    /// 90 % in 152.6, Thompson 80.5 % in 223.9 (43.5 % in 280.3). The
+    /// e-puck controller has no random numbers, so
+    /// [`ContinuousControlParams::validate`](crate::ContinuousControlParams::validate)
+    /// rejects it.
+    Thompson,
 }
 
 impl Strategy {
     /// Every strategy, in declaration order.
-    pub const ALL: [Strategy; 2] = [Strategy::Greedy, Strategy::InfoGain];
+    pub const ALL: [Strategy; 3] = [Strategy::Greedy, Strategy::InfoGain, Strategy::Thompson];
 
     /// The name used in scenario files and on the command line:
-    /// `greedy` or `info_gain`.
+    /// `greedy`, `info_gain` or `thompson`.
     pub fn name(self) -> &'static str {
         match self {
             Strategy::Greedy => "greedy",
             Strategy::InfoGain => "info_gain",
+            Strategy::Thompson => "thompson",
         }
     }
 }
@@ -175,7 +200,11 @@ mod tests {
         }
         assert_eq!("info_gain".parse::<Strategy>().unwrap(), Strategy::InfoGain);
         let e = "infogain".parse::<Strategy>().unwrap_err().to_string();
-        assert!(e.contains("greedy") && e.contains("info_gain"), "{e}");
+        assert!(
+            e.contains("greedy") && e.contains("info_gain") && e.contains("thompson"),
+            "{e}"
+        );
+        assert_eq!("thompson".parse::<Strategy>().unwrap(), Strategy::Thompson);
         assert_eq!(Strategy::default(), Strategy::Greedy);
         #[derive(Deserialize)]
         struct W {
@@ -183,6 +212,8 @@ mod tests {
         }
         let w: W = toml::from_str("s = \"info_gain\"").unwrap();
         assert_eq!(w.s, Strategy::InfoGain);
+        let w: W = toml::from_str("s = \"thompson\"").unwrap();
+        assert_eq!(w.s, Strategy::Thompson);
     }
 
     #[test]

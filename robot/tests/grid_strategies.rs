@@ -104,24 +104,66 @@ fn measure(strategy: Strategy, accuracy: f64, n: u64) -> Summary {
     }
 }
 
-/// Measured: both right in 200 of 200 episodes; greedy in 37.5 actions on
-/// average, info gain in 42.5 (one-step information gain ignores that the
-/// most telling action, goal-reached, needs the cursor on the goal, which
-/// greedy heads for). The bounds leave about 20 % margin.
+/// Measured (200 episodes): every strategy right in 200 of 200; greedy in
+/// 37.5 actions on average, info gain in 42.5 (one-step information gain
+/// ignores that the most telling action, goal-reached, needs the cursor on
+/// the goal, which greedy heads for), Thompson in 55.1. Thompson keeps its
+/// drawn goal until the user objects or the goal falls below half the
+/// leader's probability; redrawing at every action made the cursor dither
+/// between candidates and took 84.2 actions. It still loses to greedy: while
+/// the belief is spread its draws send the cursor to goals that greedy,
+/// heading for the leader, would not visit. The bounds leave about 20 %
+/// margin (Thompson's excludes the per-action redraw).
 #[test]
-fn both_strategies_find_the_goal_with_an_80_percent_decoder() {
+fn every_strategy_finds_the_goal_with_an_80_percent_decoder() {
     let (n, accuracy) = (200, 0.8);
     let greedy = measure(Strategy::Greedy, accuracy, n);
     let info = measure(Strategy::InfoGain, accuracy, n);
-    eprintln!("{n} episodes at accuracy {accuracy}:\n  greedy    {greedy:?}\n  info_gain {info:?}");
-    assert!(greedy.success_rate >= 0.85 && info.success_rate >= 0.85);
+    let thompson = measure(Strategy::Thompson, accuracy, n);
+    eprintln!(
+        "{n} episodes at accuracy {accuracy}:\n  greedy    {greedy:?}\n  info_gain {info:?}\n  \
+         thompson  {thompson:?}"
+    );
+    for s in [&greedy, &info, &thompson] {
+        assert!(s.success_rate >= 0.85, "{s:?}");
+    }
     assert!(greedy.mean_actions < 45.0, "{greedy:?}");
     assert!(info.mean_actions < 50.0, "{info:?}");
+    assert!(thompson.mean_actions < 66.0, "{thompson:?}");
     // Greedy leaves its greedy action only on epsilon's random draws (0.1 x
-    // 4/5 of them); info gain does so far more often.
+    // 4/5 of them); info gain does so far more often, Thompson whenever its
+    // drawn goal is not the most probable one and needs another action.
     assert!(greedy.not_greedy_share < 0.12, "{greedy:?}");
     assert!(
         info.not_greedy_share > greedy.not_greedy_share + 0.1,
         "{info:?}"
     );
+    assert!(
+        thompson.not_greedy_share > greedy.not_greedy_share + 0.1,
+        "{thompson:?}"
+    );
+}
+
+/// The same comparison with a weaker decoder. Measured (200 episodes):
+/// greedy right in 90 % of episodes in 152.6 actions on average, info gain
+/// 84 % in 175.1, Thompson 80.5 % in 223.9 (redrawing at every action:
+/// 43.5 % in 280.3). Greedy is the best of the three here too. The bounds
+/// leave about 10 points of success and 12 % of actions (Thompson's exclude
+/// the per-action redraw).
+#[test]
+fn every_strategy_mostly_finds_the_goal_with_a_65_percent_decoder() {
+    let (n, accuracy) = (200, 0.65);
+    let greedy = measure(Strategy::Greedy, accuracy, n);
+    let info = measure(Strategy::InfoGain, accuracy, n);
+    let thompson = measure(Strategy::Thompson, accuracy, n);
+    eprintln!(
+        "{n} episodes at accuracy {accuracy}:\n  greedy    {greedy:?}\n  info_gain {info:?}\n  \
+         thompson  {thompson:?}"
+    );
+    assert!(greedy.success_rate >= 0.8, "{greedy:?}");
+    assert!(info.success_rate >= 0.75, "{info:?}");
+    assert!(thompson.success_rate >= 0.7, "{thompson:?}");
+    assert!(greedy.mean_actions < 175.0, "{greedy:?}");
+    assert!(info.mean_actions < 200.0, "{info:?}");
+    assert!(thompson.mean_actions < 250.0, "{thompson:?}");
 }

@@ -84,8 +84,13 @@ impl EpochBank {
         per_class: usize,
         seed: u64,
     ) -> Result<Self> {
-        let (error, correct) =
-            stream_pools(&decoder, params, per_class, seed, Components::default())?;
+        let (error, correct) = stream_pools(
+            decoder.source(),
+            params,
+            per_class,
+            seed,
+            Components::default(),
+        )?;
         Ok(Self {
             decoder,
             error,
@@ -130,25 +135,25 @@ pub struct EpochBankParts {
 }
 
 impl EpochBankParts {
-    /// Streams both parts with `decoder`'s generator, montage and
-    /// preprocessor (its ratio and model are not used).
+    /// Streams both parts from `source` (its ratio is not used).
     pub fn build(
-        decoder: &EegDecoder,
+        source: EegSource<'_>,
         params: &GridTaskParams,
         per_class: usize,
         seed: u64,
     ) -> Result<Self> {
-        let unit = EegDecoder {
-            generator: GeneratorParams {
-                errp_to_noise: 1.0,
-                ..decoder.generator.clone()
-            },
-            ..decoder.clone()
+        let generator = GeneratorParams {
+            errp_to_noise: 1.0,
+            ..source.generator.clone()
+        };
+        let unit = EegSource {
+            generator: &generator,
+            ..source
         };
         let (noise, erp) = rayon::join(
             || {
                 stream_pools(
-                    &unit,
+                    unit,
                     params,
                     per_class,
                     seed,
@@ -160,7 +165,7 @@ impl EpochBankParts {
             },
             || {
                 stream_pools(
-                    &unit,
+                    unit,
                     params,
                     per_class,
                     seed,
@@ -205,7 +210,7 @@ impl EpochBankParts {
 
 /// Streams the epochs of a bank with the generator's `components`.
 fn stream_pools(
-    decoder: &EegDecoder,
+    source: EegSource<'_>,
     params: &GridTaskParams,
     per_class: usize,
     seed: u64,
@@ -216,7 +221,7 @@ fn stream_pools(
             "an epoch bank needs at least one epoch per class".into(),
         ));
     }
-    let mut stream_eeg = OnlineEeg::start(decoder, derive_seed(seed, "grid/bank", 0), components)?;
+    let mut stream_eeg = OnlineEeg::start(source, derive_seed(seed, "grid/bank", 0), components)?;
     let mut rng = stream(seed, "grid/bank/order");
     let mut error = Vec::with_capacity(per_class);
     let mut correct = Vec::with_capacity(per_class);
@@ -365,7 +370,7 @@ pub fn run_grid_episode(
     let mut rng_bank = stream(seed, "grid/bank/draw");
     let mut online = match decoder {
         AssessmentDecoder::Eeg(d) => Some(OnlineEeg::start(
-            d,
+            d.source(),
             derive_seed(seed, "grid/eeg", 0),
             Components::default(),
         )?),
@@ -465,6 +470,29 @@ fn decide(d: &EegDecoder, features: &[f64]) -> (f64, bool) {
     (p, y >= 0.0)
 }
 
+/// What an EEG stream needs: the user's EEG model, the montage and the
+/// decoder's preprocessing.
+#[derive(Debug, Clone, Copy)]
+pub struct EegSource<'a> {
+    /// The synthetic user's EEG model.
+    pub generator: &'a GeneratorParams,
+    /// The montage.
+    pub montage: &'a Montage,
+    /// The preprocessing fitted at calibration.
+    pub preprocessor: &'a Preprocessor,
+}
+
+impl EegDecoder {
+    /// The stream this decoder reads.
+    pub fn source(&self) -> EegSource<'_> {
+        EegSource {
+            generator: &self.generator,
+            montage: &self.montage,
+            preprocessor: &self.preprocessor,
+        }
+    }
+}
+
 /// A continuous EEG stream through the decoder's preprocessing.
 struct OnlineEeg {
     generator: EegGenerator,
@@ -475,10 +503,10 @@ struct OnlineEeg {
 
 impl OnlineEeg {
     /// Starts a stream and lets the filters settle.
-    fn start(d: &EegDecoder, seed: u64, components: Components) -> Result<Self> {
+    fn start(d: EegSource<'_>, seed: u64, components: Components) -> Result<Self> {
         let fs = d.generator.sfreq_hz;
         let mut generator =
-            EegGenerator::new(d.generator.clone(), &d.montage, seed)?.with_components(components);
+            EegGenerator::new(d.generator.clone(), d.montage, seed)?.with_components(components);
         let mut preprocessor = d.preprocessor.clone();
         preprocessor.reset();
         preprocessor.process(&generator.generate((WARM_UP_SECS * fs) as usize));

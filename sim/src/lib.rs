@@ -47,8 +47,8 @@ pub use grid_run::{
     run_grid_scenario,
 };
 pub use grid_task::{
-    AssessmentDecoder, EegDecoder, EpochBank, EpochBankParts, GridEpisodeResult, GridStep,
-    GridTaskParams, PErrorMapping, run_grid_episode,
+    AssessmentDecoder, EegDecoder, EegSource, EpochBank, EpochBankParts, GridEpisodeResult,
+    GridStep, GridTaskParams, PErrorMapping, run_grid_episode,
 };
 pub use grid_view::{SIM_TIME, grid_recording, record_grid_run};
 pub use output::PendingFile;

@@ -157,7 +157,7 @@ fn an_epoch_bank_from_parts_equals_the_bank_streamed_at_its_ratio() {
     let eeg = EegDecoder::from_report(&report, PErrorChoice::Platt);
     let params = GridTaskParams::default();
     let direct = errp_sim::EpochBank::build(eeg.clone(), &params, 12, 2).unwrap();
-    let parts = errp_sim::EpochBankParts::build(&eeg, &params, 12, 2).unwrap();
+    let parts = errp_sim::EpochBankParts::build(eeg.source(), &params, 12, 2).unwrap();
     let mixed = parts.bank(eeg);
     assert_eq!(mixed.len(), 12);
     let mut worst = 0.0f64;

@@ -6,14 +6,13 @@ use std::fs::{File, OpenOptions};
 use std::io::{BufRead, BufReader, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::{Arc, OnceLock};
+use std::sync::{Arc, Mutex};
 
 use errp_bci::{
     GeneratorParams, LdaDecoder, SessionParts, SvmDecoder, calibrate_session, target_accuracy_on,
     target_continuous_accuracy,
 };
 use errp_robot::{Cell, Grid, QTable};
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::calibration::{CalibrationReport, CalibrationRequest};
@@ -22,7 +21,9 @@ use crate::epuck_scenario::{AnyScenario, EpuckScenario};
 use crate::epuck_task::run_epuck_episode;
 use crate::error::{Result, SimError};
 use crate::grid_run::decoder_from_calibration;
-use crate::grid_task::{AssessmentDecoder, EegDecoder, EpochBankParts, run_grid_episode};
+use crate::grid_task::{
+    AssessmentDecoder, EegDecoder, EegSource, EpochBankParts, run_grid_episode,
+};
 use crate::output::PendingFile;
 use crate::scenario::{DecoderChoice, EegMode, Scenario};
 
@@ -203,14 +204,14 @@ enum Prepared {
     Epuck(Arc<ContinuousDecoder>),
 }
 
-/// What levels share while their decoders are prepared in parallel: the
-/// grid's calibration session (every level uses the same one, at its own
-/// ratio) and epoch banks, each simulated once by the first level that needs
-/// it.
+/// What grid levels share, simulated once before their decoders are
+/// prepared: the calibration session (every level uses the same one, at its
+/// own ratio) and the epoch banks (likewise). Each is streamed as its noise
+/// and ERP parts, the two in parallel.
 #[derive(Default)]
 struct Shared {
-    sessions: HashMap<u64, OnceLock<std::result::Result<Arc<SessionParts>, String>>>,
-    banks: HashMap<String, OnceLock<std::result::Result<Arc<EpochBankParts>, String>>>,
+    sessions: HashMap<u64, Arc<SessionParts>>,
+    banks: HashMap<String, Arc<EpochBankParts>>,
 }
 
 /// The key of a grid level's epoch bank: what its epochs depend on.
@@ -227,27 +228,37 @@ fn bank_key(s: &Scenario) -> String {
 }
 
 impl Shared {
-    fn new(levels: &[Level]) -> Self {
+    fn build(levels: &[Level]) -> Result<Self> {
         let mut shared = Shared::default();
         for level in levels {
-            if let AnyScenario::Grid(s) = &level.scenario {
-                shared.sessions.entry(s.seed).or_default();
-                shared.banks.entry(bank_key(s)).or_default();
+            let AnyScenario::Grid(s) = &level.scenario else {
+                continue;
+            };
+            if s.decoder != DecoderChoice::Eeg {
+                continue;
+            }
+            if let std::collections::hash_map::Entry::Vacant(slot) = shared.sessions.entry(s.seed) {
+                let setup = CalibrationRequest::new(s.accuracy, s.seed).setup;
+                let (noise, erp) = rayon::join(
+                    || SessionParts::simulate_part(&setup, s.seed, false),
+                    || SessionParts::simulate_part(&setup, s.seed, true),
+                );
+                slot.insert(Arc::new(SessionParts::from_parts(noise?, erp?)?));
+            }
+            let key = bank_key(s);
+            if s.eeg == EegMode::Bank && !shared.banks.contains_key(&key) {
+                let setup = CalibrationRequest::new(s.accuracy, s.seed).setup;
+                let source = EegSource {
+                    generator: &setup.generator,
+                    montage: &setup.montage,
+                    preprocessor: shared.sessions[&s.seed].preprocessor(),
+                };
+                let bank = EpochBankParts::build(source, &s.params, s.bank_per_class, s.seed)?;
+                shared.banks.insert(key, Arc::new(bank));
             }
         }
-        shared
+        Ok(shared)
     }
-}
-
-/// Runs `init` once per cell; every caller gets its result (errors as text,
-/// so they can be shared).
-fn once<T>(
-    cell: &OnceLock<std::result::Result<Arc<T>, String>>,
-    init: impl FnOnce() -> Result<T>,
-) -> Result<Arc<T>> {
-    cell.get_or_init(|| init().map(Arc::new).map_err(|e| e.to_string()))
-        .clone()
-        .map_err(SimError::Sweep)
 }
 
 /// Calibrates the decoder `level` needs, using the cache for the targeting.
@@ -271,9 +282,7 @@ fn prepare(level: &Level, cache: &TargetCache, shared: &Shared) -> Result<(Prepa
             // The level's calibration: the shared session at the ratio
             // targeted for its accuracy.
             let request = CalibrationRequest::new(s.accuracy, s.seed);
-            let parts = once(&shared.sessions[&s.seed], || {
-                Ok(SessionParts::simulate(&request.setup, request.seed)?)
-            })?;
+            let parts = &shared.sessions[&s.seed];
             let key = format!(
                 "{:?} {:?} accuracy={:?} seed={}",
                 request.setup, request.search, request.accuracy, request.seed
@@ -281,7 +290,7 @@ fn prepare(level: &Level, cache: &TargetCache, shared: &Shared) -> Result<(Prepa
             let lda = LdaDecoder::default();
             let (targeting, hit) = cache.get_or_search("grid-lda", &key, || {
                 Ok(target_accuracy_on(
-                    &parts,
+                    parts,
                     request.accuracy,
                     &lda,
                     &request.setup,
@@ -315,10 +324,7 @@ fn prepare(level: &Level, cache: &TargetCache, shared: &Shared) -> Result<(Prepa
             let decoder = match s.eeg {
                 EegMode::Stream => AssessmentDecoder::Eeg(Box::new(eeg)),
                 EegMode::Bank => {
-                    let bank = once(&shared.banks[&bank_key(s)], || {
-                        EpochBankParts::build(&eeg, &s.params, s.bank_per_class, s.seed)
-                    })?;
-                    AssessmentDecoder::EegBank(Box::new(bank.bank(eeg)))
+                    AssessmentDecoder::EegBank(Box::new(shared.banks[&bank_key(s)].bank(eeg)))
                 }
             };
             Ok((Prepared::Grid(Arc::new(decoder)), info))
@@ -356,6 +362,169 @@ fn prepare(level: &Level, cache: &TargetCache, shared: &Shared) -> Result<(Prepa
                 info,
             ))
         }
+    }
+}
+
+/// Prepares the decoders of `first_level` (level indices) on every thread of
+/// the current pool, the likely slowest first: targeting far from 75 % takes
+/// the most search steps. Results are in `first_level` order, whatever the
+/// thread count.
+fn prepare_all(
+    levels: &[Level],
+    first_level: &[usize],
+    cache: &TargetCache,
+    shared: &Shared,
+    observer: &dyn SweepObserver,
+) -> Result<Vec<(Prepared, DecoderInfo)>> {
+    let n = first_level.len();
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| {
+        let cost = |i: usize| (levels[first_level[i]].accuracy - 0.75).abs();
+        cost(b).total_cmp(&cost(a)).then(a.cmp(&b))
+    });
+    let next = AtomicUsize::new(0);
+    let ready = AtomicUsize::new(0);
+    type Slot = Mutex<Option<Result<(Prepared, DecoderInfo)>>>;
+    let slots: Vec<Slot> = (0..n).map(|_| Mutex::new(None)).collect();
+    rayon::scope(|scope| {
+        for _ in 0..rayon::current_num_threads().min(n) {
+            scope.spawn(|_| {
+                loop {
+                    let i = next.fetch_add(1, Ordering::SeqCst);
+                    let Some(&k) = order.get(i) else { break };
+                    let result = prepare(&levels[first_level[k]], cache, shared);
+                    if let Ok((_, info)) = &result {
+                        let done = ready.fetch_add(1, Ordering::SeqCst) + 1;
+                        observer.decoder_ready(info, done, n);
+                    }
+                    *slots[k].lock().expect("no panic while holding the slot") = Some(result);
+                }
+            });
+        }
+    });
+    slots
+        .into_iter()
+        .map(|slot| {
+            slot.into_inner()
+                .expect("no panic while holding the slot")
+                .expect("every decoder was prepared")
+        })
+        .collect()
+}
+
+/// The episodes of a slice, run on every thread of the current pool and
+/// written to `episodes.csv` in sweep order as they complete: a worker takes
+/// the next episode as soon as it is free (no barrier between chunks), and
+/// rows that finish early wait in memory until the rows before them are
+/// written, at most `window` of them.
+struct EpisodeJob<'a> {
+    spec: &'a SweepSpec,
+    levels: &'a [Level],
+    runners: &'a [Runner],
+    items: &'a [usize],
+    cancel: &'a AtomicBool,
+    observer: &'a dyn SweepObserver,
+    sync_every: usize,
+    window: usize,
+}
+
+/// What the workers share.
+struct Writer {
+    file: File,
+    /// Finished rows not yet written, by position in the slice.
+    pending: std::collections::BTreeMap<usize, String>,
+    /// Rows of the slice on disk.
+    written: usize,
+    /// Rows written since the last sync.
+    unsynced: usize,
+    /// The first failure; every worker stops.
+    error: Option<SimError>,
+}
+
+impl EpisodeJob<'_> {
+    /// Runs the episodes after the first `done` and returns how many rows of
+    /// the slice are on disk (all of them unless cancelled).
+    fn run(&self, file: File, done: usize, path: &Path) -> Result<usize> {
+        let next = AtomicUsize::new(done);
+        let state = Mutex::new(Writer {
+            file,
+            pending: Default::default(),
+            written: done,
+            unsynced: 0,
+            error: None,
+        });
+        let moved = std::sync::Condvar::new();
+        let io = |source| SimError::Output {
+            path: path.to_path_buf(),
+            source,
+        };
+        rayon::scope(|scope| {
+            for _ in 0..rayon::current_num_threads() {
+                scope.spawn(|_| {
+                    loop {
+                        if self.cancel.load(Ordering::SeqCst) {
+                            break;
+                        }
+                        let i = next.fetch_add(1, Ordering::SeqCst);
+                        if i >= self.items.len() {
+                            break;
+                        }
+                        // Do not run too far ahead of the oldest unfinished row.
+                        {
+                            let mut st = state.lock().expect("a worker panicked");
+                            while i >= st.written + self.window && st.error.is_none() {
+                                st = moved.wait(st).expect("a worker panicked");
+                            }
+                            if st.error.is_some() {
+                                break;
+                            }
+                        }
+                        let (l, k) = split(self.spec, self.items[i]);
+                        let row = run_row(self.spec, &self.levels[l], &self.runners[l], k);
+                        let mut guard = state.lock().expect("a worker panicked");
+                        let st = &mut *guard;
+                        let row = match row {
+                            Ok(row) => row,
+                            Err(e) => {
+                                st.error.get_or_insert(e);
+                                moved.notify_all();
+                                break;
+                            }
+                        };
+                        st.pending.insert(i, row);
+                        let mut text = String::new();
+                        while let Some(row) = st.pending.remove(&st.written) {
+                            text.push_str(&row);
+                            text.push('\n');
+                            st.written += 1;
+                            st.unsynced += 1;
+                        }
+                        if text.is_empty() {
+                            continue;
+                        }
+                        let sync = st.unsynced >= self.sync_every || st.written == self.items.len();
+                        let mut result = st.file.write_all(text.as_bytes());
+                        if sync && result.is_ok() {
+                            result = st.file.sync_data();
+                            st.unsynced = 0;
+                        }
+                        if let Err(e) = result {
+                            st.error.get_or_insert(io(e));
+                            moved.notify_all();
+                            break;
+                        }
+                        self.observer.episodes_done(st.written, self.items.len());
+                        moved.notify_all();
+                    }
+                });
+            }
+        });
+        let st = state.into_inner().expect("a worker panicked");
+        if let Some(e) = st.error {
+            return Err(e);
+        }
+        st.file.sync_data().map_err(io)?;
+        Ok(st.written)
     }
 }
 
@@ -624,17 +793,8 @@ pub fn run_sweep(
         });
         key_of.push(i);
     }
-    let ready = AtomicUsize::new(0);
-    let shared = Shared::new(&levels);
-    let prepared: Vec<(Prepared, DecoderInfo)> = first_level
-        .par_iter()
-        .map(|&l| {
-            let p = prepare(&levels[l], &opts.cache, &shared)?;
-            let done = ready.fetch_add(1, Ordering::SeqCst) + 1;
-            observer.decoder_ready(&p.1, done, first_level.len());
-            Ok(p)
-        })
-        .collect::<Result<_>>()?;
+    let shared = Shared::build(&levels)?;
+    let prepared = prepare_all(&levels, &first_level, &opts.cache, &shared, observer)?;
     let manifest = Manifest {
         decoders: prepared.iter().map(|(_, i)| i.clone()).collect(),
         ..fresh
@@ -702,35 +862,30 @@ pub fn run_sweep(
     }
     let already = done;
     observer.episodes_done(done, items.len());
-    let chunk = if opts.chunk > 0 {
+    let sync_every = if opts.chunk > 0 {
         opts.chunk
     } else {
         match spec.task {
             SweepTask::Grid => 256,
-            SweepTask::Epuck => 32,
+            SweepTask::Epuck => 16,
         }
     };
-    while done < items.len() {
-        if cancel.load(Ordering::SeqCst) {
-            return Ok(SweepOutcome::Interrupted {
-                done,
-                total: items.len(),
-            });
-        }
-        let end = (done + chunk).min(items.len());
-        let rows: Vec<String> = items[done..end]
-            .par_iter()
-            .map(|&g| {
-                let (l, k) = split(spec, g);
-                run_row(spec, &levels[l], &runners[l], k)
-            })
-            .collect::<Result<_>>()?;
-        let mut text = rows.join("\n");
-        text.push('\n');
-        file.write_all(text.as_bytes()).map_err(io)?;
-        file.sync_data().map_err(io)?;
-        done = end;
-        observer.episodes_done(done, items.len());
+    let job = EpisodeJob {
+        spec,
+        levels: &levels,
+        runners: &runners,
+        items: &items,
+        cancel,
+        observer,
+        sync_every,
+        window: 64 * rayon::current_num_threads(),
+    };
+    done = job.run(file, done, &episodes_path)?;
+    if done < items.len() {
+        return Ok(SweepOutcome::Interrupted {
+            done,
+            total: items.len(),
+        });
     }
     Ok(SweepOutcome::Complete {
         ran: done - already,

