@@ -150,33 +150,15 @@ impl EpochBankParts {
             generator: &generator,
             ..source
         };
-        let (noise, erp) = rayon::join(
-            || {
-                stream_pools(
-                    unit,
-                    params,
-                    per_class,
-                    seed,
-                    Components {
-                        erp: false,
-                        ..Components::default()
-                    },
-                )
-            },
-            || {
-                stream_pools(
-                    unit,
-                    params,
-                    per_class,
-                    seed,
-                    Components {
-                        background: false,
-                        artifacts: false,
-                        erp: true,
-                    },
-                )
-            },
-        );
+        let part = |erp: bool| {
+            let components = Components {
+                background: !erp,
+                artifacts: !erp,
+                erp,
+            };
+            stream_pools(unit, params, per_class, seed, components)
+        };
+        let (noise, erp) = rayon::join(|| part(false), || part(true));
         Ok(Self {
             noise: noise?,
             erp: erp?,
