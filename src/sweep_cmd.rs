@@ -275,7 +275,8 @@ pub fn sweep(args: &SweepArgs) -> Result<bool> {
         shard,
         chunk: 0,
     };
-    // Validate every level before any work.
+    // Validate every level before printing anything or starting work
+    // (`run_sweep` checks them again, before it creates the directory).
     spec.levels()?;
 
     let cancel = Arc::new(AtomicBool::new(false));

@@ -32,17 +32,24 @@ pub fn load_scenario(path: impl AsRef<Path>) -> Result<AnyScenario> {
 
 /// Validates scenario text of either task; `path` names it in errors.
 pub(crate) fn parse_scenario(text: &str, path: &Path) -> Result<AnyScenario> {
+    if is_epuck(text, path)? {
+        Ok(AnyScenario::Epuck(Box::new(EpuckScenario::parse(
+            text, path,
+        )?)))
+    } else {
+        Ok(AnyScenario::Grid(Box::new(Scenario::parse(text, path)?)))
+    }
+}
+
+/// True if the scenario text says `task = "epuck"`; any other task is left
+/// to the grid loader, which names the accepted values.
+pub(crate) fn is_epuck(text: &str, path: &Path) -> Result<bool> {
     #[derive(Deserialize)]
     struct Task {
         task: Option<String>,
     }
     let task: Task = parse_toml(text, path)?;
-    match task.task.as_deref() {
-        Some("epuck") => Ok(AnyScenario::Epuck(Box::new(EpuckScenario::parse(
-            text, path,
-        )?))),
-        _ => Ok(AnyScenario::Grid(Box::new(Scenario::parse(text, path)?))),
-    }
+    Ok(task.task.as_deref() == Some("epuck"))
 }
 
 #[derive(Debug, Deserialize)]

@@ -6,14 +6,13 @@
 //! which it also stores and compares on read: an entry for another request
 //! is never used. An unreadable entry is searched again and rewritten.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use errp_bci::TargetingResult;
 use serde::{Deserialize, Serialize};
 
+use super::run::write_atomic;
 use crate::error::Result;
-use crate::output::PendingFile;
 
 /// Where targeting results are kept (or nowhere).
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -102,14 +101,7 @@ impl TargetCache {
                 source,
             })?;
         }
-        let (pending, mut file) = PendingFile::create(path)?;
         let text = serde_json::to_string(entry).expect("a targeting result serialises");
-        file.write_all(text.as_bytes())
-            .map_err(|source| crate::SimError::Output {
-                path: path.to_path_buf(),
-                source,
-            })?;
-        pending.commit()?;
-        Ok(())
+        write_atomic(path, text.as_bytes())
     }
 }

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 use toml::{Table, Value};
 
-use crate::epuck_scenario::{AnyScenario, parse_scenario};
+use crate::epuck_scenario::{AnyScenario, is_epuck, parse_scenario};
 use crate::error::{Result, SimError};
 use crate::scenario::{parse_toml, read_scenario};
 
@@ -126,17 +126,6 @@ pub struct Level {
     pub values: Vec<Value>,
     /// The scenario with the level's values written in.
     pub scenario: AnyScenario,
-}
-
-impl Level {
-    /// `tau=0.3, strategy=greedy` (empty when no axis is swept).
-    pub fn series_label(&self, axes: &[Axis]) -> String {
-        axes.iter()
-            .zip(&self.values)
-            .map(|(a, v)| format!("{}={}", a.name, value_text(v)))
-            .collect::<Vec<_>>()
-            .join(", ")
-    }
 }
 
 /// A value as written in the CSV files and labels.
@@ -358,14 +347,10 @@ pub fn parse_axis(task: SweepTask, text: &str) -> Result<Axis> {
 /// The task of the scenario file at `path` and its text.
 pub fn read_task(path: &Path) -> Result<(SweepTask, String)> {
     let text = read_scenario(path)?;
-    #[derive(Deserialize)]
-    struct Task {
-        task: Option<String>,
-    }
-    let task: Task = parse_toml(&text, path)?;
-    let task = match task.task.as_deref() {
-        Some("epuck") => SweepTask::Epuck,
-        _ => SweepTask::Grid,
+    let task = if is_epuck(&text, path)? {
+        SweepTask::Epuck
+    } else {
+        SweepTask::Grid
     };
     Ok((task, text))
 }
@@ -414,6 +399,17 @@ impl SweepSpec {
         (accuracy, values)
     }
 
+    /// The label of a setting, one value per axis: `tau=0.3, strategy=greedy`
+    /// (empty when no axis is swept).
+    pub fn series_label(&self, values: &[Value]) -> String {
+        self.axes
+            .iter()
+            .zip(values)
+            .map(|(a, v)| format!("{}={}", a.name, value_text(v)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
     /// The seed of the calibration sessions. Every level uses the same
     /// session (the same background EEG, artifacts and schedule) with the
     /// ErrP amplitude targeted at its accuracy, so decoders differ only in
@@ -441,8 +437,8 @@ impl SweepSpec {
                 let mut t = base.clone();
                 let context = |why: String| {
                     let mut label = format!("accuracy={}", format_number(accuracy));
-                    for (a, v) in self.axes.iter().zip(&values) {
-                        label.push_str(&format!(", {}={}", a.name, value_text(v)));
+                    if !self.axes.is_empty() {
+                        label = format!("{label}, {}", self.series_label(&values));
                     }
                     SimError::Sweep(format!("sweep level {label}: {why}"))
                 };

@@ -207,13 +207,7 @@ impl Acc {
         series: &mut Vec<(String, StreamingPearson)>,
     ) -> LevelSummary {
         let (accuracy, values) = spec.level_values(self.level);
-        let label = spec
-            .axes
-            .iter()
-            .zip(&values)
-            .map(|(a, v)| format!("{}={}", a.name, value_text(v)))
-            .collect::<Vec<_>>()
-            .join(", ");
+        let label = spec.series_label(&values);
         let (mean, sd) = mean_sd(&self.cost);
         // Pairs with an undefined online accuracy are left out of r.
         let (x, y): (Vec<f64>, Vec<f64>) = self
