@@ -9,10 +9,10 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
-use errp_bci::{EdfWriter, GoalSet, TargetingStep, subject, subjects};
+use errp_bci::{EdfWriter, GoalSet, OnlineStep, TargetingStep, subject, subjects};
 use errp_sim::{
     AnyScenario, EpuckRecorder, EpuckScenario, PAPER_EPUCK, epuck_recording, load_scenario,
-    prepare_continuous_decoder, run_epuck_batch, run_epuck_once, summarise,
+    prepare_continuous_decoder_with, run_epuck_batch, run_epuck_once, summarise,
 };
 use errp_sim::{
     CalibrationRequest, DecoderChoice, EegMode, GridRunReport, PAPER, PAPER_POOLED, PendingFile,
@@ -625,7 +625,10 @@ fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<()> {
         scenario.runs = runs as usize;
     }
     if let Some(a) = args.accuracy {
+        // --accuracy replaces the scenario's decoder target, online or not.
         scenario.accuracy = a;
+        scenario.online_target = None;
+        scenario.params.control.assumed_accuracy = a;
     }
     if let Some(p) = &args.save {
         check_extension(p, "rrd", "--save")?;
@@ -635,22 +638,45 @@ fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<()> {
         None => None,
     };
     let quiet = args.quiet;
+    let decoder_text = match scenario.online_target {
+        None => format!("decoder accuracy {:.2} %", 100.0 * scenario.accuracy),
+        Some(t) => format!(
+            "decoder calibrated online for {:.1} % hits{}",
+            100.0 * t.hit_rate,
+            t.false_alarms_per_min
+                .map(|f| format!(" at {f} false alarms per minute"))
+                .unwrap_or_default()
+        ),
+    };
     let layout = &scenario.layout;
     let start = &scenario.episode.start;
     let goal = &layout.goals()[scenario.episode.goal].name;
     if !quiet {
         eprintln!(
-            "{}: e-puck from ({:.0}, {:.0}) cm to {goal}, {} run(s), decoder accuracy {:.2} %, seed {}",
+            "{}: e-puck from ({:.0}, {:.0}) cm to {goal}, {} run(s), {decoder_text}, seed {}",
             scenario.name,
             100.0 * start.x_m,
             100.0 * start.y_m,
             scenario.runs,
-            100.0 * scenario.accuracy,
             scenario.seed
         );
     }
-    let (decoder, report) = prepare_continuous_decoder(&scenario, calibration_progress(quiet))
-        .context("calibrating the continuous decoder")?;
+    let (decoder, report) = prepare_continuous_decoder_with(
+        &scenario,
+        calibration_progress(quiet),
+        |s: &OnlineStep| {
+            if !quiet {
+                eprintln!(
+                    "  calibrating: ErrP-to-noise {:.4}, T_e {:.3} -> {:.1} % hits, {:.2} false alarms/min",
+                    s.ratio,
+                    s.t_e,
+                    100.0 * s.point.hit_rate,
+                    s.point.false_alarms_per_min
+                );
+            }
+        },
+    )
+    .context("calibrating the continuous decoder")?;
     let acc = report.calibrated.accuracy;
     println!(
         "SVM decoder calibrated on {} error + {} correct button-locked examples: correct {:.2} %, \
@@ -662,16 +688,22 @@ fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<()> {
         100.0 * acc.mean(),
         decoder.model.n_support()
     );
+    if let Some(online) = &decoder.online {
+        print!("{online}");
+    }
     let results = match &rrd {
         Some(file) => {
-            let mut recorder =
-                EpuckRecorder::new(file, &scenario.arena, layout, scenario.params.control.t_e)?;
+            let mut recorder = EpuckRecorder::new(
+                file,
+                &scenario.arena,
+                layout,
+                decoder.t_e(scenario.params.control.t_e),
+            )?;
             let mut out = Vec::with_capacity(scenario.runs);
             for k in 0..scenario.runs {
                 recorder.next_run(&format!(
-                    "run {}: the user wants {goal} (decoder accuracy {:.2} %)",
-                    k + 1,
-                    100.0 * scenario.accuracy
+                    "run {}: the user wants {goal} ({decoder_text})",
+                    k + 1
                 ));
                 out.push(run_epuck_once(&scenario, &decoder, k, &mut recorder)?);
             }
@@ -686,7 +718,7 @@ fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<()> {
         }
     };
     println!(
-        "{:>4}  {:<16} {:>8}  {:>8} {:>6} {:>6} {:>6}  {:>8} {:>8}",
+        "{:>4}  {:<16} {:>8}  {:>8} {:>6} {:>6} {:>6}  {:>8} {:>8}  {:>5} {:>6}",
         "run",
         "converged on",
         "time (s)",
@@ -695,7 +727,9 @@ fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<()> {
         "missed",
         "ErrPs",
         "acc corr",
-        "acc err"
+        "acc err",
+        "hit %",
+        "FA/min"
     );
     for (k, r) in results.iter().enumerate() {
         let on = match r.committed {
@@ -704,7 +738,7 @@ fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<()> {
             None => "time-out".into(),
         };
         println!(
-            "{:>4}  {:<16} {:>8.1}  {:>8} {:>6} {:>6} {:>6}  {:>8.1} {:>8.1}",
+            "{:>4}  {:<16} {:>8.1}  {:>8} {:>6} {:>6} {:>6}  {:>8.1} {:>8.1}  {:>5.0} {:>6.2}",
             k + 1,
             on,
             r.time_secs,
@@ -713,7 +747,9 @@ fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<()> {
             r.missed_errors,
             r.errps,
             100.0 * r.online.correct,
-            100.0 * r.online.error
+            100.0 * r.online.error,
+            100.0 * r.hit_rate(),
+            r.false_alarms_per_min()
         );
     }
     let s = summarise(&results);
@@ -736,10 +772,23 @@ fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<()> {
     );
     println!("  median false         {:.1}", s.median_false);
     println!(
+        "  detections           {:.3} per second of run; {:.0} % turning, {:.0} % driving, \
+         {:.0} % on a goal   [paper: 0.18 and 0.21, mostly during turns]",
+        s.detections_per_sec,
+        100.0 * s.phase_shares[0],
+        100.0 * s.phase_shares[1],
+        100.0 * s.phase_shares[2]
+    );
+    println!(
+        "  online detector      hit rate {:.1} % per ErrP, {:.2} false alarms per error-free minute",
+        100.0 * s.hit_rate,
+        s.false_alarms_per_min
+    );
+    println!(
         "  window accuracy      correct {:.2} %, error {:.2} % at T_e = {} ({} clean / {} ErrP windows)",
         100.0 * s.online.correct,
         100.0 * s.online.error,
-        scenario.params.control.t_e,
+        decoder.t_e(scenario.params.control.t_e),
         s.online.n_correct,
         s.online.n_error
     );

@@ -17,7 +17,9 @@
 //!   an 800 ms window ([`ContinuousFeatures`], [`ThetaPsd`]), an RBF SVM with
 //!   Platt-scaled output ([`SvmDecoder`]), its trigger-locked calibration
 //!   ([`calibrate_continuous`]) and accuracy targeting
-//!   ([`target_continuous_accuracy`]);
+//!   ([`target_continuous_accuracy`]), and its online side: the sliding
+//!   window ([`SlidingWindow`]), the asynchronous [`Detector`] and its
+//!   operating point on a held-out recording ([`operating_point`]);
 //! * the subjects of Table 1 ([`subject`]) and EDF+ export ([`EdfWriter`]).
 
 mod calibration;
@@ -33,6 +35,7 @@ mod generator;
 mod lda;
 mod montage;
 mod noise;
+mod online;
 mod platt;
 mod preprocess;
 mod psd;
@@ -62,6 +65,12 @@ pub use generator::{Assessment, Components, EegBlock, EegGenerator, GeneratorPar
 pub use lda::{LdaDecoder, LdaModel, Shrinkage, ledoit_wolf_shrinkage, pca_basis};
 pub use montage::{Channel, ChannelKind, DECODING_CHANNELS, Montage};
 pub use noise::{PinkNoise, Resonator};
+pub use online::{
+    Decision, Detector, DetectorMode, DetectorParams, OnlineRecording, OnlineRecordingParams,
+    OnlineStep, OnlineTarget, OnlineTargeting, OperatingPoint, ResponseSpan, SPAN_FRACTION,
+    SlidingWindow, WARM_UP_SECS, WINDOW_STEP_SECS, operating_point, record_online, response_span,
+    target_online, threshold_for_false_alarms,
+};
 pub use platt::PlattScaling;
 pub use preprocess::{PreprocessParams, Preprocessor};
 pub use psd::ThetaPsd;

@@ -36,6 +36,14 @@ pub struct ContinuousControlParams {
     /// Length of a stop, on a goal or after a detected error, s; the paper:
     /// "for a second". > 0.
     pub stop_secs: f64,
+    /// Least length of a stop on a goal, s: the time the user's verdict on
+    /// the arrival needs to reach the decoder (0: `stop_secs`, the paper's
+    /// literal stop). In [0, 10].
+    pub goal_hold_secs: f64,
+    /// After the robot leaves a goal, a detected error within this time is
+    /// the user's late verdict on the stop (a veto of that goal), not on the
+    /// new motion, s (0: none, the paper read literally). In [0, 10].
+    pub veto_window_secs: f64,
     /// Forward speed while driving, as a fraction of the top speed. In (0, 1].
     pub drive_speed_fraction: f64,
     /// Wheel speed while turning in place (one wheel forwards, one
@@ -74,6 +82,8 @@ impl Default for ContinuousControlParams {
             sigma_deg: 20.0,
             p_c: 0.4,
             stop_secs: 1.0,
+            goal_hold_secs: 0.0,
+            veto_window_secs: 0.0,
             drive_speed_fraction: 0.5,
             turn_speed_fraction: 0.25,
             align_tolerance_deg: 3.0,
@@ -116,7 +126,24 @@ impl ContinuousControlParams {
             ),
         )?;
         check(open01(self.p_c), "p_c", self.p_c, "in (0, 1)")?;
-        check(self.stop_secs > 0.0, "stop_secs", self.stop_secs, "> 0")?;
+        check(
+            self.stop_secs > 0.0 && self.stop_secs <= 10.0,
+            "stop_secs",
+            self.stop_secs,
+            "in (0, 10] s (the paper: 1)",
+        )?;
+        check(
+            (0.0..=10.0).contains(&self.goal_hold_secs),
+            "goal_hold_secs",
+            self.goal_hold_secs,
+            "in [0, 10] s",
+        )?;
+        check(
+            (0.0..=10.0).contains(&self.veto_window_secs),
+            "veto_window_secs",
+            self.veto_window_secs,
+            "in [0, 10] s",
+        )?;
         check(
             half_open01(self.drive_speed_fraction),
             "drive_speed_fraction",

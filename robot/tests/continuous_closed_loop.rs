@@ -84,7 +84,7 @@ fn run_with(
             let dh = wrap_angle(pose.heading_rad - window_heading);
             window_heading = pose.heading_rad;
             let p = truth.map_or(0.05, |g| oracle_p(&c, &pose, dh, g));
-            let o = c.observe(p, &pose, t).unwrap();
+            let o = c.observe(p >= c.params().t_e, &pose, t).unwrap();
             detections += usize::from(o.detected);
             if o.converged.is_some() {
                 return Run {

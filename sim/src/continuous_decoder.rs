@@ -3,9 +3,12 @@
 //! that slides every 62.5 ms over streamed EEG.
 
 use errp_bci::{
-    Calibrated, ContinuousFeatures, ContinuousSetup, EegBlock, EegGenerator, ErrorModel,
-    GeneratorParams, Montage, Preprocessor, SvmDecoder, SvmModel, TargetingParams, TargetingResult,
-    TargetingStep, calibrate_continuous, target_continuous_accuracy,
+    Accuracy, Calibrated, ContinuousFeatures, ContinuousSetup, Detector, DetectorMode,
+    DetectorParams, EegGenerator, GeneratorParams, Montage, OnlineRecordingParams, OnlineStep,
+    OnlineTarget, OnlineTargeting, OperatingPoint, Preprocessor, ResponseSpan, SPAN_FRACTION,
+    SlidingWindow, SvmDecoder, SvmModel, TargetingParams, TargetingResult, TargetingStep,
+    calibrate_continuous, operating_point, record_online, response_span, rng::derive_seed,
+    target_continuous_accuracy, target_online,
 };
 
 use crate::error::Result;
@@ -89,8 +92,164 @@ pub fn calibrate_continuous_at(
     })
 }
 
+/// What the calibrated decoder does online, measured at calibration time on
+/// a held-out continuous recording (same user, fresh EEG): the span over
+/// which its windows respond to an ErrP, and the operating point of the
+/// scenario's detector beside the paper's literal per-window reading.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OnlineReport {
+    /// Window ends, after an ErrP's time zero, at which the decoder's
+    /// windows respond (p(error) >= T_e clearly above its background rate).
+    pub window_span: ResponseSpan,
+    /// The detector in force.
+    pub detector: DetectorParams,
+    /// T_e.
+    pub t_e: f64,
+    /// The detector in force, scored per ErrP and per minute of error-free
+    /// time over `window_span` delayed by its smoothing.
+    pub point: OperatingPoint,
+    /// Each window against T_e on its own (the paper read literally).
+    pub literal: OperatingPoint,
+}
+
+impl OnlineReport {
+    /// Records `params` of held-out EEG through the calibrated pipeline and
+    /// scores `detector` and the literal reading on it.
+    pub fn measure(
+        decoder: &ContinuousDecoder,
+        detector: DetectorParams,
+        t_e: f64,
+        params: &OnlineRecordingParams,
+        seed: u64,
+    ) -> Result<Self> {
+        let recording = record_online(
+            &decoder.generator,
+            &decoder.montage,
+            &decoder.preprocessor,
+            &decoder.model,
+            params,
+            seed,
+        )?;
+        let window_span = response_span(&recording, t_e, SPAN_FRACTION);
+        let point = operating_point(
+            &recording,
+            Detector::new(detector, t_e)?,
+            window_span.delayed(detector.delay_secs()),
+        );
+        let literal = operating_point(
+            &recording,
+            Detector::new(DetectorParams::literal(), t_e)?,
+            window_span,
+        );
+        Ok(Self {
+            window_span,
+            detector,
+            t_e,
+            point,
+            literal,
+        })
+    }
+}
+
+impl std::fmt::Display for OnlineReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let row = |f: &mut std::fmt::Formatter<'_>, name: &str, p: &OperatingPoint| {
+            writeln!(
+                f,
+                "  {name:<34} hit rate {:5.1} %  false alarms {:5.2}/min  median latency {:.2} s",
+                100.0 * p.hit_rate,
+                p.false_alarms_per_min,
+                p.median_latency_secs
+            )
+        };
+        writeln!(
+            f,
+            "Online operating point (held-out recording: {} ErrPs, {:.1} min error-free; \
+             windows respond {:.2}-{:.2} s after an ErrP):",
+            self.point.n_errps,
+            self.point.clean_minutes,
+            self.window_span.from_secs,
+            self.window_span.to_secs
+        )?;
+        let t_e = format!("{:.3}", self.t_e);
+        let t_e = t_e.trim_end_matches('0').trim_end_matches('.');
+        let name = match self.detector.mode {
+            DetectorMode::Smoothed => format!(
+                "detector: mean of {} windows >= {t_e}",
+                self.detector.smooth_windows
+            ),
+            DetectorMode::Literal => format!("detector: each window >= {t_e}"),
+        };
+        row(f, &name, &self.point)?;
+        if self.detector.mode != DetectorMode::Literal {
+            row(f, &format!("literal: each window >= {t_e}"), &self.literal)?;
+        }
+        Ok(())
+    }
+}
+
+/// Calibrates the continuous decoder for an online operating point: the
+/// ErrP-to-noise ratio (and T_e, if false alarms are targeted) at which
+/// `detector`, run over the held-out recording of
+/// [`ContinuousDecoder::measure_online`], meets `target`. Every evaluation
+/// is a full calibration at the ratio tried. Returns the calibration at the
+/// ratio found and the search.
+pub fn run_online_calibration(
+    request: &ContinuousRequest,
+    target: OnlineTarget,
+    detector: DetectorParams,
+    t_e: f64,
+    progress: impl FnMut(&OnlineStep),
+) -> Result<(ContinuousReport, OnlineTargeting)> {
+    let at = |ratio: f64| -> Result<ContinuousReport> {
+        let mut report = calibrate_continuous_at(
+            request,
+            TargetingResult {
+                requested: target.hit_rate,
+                ratio,
+                accuracy: Accuracy {
+                    correct: f64::NAN,
+                    error: f64::NAN,
+                    n_correct: 0,
+                    n_error: 0,
+                },
+                steps: Vec::new(),
+            },
+        )?;
+        report.targeting.accuracy = report.calibrated.accuracy;
+        Ok(report)
+    };
+    let search = target_online(
+        target,
+        detector,
+        t_e,
+        request.search.max_ratio,
+        0.02,
+        request.search.max_evaluations,
+        |ratio| -> Result<_> {
+            let d = ContinuousDecoder::from_report(&at(ratio)?);
+            Ok(record_online(
+                &d.generator,
+                &d.montage,
+                &d.preprocessor,
+                &d.model,
+                &OnlineRecordingParams::default(),
+                held_out_seed(request.seed),
+            )?)
+        },
+        progress,
+    )?;
+    Ok((at(search.ratio)?, search))
+}
+
+/// The seed of the held-out recording of a calibration seeded `seed`.
+fn held_out_seed(seed: u64) -> u64 {
+    derive_seed(seed, "online/held-out", 0)
+}
+
 /// The calibrated online pipeline: the user's EEG model, the preprocessing
-/// fitted on the calibration's EOG recording, and the trained SVM.
+/// fitted on the calibration's EOG recording, the trained SVM, and what it
+/// does online.
 #[derive(Debug, Clone)]
 pub struct ContinuousDecoder {
     /// The synthetic user's EEG model (at the calibrated ErrP-to-noise ratio).
@@ -103,10 +262,13 @@ pub struct ContinuousDecoder {
     pub model: SvmModel,
     /// Temporal + theta PSD features of one window.
     pub features: ContinuousFeatures,
+    /// The operating point on a held-out recording (set by
+    /// [`measure_online`](Self::measure_online)).
+    pub online: Option<OnlineReport>,
 }
 
 impl ContinuousDecoder {
-    /// The online decoder a calibration produced.
+    /// The online decoder a calibration produced, not yet measured online.
     pub fn from_report(report: &ContinuousReport) -> Self {
         Self {
             generator: report.generator.clone(),
@@ -114,88 +276,66 @@ impl ContinuousDecoder {
             preprocessor: report.calibrated.session.preprocessor.clone(),
             model: report.calibrated.model.clone(),
             features: ContinuousFeatures::paper(report.generator.sfreq_hz),
+            online: None,
         }
     }
 
-    /// Samples between two decoder windows: 62.5 ms (sec. 2.2.2).
-    pub fn hop_samples(&self) -> usize {
-        (0.0625 * self.generator.sfreq_hz).round() as usize
+    /// Measures the operating point of `detector` at threshold `t_e` on a
+    /// held-out recording drawn from `seed` and keeps it.
+    pub fn measure_online(&mut self, detector: DetectorParams, t_e: f64, seed: u64) -> Result<()> {
+        let report = OnlineReport::measure(
+            self,
+            detector,
+            t_e,
+            &OnlineRecordingParams::default(),
+            held_out_seed(seed),
+        )?;
+        self.online = Some(report);
+        Ok(())
     }
-}
 
-/// Seconds of EEG streamed before an episode so the causal filters settle.
-pub const WARM_UP_SECS: f64 = 2.0;
+    /// The span over which detections (of the detector in force) and windows
+    /// are attributed to an ErrP: measured if
+    /// [`measure_online`](Self::measure_online) ran, else the span the
+    /// features can see.
+    pub fn detection_span(&self) -> ResponseSpan {
+        self.online.as_ref().map_or(
+            ResponseSpan {
+                from_secs: 0.45,
+                to_secs: 1.1,
+            },
+            |o| o.point.span,
+        )
+    }
 
-/// Streamed EEG and the sliding window over its preprocessed channels.
-pub(crate) struct OnlineWindow {
-    pub(crate) generator: EegGenerator,
-    preprocessor: Preprocessor,
-    features: ContinuousFeatures,
-    window: EegBlock,
-    scratch: Vec<f64>,
-    raw: EegBlock,
-    /// Rows of FCz and Cz among the preprocessed channels.
-    pub(crate) fcz_cz: [usize; 2],
-}
+    /// The threshold the detector runs at: the one its operating point was
+    /// measured at (calibrated, with an online false-alarm target), else
+    /// `scenario_t_e`.
+    pub fn t_e(&self, scenario_t_e: f64) -> f64 {
+        self.online.as_ref().map_or(scenario_t_e, |o| o.t_e)
+    }
 
-impl OnlineWindow {
-    /// Starts the stream and lets the filters settle; the episode's time 0
-    /// is generator time [`WARM_UP_SECS`].
-    pub(crate) fn start(d: &ContinuousDecoder, seed: u64) -> Result<Self> {
-        let fs = d.generator.sfreq_hz;
-        let mut generator = EegGenerator::new(d.generator.clone(), &d.montage, seed)?;
-        let mut preprocessor = d.preprocessor.clone();
-        preprocessor.reset();
-        let warm = preprocessor.process(&generator.generate((WARM_UP_SECS * fs) as usize));
-        let span = d.features.span();
-        let mut window = EegBlock::zeros(warm.n_channels, span);
-        for ch in 0..warm.n_channels {
-            let src = warm.channel(ch);
-            window
-                .channel_mut(ch)
-                .copy_from_slice(&src[src.len() - span..]);
-        }
-        let row = |name: &str| -> Result<usize> {
-            let i = d.montage.index(name)?;
-            Ok(preprocessor
-                .outputs()
-                .iter()
-                .position(|&o| o == i)
-                .unwrap_or(0))
-        };
-        let fcz_cz = [row("FCz")?, row("Cz")?];
-        let n_ch = d.montage.len();
-        Ok(Self {
+    /// The span over which single windows respond to an ErrP.
+    pub fn window_span(&self) -> ResponseSpan {
+        self.online.as_ref().map_or(
+            ResponseSpan {
+                from_secs: 0.45,
+                to_secs: 1.1,
+            },
+            |o| o.window_span,
+        )
+    }
+
+    /// Starts the online stream for one episode: EEG from `seed`, the
+    /// filters settled; episode time 0 is generator time
+    /// [`WARM_UP_SECS`](errp_bci::WARM_UP_SECS).
+    pub fn start_stream(&self, seed: u64) -> Result<SlidingWindow> {
+        let generator = EegGenerator::new(self.generator.clone(), &self.montage, seed)?;
+        Ok(SlidingWindow::start(
             generator,
-            preprocessor,
-            features: d.features.clone(),
-            window,
-            scratch: Vec::with_capacity(d.features.n_features(warm.n_channels)),
-            raw: EegBlock::zeros(n_ch, d.hop_samples()),
-            fcz_cz,
-        })
-    }
-
-    /// Streams `hop` more samples through the preprocessing, slides the
-    /// window, and returns the new preprocessed samples `(n_channels, hop)`.
-    pub(crate) fn advance(&mut self) -> EegBlock {
-        self.generator.generate_into(&mut self.raw);
-        let fresh = self.preprocessor.process(&self.raw);
-        let hop = fresh.n_samples;
-        for ch in 0..fresh.n_channels {
-            let w = self.window.channel_mut(ch);
-            w.copy_within(hop.., 0);
-            let n = w.len();
-            w[n - hop..].copy_from_slice(fresh.channel(ch));
-        }
-        fresh
-    }
-
-    /// p(error) of the current window.
-    pub(crate) fn p_error(&mut self, model: &SvmModel) -> f64 {
-        self.scratch.clear();
-        self.features
-            .extract_into(&self.window, 0, &mut self.scratch);
-        model.p_error(&self.scratch)
+            &self.preprocessor,
+            &self.features,
+            &self.montage,
+        )?)
     }
 }

@@ -2,11 +2,12 @@
 //! scenario's accuracy, then every run of the episode, each from its own
 //! derived seed (in parallel when no recording watches).
 
-use errp_bci::{Accuracy, TargetingStep, rng::derive_seed};
+use errp_bci::{Accuracy, OnlineStep, TargetingStep, rng::derive_seed};
 use rayon::prelude::*;
 
 use crate::continuous_decoder::{
     ContinuousDecoder, ContinuousReport, ContinuousRequest, run_continuous_calibration,
+    run_online_calibration,
 };
 use crate::epuck_scenario::EpuckScenario;
 use crate::epuck_task::{EpuckEpisodeResult, EpuckObserver, run_epuck_episode};
@@ -17,16 +18,62 @@ use crate::error::Result;
 pub const PAPER_EPUCK: [(&str, f64, usize); 2] =
     [("Mexico to Pisa", 60.0, 11), ("Lisbon to Tokyo", 121.0, 26)];
 
-/// Calibrates the scenario's continuous decoder (`progress` sees the search).
+/// Calibrates the scenario's continuous decoder (`progress` sees the search)
+/// and measures its online operating point with the scenario's detector.
+///
+/// With an online target (`[user] hit_rate`), `online_progress` sees that
+/// search instead, and the decoder's T_e is the one it calibrated
+/// ([`ContinuousDecoder::t_e`]).
 pub fn prepare_continuous_decoder(
     scenario: &EpuckScenario,
     progress: impl FnMut(&TargetingStep),
 ) -> Result<(ContinuousDecoder, ContinuousReport)> {
-    let report = run_continuous_calibration(
-        &ContinuousRequest::new(scenario.accuracy, scenario.seed),
-        progress,
+    prepare_continuous_decoder_with(scenario, progress, |_| {})
+}
+
+/// [`prepare_continuous_decoder`] with a progress callback for each kind of
+/// search.
+pub fn prepare_continuous_decoder_with(
+    scenario: &EpuckScenario,
+    progress: impl FnMut(&TargetingStep),
+    online_progress: impl FnMut(&OnlineStep),
+) -> Result<(ContinuousDecoder, ContinuousReport)> {
+    let request = ContinuousRequest::new(scenario.accuracy, scenario.seed);
+    match scenario.online_target {
+        None => {
+            let report = run_continuous_calibration(&request, progress)?;
+            Ok((finish_continuous_decoder(scenario, &report)?, report))
+        }
+        Some(target) => {
+            let (report, search) = run_online_calibration(
+                &request,
+                target,
+                scenario.params.detector,
+                scenario.params.control.t_e,
+                online_progress,
+            )?;
+            let mut decoder = ContinuousDecoder::from_report(&report);
+            decoder.measure_online(scenario.params.detector, search.t_e, scenario.seed)?;
+            Ok((decoder, report))
+        }
+    }
+}
+
+/// The online decoder of a finished calibration, with the operating point
+/// of the scenario's detector measured on a held-out recording (seeded by
+/// the scenario's seed): the last step of every path that prepares an
+/// e-puck decoder.
+pub fn finish_continuous_decoder(
+    scenario: &EpuckScenario,
+    report: &ContinuousReport,
+) -> Result<ContinuousDecoder> {
+    let mut decoder = ContinuousDecoder::from_report(report);
+    decoder.measure_online(
+        scenario.params.detector,
+        scenario.params.control.t_e,
+        scenario.seed,
     )?;
-    Ok((ContinuousDecoder::from_report(&report), report))
+    Ok(decoder)
 }
 
 /// The seed of run `k` of a scenario with base seed `seed`.
@@ -97,12 +144,22 @@ pub struct EpuckSummary {
     pub median_false: f64,
     /// Window accuracy pooled over every run.
     pub online: Accuracy,
+    /// Detections per second of run, pooled over every run.
+    pub detections_per_sec: f64,
+    /// Shares of all detections made while turning, driving and stopped on
+    /// a goal.
+    pub phase_shares: [f64; 3],
+    /// Hit rate per ErrP, pooled over every run.
+    pub hit_rate: f64,
+    /// False detections per minute of error-free time, pooled.
+    pub false_alarms_per_min: f64,
 }
 
 /// Summarises `results`.
 pub fn summarise(results: &[EpuckEpisodeResult]) -> EpuckSummary {
     let ok: Vec<&EpuckEpisodeResult> = results.iter().filter(|r| r.reached()).collect();
     let col = |f: &dyn Fn(&EpuckEpisodeResult) -> f64| ok.iter().map(|r| f(r)).collect::<Vec<_>>();
+    let sum = |f: &dyn Fn(&EpuckEpisodeResult) -> f64| results.iter().map(f).sum::<f64>();
     EpuckSummary {
         runs: results.len(),
         reached: ok.len(),
@@ -114,5 +171,12 @@ pub fn summarise(results: &[EpuckEpisodeResult]) -> EpuckSummary {
         median_detected: median(&col(&|r| r.detected_errors as f64)),
         median_false: median(&col(&|r| r.false_detections as f64)),
         online: Accuracy::pooled(results.iter().map(|r| &r.online)),
+        detections_per_sec: sum(&|r| r.detected_errors as f64) / sum(&|r| r.time_secs),
+        phase_shares: {
+            let total = sum(&|r| r.detected_errors as f64).max(1.0);
+            [0, 1, 2].map(|k| sum(&|r| r.detected_by_phase[k] as f64) / total)
+        },
+        hit_rate: 1.0 - sum(&|r| r.missed_errors as f64) / sum(&|r| r.errps_scored as f64),
+        false_alarms_per_min: sum(&|r| r.false_detections as f64) / (sum(&|r| r.clean_secs) / 60.0),
     }
 }

@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use errp_bci::check_requested_accuracy;
+use errp_bci::{DetectorMode, DetectorParams, OnlineTarget, check_requested_accuracy};
 use errp_robot::{GoalLayout, Pose, Strategy};
 use serde::Deserialize;
 
@@ -78,7 +78,17 @@ struct EpuckFile {
     #[serde(default)]
     avoidance: Option<AvoidanceFile>,
     #[serde(default)]
+    detector: Option<DetectorFile>,
+    #[serde(default)]
     arena: Option<ArenaFile>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DetectorFile {
+    mode: Option<DetectorMode>,
+    smooth_windows: Option<usize>,
+    refractory_secs: Option<f64>,
 }
 
 fn default_seed() -> u64 {
@@ -104,7 +114,9 @@ enum StartFile {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct UserFile {
-    accuracy: f64,
+    accuracy: Option<f64>,
+    hit_rate: Option<f64>,
+    false_alarms_per_min: Option<f64>,
     fov_deg: Option<f64>,
     reaction_latency_ms: Option<f64>,
     reelicit_secs: Option<f64>,
@@ -122,6 +134,8 @@ struct ControlFile {
     stop_secs: Option<f64>,
     drive_speed_fraction: Option<f64>,
     turn_speed_fraction: Option<f64>,
+    goal_hold_secs: Option<f64>,
+    veto_window_secs: Option<f64>,
     strategy: Option<Strategy>,
 }
 
@@ -159,6 +173,11 @@ struct ObstacleFile {
     angle_deg: f64,
 }
 
+/// `f` of the `[control]` table, if there is one.
+fn c_opt(c: &Option<ControlFile>, f: impl Fn(&ControlFile) -> Option<f64>) -> Option<f64> {
+    c.as_ref().and_then(f)
+}
+
 /// A validated e-puck scenario.
 #[derive(Debug, Clone)]
 pub struct EpuckScenario {
@@ -170,8 +189,11 @@ pub struct EpuckScenario {
     pub description: String,
     /// Base seed (calibration and runs).
     pub seed: u64,
-    /// The continuous decoder's cross-validated mean accuracy, in (0.5, 1).
+    /// The continuous decoder's cross-validated mean accuracy, in (0.5, 1)
+    /// (with an online target: its hit rate, as the device assumes it).
     pub accuracy: f64,
+    /// Calibrate for this online operating point instead of the accuracy.
+    pub online_target: Option<OnlineTarget>,
     /// Runs of the episode, each from its own derived seed.
     pub runs: usize,
     /// Start pose and goal.
@@ -261,13 +283,66 @@ impl EpuckScenario {
             ));
         }
 
-        check_requested_accuracy(file.user.accuracy).map_err(|e| {
-            bad(
-                "user.accuracy",
-                file.user.accuracy.to_string(),
-                &e.to_string(),
-            )
-        })?;
+        let u = &file.user;
+        let online_target = match (u.accuracy, u.hit_rate, u.false_alarms_per_min) {
+            (Some(a), None, None) => {
+                check_requested_accuracy(a)
+                    .map_err(|e| bad("user.accuracy", a.to_string(), &e.to_string()))?;
+                None
+            }
+            (None, Some(h), fa) => {
+                let target = OnlineTarget {
+                    hit_rate: h,
+                    false_alarms_per_min: fa,
+                };
+                target.validate().map_err(|e| match e {
+                    errp_bci::BciError::InvalidParameter {
+                        name,
+                        value,
+                        expected,
+                    } => bad(&format!("user.{name}"), value, &expected),
+                    other => SimError::Scenario(format!("{}: [user] {other}", path.display())),
+                })?;
+                if fa.is_some() && file.control.as_ref().is_some_and(|c| c.t_e.is_some()) {
+                    return Err(bad(
+                        "control.t_e",
+                        "given".into(),
+                        "no t_e when user.false_alarms_per_min is given: T_e is then \
+                         calibrated to meet that false-alarm rate",
+                    ));
+                }
+                Some(target)
+            }
+            (None, None, Some(f)) => {
+                return Err(bad(
+                    "user.false_alarms_per_min",
+                    f.to_string(),
+                    "user.hit_rate beside it (an online operating point is a hit rate and, \
+                     optionally, a false-alarm rate)",
+                ));
+            }
+            (None, None, None) => {
+                return Err(bad(
+                    "user.accuracy",
+                    "missing".into(),
+                    "the decoder: accuracy = A (cross-validated mean accuracy in (0.5, 1)) or \
+                     hit_rate = H [and false_alarms_per_min = F] (the online operating point)",
+                ));
+            }
+            (Some(a), _, _) => {
+                return Err(bad(
+                    "user.accuracy",
+                    a.to_string(),
+                    "either accuracy or hit_rate [and false_alarms_per_min], not both",
+                ));
+            }
+        };
+        // The accuracy the device assumes (info gain): the cross-validated
+        // accuracy, or the targeted hit rate.
+        let accuracy = match online_target {
+            None => u.accuracy.unwrap_or(0.0),
+            Some(t) => t.hit_rate.max(0.51),
+        };
         if let Some(v) = file.user.fov_deg {
             params.user.fov_rad = v.to_radians();
         }
@@ -302,8 +377,60 @@ impl EpuckScenario {
                 p.strategy = strategy;
             }
         }
+        for (field, v) in [
+            ("goal_hold_secs", c_opt(&file.control, |c| c.goal_hold_secs)),
+            (
+                "veto_window_secs",
+                c_opt(&file.control, |c| c.veto_window_secs),
+            ),
+        ] {
+            if let Some(v) = v
+                && !(v.is_finite() && (0.0..=10.0).contains(&v))
+            {
+                return Err(bad(
+                    &format!("control.{field}"),
+                    v.to_string(),
+                    "a time in [0, 10] s (omit it for the automatic value)",
+                ));
+            }
+        }
+        params.goal_hold_secs = c_opt(&file.control, |c| c.goal_hold_secs);
+        params.veto_window_secs = c_opt(&file.control, |c| c.veto_window_secs);
+        if let Some(d) = &file.detector {
+            let p = &mut params.detector;
+            if let Some(m) = d.mode {
+                *p = match m {
+                    DetectorMode::Literal => DetectorParams::literal(),
+                    DetectorMode::Smoothed => DetectorParams::default(),
+                };
+            }
+            if let Some(n) = d.smooth_windows {
+                p.smooth_windows = n;
+            }
+            if let Some(r) = d.refractory_secs {
+                p.refractory_secs = r;
+            }
+            if p.mode == DetectorMode::Literal
+                && (d.smooth_windows.is_some() || d.refractory_secs.is_some())
+            {
+                return Err(bad(
+                    "detector.mode",
+                    "\"literal\"".into(),
+                    "\"smoothed\" when smooth_windows or refractory_secs is given (the \
+                     literal reading compares each window with T_e on its own)",
+                ));
+            }
+            p.validate().map_err(|e| match e {
+                errp_bci::BciError::InvalidParameter {
+                    name,
+                    value,
+                    expected,
+                } => bad(&format!("detector.{name}"), value, &expected),
+                other => SimError::Scenario(format!("{}: [detector] {other}", path.display())),
+            })?;
+        }
         // The device knows its decoder's accuracy from the calibration.
-        params.control.assumed_accuracy = file.user.accuracy;
+        params.control.assumed_accuracy = accuracy;
         params
             .control
             .validate()
@@ -442,7 +569,8 @@ impl EpuckScenario {
             name: scenario_name(file.name, path),
             description: file.description.unwrap_or_default(),
             seed: file.seed,
-            accuracy: file.user.accuracy,
+            accuracy,
+            online_target,
             runs: file.runs,
             episode: EpuckEpisode { start, goal },
             arena,
@@ -478,6 +606,73 @@ accuracy = 0.7438
         assert_eq!(s.layout.goals()[s.episode.goal].name, "Pisa");
         assert!((s.episode.start.x_m - 0.2).abs() < 1e-12);
         assert!(s.arena.obstacles.is_empty());
+    }
+
+    #[test]
+    fn the_decoder_is_an_accuracy_or_an_online_operating_point() {
+        let online = OK.replace(
+            "accuracy = 0.7438",
+            "hit_rate = 0.9\nfalse_alarms_per_min = 0.5",
+        );
+        let s = EpuckScenario::parse(&online, Path::new("x.toml")).unwrap();
+        let t = s.online_target.unwrap();
+        assert_eq!((t.hit_rate, t.false_alarms_per_min), (0.9, Some(0.5)));
+        assert_eq!(s.params.control.assumed_accuracy, 0.9);
+        for (text, field, range) in [
+            (
+                OK.replace("accuracy = 0.7438", "accuracy = 0.8\nhit_rate = 0.9"),
+                "user.accuracy",
+                "not both",
+            ),
+            (
+                OK.replace("accuracy = 0.7438", "false_alarms_per_min = 0.5"),
+                "user.false_alarms_per_min",
+                "user.hit_rate",
+            ),
+            (
+                OK.replace("accuracy = 0.7438", "hit_rate = 1.5"),
+                "user.hit_rate",
+                "(0, 1)",
+            ),
+            (
+                OK.replace(
+                    "accuracy = 0.7438",
+                    "hit_rate = 0.9\nfalse_alarms_per_min = 0",
+                ),
+                "user.false_alarms_per_min",
+                "(0, 60]",
+            ),
+            (
+                format!("{online}[control]\nt_e = 0.8\n"),
+                "control.t_e",
+                "calibrated",
+            ),
+            (
+                OK.replace("accuracy = 0.7438", ""),
+                "user.accuracy",
+                "hit_rate",
+            ),
+            (
+                format!("{OK}[detector]\nsmooth_windows = 40\n"),
+                "detector.smooth_windows",
+                "1 to 16",
+            ),
+            (
+                format!("{OK}[detector]\nmode = \"literal\"\nsmooth_windows = 3\n"),
+                "detector.mode",
+                "smoothed",
+            ),
+            (
+                format!("{OK}[control]\ngoal_hold_secs = -1\n"),
+                "control.goal_hold_secs",
+                "[0, 10]",
+            ),
+        ] {
+            let e = err(&text);
+            assert!(e.contains("scenarios/x.toml"), "{e}");
+            assert!(e.contains(field), "{field}: {e}");
+            assert!(e.contains(range), "{range}: {e}");
+        }
     }
 
     #[test]

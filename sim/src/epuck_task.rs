@@ -7,14 +7,17 @@
 //! through the preprocessing, the 800 ms window is decoded into p(error) and
 //! the controller updates its belief (eq. 6-7) and reacts to a detection.
 
-use errp_bci::{Accuracy, Assessment, AssessmentKind, rng::stream};
+use errp_bci::{
+    Accuracy, AssessmentKind, Detector, DetectorParams, ResponseSpan,
+    rng::{derive_seed, stream},
+};
 use errp_robot::{
-    ContinuousControlParams, ContinuousController, EpuckParams, GoalLayout, Phase, Pose,
+    ContinuousControlParams, ContinuousController, EpuckParams, GoalLayout, Pose, StepKind,
     WheelSpeeds, wrap_angle,
 };
 use serde::{Deserialize, Serialize};
 
-use crate::continuous_decoder::{ContinuousDecoder, OnlineWindow, WARM_UP_SECS};
+use crate::continuous_decoder::ContinuousDecoder;
 use crate::error::{Result, SimError};
 use crate::tracker::{CameraTracker, TrackerParams};
 use crate::user::{SyntheticUser, UserParams};
@@ -92,8 +95,30 @@ pub struct EpuckTaskParams {
     pub tracker: TrackerParams,
     /// Obstacle reflex.
     pub avoidance: AvoidanceParams,
+    /// How window outputs become detected errors.
+    pub detector: DetectorParams,
+    /// Least length of a stop on a goal (s); `None`: long enough for the
+    /// user's verdict on the arrival to reach the detector (the user's
+    /// motion window + reaction latency + the end of the detector's measured
+    /// response span).
+    pub goal_hold_secs: Option<f64>,
+    /// After the robot leaves a goal, detections within this time veto the
+    /// goal instead of stopping the robot (s); `None`: the end of the
+    /// detector's measured response span.
+    pub veto_window_secs: Option<f64>,
     /// The episode gives up after this long (s).
     pub max_secs: f64,
+}
+
+impl EpuckTaskParams {
+    /// The stop on a goal that lets the user's verdict reach a detector that
+    /// responds over `span` after an ErrP's time zero: the user needs up to
+    /// the motion window to see the stop and the reaction latency to react.
+    pub fn goal_hold_secs(&self, span: &ResponseSpan) -> f64 {
+        self.goal_hold_secs.unwrap_or(
+            self.user.motion_window_secs + self.user.reaction_latency_secs + span.to_secs,
+        )
+    }
 }
 
 impl Default for EpuckTaskParams {
@@ -103,6 +128,9 @@ impl Default for EpuckTaskParams {
             user: UserParams::default(),
             tracker: TrackerParams::default(),
             avoidance: AvoidanceParams::default(),
+            detector: DetectorParams::default(),
+            goal_hold_secs: None,
+            veto_window_secs: None,
             max_secs: 600.0,
         }
     }
@@ -111,15 +139,9 @@ impl Default for EpuckTaskParams {
 /// Physics steps per decoder window step.
 pub const STEPS_PER_WINDOW: usize = 4;
 /// The decoder's window step: 62.5 ms (sec. 2.2.2).
-pub const WINDOW_STEP_SECS: f64 = 0.0625;
+pub const WINDOW_STEP_SECS: f64 = errp_bci::WINDOW_STEP_SECS;
 /// The physics time step (s).
 pub const PHYSICS_DT_SECS: f64 = WINDOW_STEP_SECS / STEPS_PER_WINDOW as f64;
-/// An ErrP counts as inside a window ending at t if its time zero lies in
-/// [t - 0.8, t - 0.45] s: its three peaks (250-455 ms) are then inside.
-const ERRP_IN_WINDOW_SECS: (f64, f64) = (0.8, 0.45);
-/// A detection is attributed to an ErrP with time zero in [t - 0.8, t - 0.1].
-const DETECTION_SPAN_SECS: (f64, f64) = (0.8, 0.1);
-
 /// One physics step, for observers.
 #[derive(Debug, Clone, Copy)]
 pub struct PhysicsFrame {
@@ -140,11 +162,14 @@ pub struct WindowFrame {
     pub time_secs: f64,
     /// The decoder's output.
     pub p_error: f64,
+    /// What the detector compared with T_e (p(error) or its moving average).
+    pub evidence: f64,
     /// The belief after the update.
     pub belief: Vec<f64>,
     /// The goal the robot is heading to.
     pub target: usize,
-    /// Whether this window stopped the robot.
+    /// Whether the detector reported an error that the controller used (in
+    /// motion it stops the robot; on a goal it vetoes the goal).
     pub detected: bool,
     /// The tracked pose the controller used.
     pub tracked: Pose,
@@ -192,16 +217,27 @@ pub struct EpuckEpisodeResult {
     pub committed: Option<usize>,
     /// Time from the start to convergence, or to the time-out (s).
     pub time_secs: f64,
-    /// Errors detected (p >= T_e during motion: each stopped the robot).
+    /// Errors detected: the detector's events that the controller used
+    /// (while turning or driving each stopped the robot; on a goal each
+    /// vetoed it).
     pub detected_errors: usize,
-    /// Detections with no ErrP behind them.
+    /// Of those, while turning, while driving, and while stopped on a goal.
+    pub detected_by_phase: [usize; 3],
+    /// Detections with no ErrP behind them (none within the detector's
+    /// response span before them).
     pub false_detections: usize,
-    /// ErrPs elicited during motion that no window detected.
+    /// ErrPs whose response span ended within the episode with no
+    /// detection in it.
     pub missed_errors: usize,
     /// ErrPs elicited (error onsets and re-elicitations).
     pub errps: usize,
-    /// Per-window accuracy at T_e: windows holding an ErrP against windows
-    /// with none near.
+    /// ErrPs scored (their response span ended within the episode).
+    pub errps_scored: usize,
+    /// Error-free time the detector watched (s): windows outside every
+    /// ErrP's response span, the stops after a detection excluded.
+    pub clean_secs: f64,
+    /// Per-window accuracy at T_e: windows inside an ErrP's window response
+    /// span against windows with no ErrP near.
     pub online: Accuracy,
     /// Distance driven (m).
     pub path_m: f64,
@@ -215,6 +251,24 @@ impl EpuckEpisodeResult {
     /// True if the robot converged on the user's goal.
     pub fn reached(&self) -> bool {
         self.committed == Some(self.goal)
+    }
+
+    /// Share of the scored ErrPs that a detection followed (NaN if none).
+    pub fn hit_rate(&self) -> f64 {
+        if self.errps_scored == 0 {
+            f64::NAN
+        } else {
+            (self.errps_scored - self.missed_errors) as f64 / self.errps_scored as f64
+        }
+    }
+
+    /// False detections per minute of error-free time (NaN if none).
+    pub fn false_alarms_per_min(&self) -> f64 {
+        if self.clean_secs <= 0.0 {
+            f64::NAN
+        } else {
+            self.false_detections as f64 / (self.clean_secs / 60.0)
+        }
     }
 }
 
@@ -240,9 +294,16 @@ pub fn run_epuck_episode(
     let mut tracker = CameraTracker::new(params.tracker, stream(seed, "epuck/tracker"));
     let mut wheels_rng = stream(seed, "epuck/wheels");
     let mut user = SyntheticUser::new(params.user, layout, episode.goal);
-    let mut controller =
-        ContinuousController::new(params.control.clone(), layout.clone(), episode.start)?;
-    let mut eeg = OnlineWindow::start(decoder, errp_bci::rng::derive_seed(seed, "epuck/eeg", 0))?;
+    let span = decoder.detection_span();
+    let window_span = decoder.window_span();
+    let mut control = params.control.clone();
+    control.goal_hold_secs = params.goal_hold_secs(&span);
+    control.veto_window_secs = params.veto_window_secs.unwrap_or(span.to_secs);
+    let mut controller = ContinuousController::new(control, layout.clone(), episode.start)?;
+    let t_e = decoder.t_e(params.control.t_e);
+    let mut detector = Detector::new(params.detector, t_e)?;
+    let mut eeg = decoder.start_stream(derive_seed(seed, "epuck/eeg", 0))?;
+    let fcz_cz = eeg.fcz_cz();
 
     let watching = observer.watches();
     if watching {
@@ -253,27 +314,26 @@ pub fn run_epuck_episode(
     let mut time_secs = 0.0;
     let mut pose = world.pose();
     let mut tracked = tracker.observe(0.0, &pose);
-    let mut errps: Vec<(f64, bool)> = Vec::new(); // (time zero, during motion)
-    let mut recent = 0; // first ErrP that can still fall in a window
+    let mut errps: Vec<f64> = Vec::new(); // time zeros
+    let mut recent = 0; // first ErrP whose spans can still hold a window
     let mut detections: Vec<f64> = Vec::new();
     let mut detected_at = Vec::new();
+    let mut by_phase = [0usize; 3];
     let (mut hits, mut n_err_windows, mut false_alarms, mut n_clean_windows) = (0, 0, 0, 0);
+    let mut clean_windows = 0usize;
     let mut path_m = 0.0;
     let mut max_lateral: f64 = 0.0;
     let mut committed = None;
     let n_windows = (params.max_secs / WINDOW_STEP_SECS).ceil() as usize;
+    let horizon = span.to_secs.max(window_span.to_secs) + WINDOW_STEP_SECS;
     let mut last_target = controller.target();
     'episode: for _ in 0..n_windows {
         for _ in 0..STEPS_PER_WINDOW {
             if let Some(e) = user.observe(time_secs, &tracked) {
-                let moving = !matches!(controller.phase(), Phase::Stopped { .. });
                 if e.kind == AssessmentKind::Error {
-                    errps.push((e.onset_secs, moving));
+                    errps.push(e.onset_secs);
                 }
-                eeg.generator.schedule(Assessment {
-                    onset_secs: WARM_UP_SECS + e.onset_secs,
-                    kind: e.kind,
-                });
+                eeg.schedule(e.onset_secs, e.kind);
                 if watching && e.kind == AssessmentKind::Error {
                     observer.on_event(time_secs, "the user sees an error (ErrP)", false);
                 }
@@ -310,41 +370,54 @@ pub fn run_epuck_episode(
 
         let fresh = eeg.advance();
         let p_error = eeg.p_error(&decoder.model);
-        let obs = controller.observe(p_error, &tracked, time_secs)?;
+        let decision = detector.push(p_error, time_secs);
+        let obs = controller.observe(decision.detected, &tracked, time_secs)?;
+        let used = obs.step != StepKind::Idle;
 
         // Scoring of this window against the ErrPs the user produced.
-        let says_error = p_error >= params.control.t_e;
-        // ErrP time zeros only grow: skip those too old for any window span.
-        while recent < errps.len() && errps[recent].0 < time_secs - 1.0 {
+        while recent < errps.len() && errps[recent] < time_secs - horizon {
             recent += 1;
         }
         let errps_near = &errps[recent..];
-        let has_errp = errps_near.iter().any(|&(o, _)| {
-            o >= time_secs - ERRP_IN_WINDOW_SECS.0 && o <= time_secs - ERRP_IN_WINDOW_SECS.1
-        });
+        let says_error = p_error >= t_e;
+        let in_window_span = errps_near
+            .iter()
+            .any(|&o| window_span.contains(o, time_secs));
         let near_errp = errps_near
             .iter()
-            .any(|&(o, _)| o >= time_secs - 1.0 && o <= time_secs);
-        if has_errp {
+            .any(|&o| o <= time_secs && time_secs - o <= window_span.to_secs + WINDOW_STEP_SECS);
+        if in_window_span {
             n_err_windows += 1;
             hits += usize::from(says_error);
         } else if !near_errp {
             n_clean_windows += 1;
             false_alarms += usize::from(says_error);
         }
-        if obs.detected {
+        let real = errps_near.iter().any(|&o| span.contains(o, time_secs));
+        if used && !real {
+            clean_windows += 1;
+        }
+        let detected = decision.detected && used;
+        if detected {
             detections.push(time_secs);
             detected_at.push([pose.x_m, pose.y_m]);
-            let real = errps_near.iter().any(|&(o, _)| {
-                o >= time_secs - DETECTION_SPAN_SECS.0 && o <= time_secs - DETECTION_SPAN_SECS.1
-            });
+            by_phase[match obs.step {
+                StepKind::Turn { .. } => 0,
+                StepKind::Linear => 1,
+                _ => 2,
+            }] += 1;
             if watching {
+                let what = if obs.detected {
+                    format!("stop {:.0} s", params.control.stop_secs)
+                } else {
+                    "a veto of the goal".to_string()
+                };
                 observer.on_event(
                     time_secs,
                     &format!(
-                        "error detected (p = {p_error:.2}){}: stop {:.0} s",
+                        "error detected (evidence {:.2}){}: {what}",
+                        decision.evidence,
                         if real { "" } else { ", a false positive" },
-                        params.control.stop_secs
                     ),
                     !real,
                 );
@@ -362,13 +435,14 @@ pub fn run_epuck_episode(
             observer.on_window(&WindowFrame {
                 time_secs,
                 p_error,
+                evidence: decision.evidence,
                 belief: controller.belief().probabilities(),
                 target: controller.target(),
-                detected: obs.detected,
+                detected,
                 tracked,
                 fcz_cz: [
-                    fresh.channel(eeg.fcz_cz[0]).to_vec(),
-                    fresh.channel(eeg.fcz_cz[1]).to_vec(),
+                    fresh.channel(fcz_cz[0]).to_vec(),
+                    fresh.channel(fcz_cz[1]).to_vec(),
                 ],
             });
         }
@@ -394,33 +468,32 @@ pub fn run_epuck_episode(
         observer.on_event(time_secs, "time-out: no convergence", true);
     }
 
-    // ErrPs during motion whose detection span saw no detection.
-    let missed_errors = errps
+    // ErrPs whose detection span closed within the episode, and those of
+    // them with no detection in it.
+    let scored: Vec<f64> = errps
         .iter()
-        .filter(|&&(o, moving)| {
-            moving
-                && o + DETECTION_SPAN_SECS.0 <= time_secs
-                && !detections
-                    .iter()
-                    .any(|&t| t >= o + DETECTION_SPAN_SECS.1 && t <= o + DETECTION_SPAN_SECS.0)
-        })
+        .copied()
+        .filter(|&o| o + span.to_secs <= time_secs)
+        .collect();
+    let missed_errors = scored
+        .iter()
+        .filter(|&&o| !detections.iter().any(|&t| span.contains(o, t)))
         .count();
     let false_detections = detections
         .iter()
-        .filter(|&&t| {
-            !errps
-                .iter()
-                .any(|&(o, _)| o >= t - DETECTION_SPAN_SECS.0 && o <= t - DETECTION_SPAN_SECS.1)
-        })
+        .filter(|&&t| !errps.iter().any(|&o| span.contains(o, t)))
         .count();
     Ok(EpuckEpisodeResult {
         goal: episode.goal,
         committed,
         time_secs,
         detected_errors: detections.len(),
+        detected_by_phase: by_phase,
         false_detections,
         missed_errors,
         errps: errps.len(),
+        errps_scored: scored.len(),
+        clean_secs: clean_windows as f64 * WINDOW_STEP_SECS,
         online: Accuracy {
             correct: 1.0 - false_alarms as f64 / n_clean_windows.max(1) as f64,
             error: hits as f64 / n_err_windows.max(1) as f64,

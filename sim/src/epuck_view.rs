@@ -274,6 +274,11 @@ impl EpuckObserver for EpuckRecorder<'_> {
         }
         let r = self.rec.log("decoder/p_error", &Scalars::single(f.p_error));
         self.keep(r);
+        // What the detector compared with T_e (the smoothed p(error)).
+        let r = self
+            .rec
+            .log("decoder/evidence", &Scalars::single(f.evidence));
+        self.keep(r);
         let r = self
             .rec
             .log("decoder/threshold", &Scalars::single(self.t_e));

@@ -28,12 +28,13 @@ mod world;
 pub use calibration::{CalibrationReport, CalibrationRequest, calibrate_at, run_calibration};
 pub use calibration_view::{LATENCY_TIMELINE, calibration_recording, record_calibration};
 pub use continuous_decoder::{
-    ContinuousDecoder, ContinuousReport, ContinuousRequest, WARM_UP_SECS, calibrate_continuous_at,
-    run_continuous_calibration,
+    ContinuousDecoder, ContinuousReport, ContinuousRequest, OnlineReport, calibrate_continuous_at,
+    run_continuous_calibration, run_online_calibration,
 };
 pub use epuck_run::{
-    EpuckSummary, PAPER_EPUCK, epuck_run_seed, median, prepare_continuous_decoder, run_epuck_batch,
-    run_epuck_once, summarise,
+    EpuckSummary, PAPER_EPUCK, epuck_run_seed, finish_continuous_decoder, median,
+    prepare_continuous_decoder, prepare_continuous_decoder_with, run_epuck_batch, run_epuck_once,
+    summarise,
 };
 pub use epuck_scenario::{AnyScenario, EpuckScenario, load_scenario};
 pub use epuck_task::{

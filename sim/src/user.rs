@@ -13,7 +13,10 @@
 //! * **stopped on a goal**: correct on g, error on any other goal;
 //! * **on g** (within the goal radius): stopping or approaching is correct,
 //!   turning or leaving is an error;
-//! * **stopped elsewhere** (the stop after a detected error): no judgement.
+//! * **stopped elsewhere** (the stop after a detected error): no judgement;
+//!   a robot halted mid-turn near a goal has not arrived there, so that is
+//!   no judgement either (a stop counts as on a goal when the last motion
+//!   seen before it was a drive, or at the start).
 //!
 //! The user sees motion over a short window of tracked poses (0.5 s by
 //! default), which is also part of the perception delay. An error onset
@@ -179,6 +182,9 @@ pub struct SyntheticUser {
     state: Judgement,
     last_error_secs: f64,
     last_correct_secs: f64,
+    /// The robot's last seen motion before it stood still was a drive (or it
+    /// has not moved yet): standing on a goal is then an arrival there.
+    arrived: bool,
 }
 
 impl SyntheticUser {
@@ -192,6 +198,7 @@ impl SyntheticUser {
             state: Judgement::None,
             last_error_secs: f64::NEG_INFINITY,
             last_correct_secs: f64::NEG_INFINITY,
+            arrived: true,
         }
     }
 
@@ -235,6 +242,11 @@ impl SyntheticUser {
             let before = p0.distance_to(gx, gy);
             now < before
         };
+        match motion {
+            SeenMotion::Driving => self.arrived = true,
+            SeenMotion::Turning(_) => self.arrived = false,
+            SeenMotion::Still => {}
+        }
         let judgement = self.judge(motion, tracked, approaching);
         let previous = self.state;
         self.state = judgement;
@@ -295,9 +307,10 @@ impl SyntheticUser {
                 }
             }
             SeenMotion::Still => {
-                let on_other = self.goals.iter().enumerate().any(|(i, &(x, y))| {
-                    i != self.goal && pose.distance_to(x, y) <= p.on_goal_radius_m
-                });
+                let on_other = self.arrived
+                    && self.goals.iter().enumerate().any(|(i, &(x, y))| {
+                        i != self.goal && pose.distance_to(x, y) <= p.on_goal_radius_m
+                    });
                 if on_other {
                     Judgement::Error
                 } else {

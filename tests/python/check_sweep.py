@@ -5,7 +5,8 @@ Usage: check_sweep.py DIR LEVELS EPISODES
 Checks, independently of the Rust code: every file is there and whole; the
 episodes are one row per (level, episode) in order; every summary statistic
 (success rate, Wilson interval, mean/sd/median cost of the successful
-episodes, Pearson r and p against online accuracy, via NumPy and SciPy)
+episodes, Pearson r and p against online accuracy, via NumPy and SciPy; for
+the e-puck the detector's mean hit rate and false alarms per minute)
 matches what summary.csv says; sweep.json records the parameters; the plots
 are a PNG and an SVG document.
 """
@@ -73,6 +74,20 @@ def main():
             res = stats.pearsonr([p[0] for p in pairs], [p[1] for p in pairs])
             assert close(num(s[f"r_online_{cost}"]), res.statistic, 1e-5), (s, res)
             assert abs(num(s[f"p_online_{cost}"]) - res.pvalue) <= 1e-5 + 1e-3 * res.pvalue, (s, res)
+
+        if task == "epuck":
+            # The detector's online operating point: per-episode means.
+            for col in ("hit_rate", "false_alarms_per_min"):
+                v = [float(r[col]) for r in lv if r[col] != ""]
+                if v:
+                    assert close(float(s[col]), float(np.mean(v))), (col, s, np.mean(v))
+            for r in lv:
+                by_phase = sum(int(r[c]) for c in ("detected_turning", "detected_driving", "detected_on_goal"))
+                assert by_phase == int(r["detected"]), r
+    if task == "epuck":
+        for dec in manifest["decoders"]:
+            assert 0.0 <= dec["online_hit_rate"] <= 1.0, dec
+            assert dec["online_false_alarms_per_min"] >= 0.0, dec
 
     png = (d / "sweep.png").read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000, len(png)

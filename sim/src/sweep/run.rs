@@ -17,6 +17,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::calibration::{CalibrationReport, CalibrationRequest};
 use crate::continuous_decoder::{ContinuousDecoder, ContinuousRequest, calibrate_continuous_at};
+use crate::epuck_run::finish_continuous_decoder;
 use crate::epuck_scenario::{AnyScenario, EpuckScenario};
 use crate::epuck_task::run_epuck_episode;
 use crate::error::{Result, SimError};
@@ -47,6 +48,12 @@ pub struct DecoderInfo {
     pub cv_error: Option<f64>,
     /// Their mean: the accuracy reached.
     pub cv_mean: Option<f64>,
+    /// E-puck: the detector's hit rate per ErrP on the held-out recording.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub online_hit_rate: Option<f64>,
+    /// E-puck: its false alarms per minute of error-free time there.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub online_false_alarms_per_min: Option<f64>,
     /// True if the targeting came from the cache (not written to disk).
     #[serde(skip)]
     pub cached: bool,
@@ -273,6 +280,8 @@ fn prepare(level: &Level, cache: &TargetCache, shared: &Shared) -> Result<(Prepa
                 cv_correct: None,
                 cv_error: None,
                 cv_mean: None,
+                online_hit_rate: None,
+                online_false_alarms_per_min: None,
                 cached: false,
             };
             if s.decoder == DecoderChoice::Oracle {
@@ -347,6 +356,8 @@ fn prepare(level: &Level, cache: &TargetCache, shared: &Shared) -> Result<(Prepa
             })?;
             let report = calibrate_continuous_at(&request, targeting)?;
             let a = report.calibrated.accuracy;
+            let decoder = finish_continuous_decoder(s, &report)?;
+            let point = decoder.online.as_ref().map(|o| o.point);
             let info = DecoderInfo {
                 accuracy: s.accuracy,
                 kind: "svm".into(),
@@ -355,12 +366,11 @@ fn prepare(level: &Level, cache: &TargetCache, shared: &Shared) -> Result<(Prepa
                 cv_correct: Some(a.correct),
                 cv_error: Some(a.error),
                 cv_mean: Some(a.mean()),
+                online_hit_rate: point.map(|p| p.hit_rate),
+                online_false_alarms_per_min: point.map(|p| p.false_alarms_per_min),
                 cached: hit,
             };
-            Ok((
-                Prepared::Epuck(Arc::new(ContinuousDecoder::from_report(&report))),
-                info,
-            ))
+            Ok((Prepared::Epuck(Arc::new(decoder)), info))
         }
     }
 }
@@ -558,6 +568,11 @@ pub fn episodes_header(spec: &SweepSpec) -> String {
             "detected",
             "false_alarms",
             "missed",
+            "detected_turning",
+            "detected_driving",
+            "detected_on_goal",
+            "hit_rate",
+            "false_alarms_per_min",
         ],
     };
     cols.extend(task_cols.iter().map(|s| s.to_string()));
@@ -650,6 +665,11 @@ fn run_row(spec: &SweepSpec, level: &Level, runner: &Runner, k: usize) -> Result
                 r.detected_errors.to_string(),
                 r.false_detections.to_string(),
                 r.missed_errors.to_string(),
+                r.detected_by_phase[0].to_string(),
+                r.detected_by_phase[1].to_string(),
+                r.detected_by_phase[2].to_string(),
+                rate(r.hit_rate()),
+                rate(r.false_alarms_per_min()),
             ]);
             r.online
         }

@@ -445,6 +445,9 @@ impl SweepSpec {
                 if let Some(user) = t.get_mut("user").and_then(Value::as_table_mut) {
                     user.remove("subject");
                     user.remove("goals");
+                    // The level's accuracy replaces an online target.
+                    user.remove("hit_rate");
+                    user.remove("false_alarms_per_min");
                 }
                 let mut sets: Vec<(&str, Value)> = vec![
                     ("user.accuracy", Value::Float(accuracy)),

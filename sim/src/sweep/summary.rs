@@ -46,6 +46,9 @@ pub struct LevelSummary {
     /// Pearson r and p between online accuracy and cost (successful
     /// episodes).
     pub r_p: (f64, f64),
+    /// E-puck: mean per-episode hit rate per ErrP, and mean false alarms
+    /// per minute of error-free time (NaN for the grid).
+    pub detector: (f64, f64),
 }
 
 impl LevelSummary {
@@ -76,6 +79,8 @@ struct Columns {
     committed: usize,
     cost: usize,
     online: usize,
+    /// E-puck: hit rate and false alarms per minute.
+    detector: Option<(usize, usize)>,
 }
 
 fn columns(header: &str, task: SweepTask, path: &Path) -> Result<Columns> {
@@ -95,6 +100,10 @@ fn columns(header: &str, task: SweepTask, path: &Path) -> Result<Columns> {
         })?,
         cost: find(cost_column(task))?,
         online: find("online_accuracy")?,
+        detector: match task {
+            SweepTask::Grid => None,
+            SweepTask::Epuck => Some((find("hit_rate")?, find("false_alarms_per_min")?)),
+        },
     })
 }
 
@@ -152,6 +161,14 @@ pub fn summarise_dir(dir: &Path, spec: &SweepSpec) -> Result<SweepReport> {
             acc.online_sum += online;
             acc.online_n += 1;
         }
+        if let Some((hit, fa)) = cols.detector {
+            for (k, v) in [parse(hit)?, parse(fa)?].into_iter().enumerate() {
+                if v.is_finite() {
+                    acc.detector[k].0 += v;
+                    acc.detector[k].1 += 1;
+                }
+            }
+        }
         rows += 1;
     }
     if let Some(c) = current {
@@ -185,6 +202,8 @@ struct Acc {
     cost_online: Vec<f64>,
     online_sum: f64,
     online_n: usize,
+    /// Sums and counts of the defined hit rates and false-alarm rates.
+    detector: [(f64, usize); 2],
 }
 
 impl Acc {
@@ -198,6 +217,7 @@ impl Acc {
             cost_online: Vec::new(),
             online_sum: 0.0,
             online_n: 0,
+            detector: [(0.0, 0); 2],
         }
     }
 
@@ -242,8 +262,14 @@ impl Acc {
                 self.online_sum / self.online_n as f64
             },
             r_p: pearson(&x, &y),
+            detector: (mean_of(self.detector[0]), mean_of(self.detector[1])),
         }
     }
+}
+
+/// The mean of a (sum, count) pair; NaN for none.
+fn mean_of((sum, n): (f64, usize)) -> f64 {
+    if n == 0 { f64::NAN } else { sum / n as f64 }
 }
 
 /// A statistic in the summary: 6 decimals, empty when undefined.
@@ -277,6 +303,10 @@ pub fn summary_csv(spec: &SweepSpec, report: &SweepReport) -> String {
     cols.push("online_accuracy".into());
     cols.push(format!("r_online_{cost}"));
     cols.push(format!("p_online_{cost}"));
+    let epuck = spec.task == SweepTask::Epuck;
+    if epuck {
+        cols.extend(["hit_rate", "false_alarms_per_min"].map(String::from));
+    }
     let mut out = cols.join(",");
     out.push('\n');
     for l in &report.levels {
@@ -299,6 +329,9 @@ pub fn summary_csv(spec: &SweepSpec, report: &SweepReport) -> String {
             stat(l.r_p.0),
             stat(l.r_p.1),
         ]);
+        if epuck {
+            f.extend([stat(l.detector.0), stat(l.detector.1)]);
+        }
         out.push_str(&f.join(","));
         out.push('\n');
     }
@@ -322,7 +355,8 @@ impl fmt::Display for SweepReport {
         if with_series {
             write!(f, "{:<width$}  ", "series")?;
         }
-        writeln!(
+        let epuck = self.task == SweepTask::Epuck;
+        write!(
             f,
             "{:>8} {:>6} {:>8} {:>15} {:>17} {:>7} {:>7} {:>6} {:>7}",
             "accuracy",
@@ -335,6 +369,10 @@ impl fmt::Display for SweepReport {
             "r",
             "p"
         )?;
+        if epuck {
+            write!(f, " {:>6} {:>8}", "hits", "FA/min")?;
+        }
+        writeln!(f)?;
         for l in &self.levels {
             let (lo, hi) = wilson_interval(l.successes, l.episodes);
             if with_series {
@@ -347,7 +385,7 @@ impl fmt::Display for SweepReport {
                     "-".into()
                 }
             };
-            writeln!(
+            write!(
                 f,
                 "{:>8} {:>6} {:>7.1}% {:>15} {:>17} {:>7} {:>7} {:>6} {:>7}",
                 format_number(l.accuracy),
@@ -360,6 +398,15 @@ impl fmt::Display for SweepReport {
                 num(l.r_p.0, 2),
                 num(l.r_p.1, 3),
             )?;
+            if epuck {
+                write!(
+                    f,
+                    " {:>6} {:>8}",
+                    num(l.detector.0, 3),
+                    num(l.detector.1, 2)
+                )?;
+            }
+            writeln!(f)?;
         }
         for (label, n, (r, p)) in &self.series {
             let name = if label.is_empty() {
