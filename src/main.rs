@@ -780,6 +780,12 @@ fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<()> {
         100.0 * s.phase_shares[2]
     );
     println!(
+        "  true detections      of ErrPs judging a turn {:.0} %, a drive {:.0} %, a stop {:.0} %",
+        100.0 * s.judged_shares[0],
+        100.0 * s.judged_shares[1],
+        100.0 * s.judged_shares[2]
+    );
+    println!(
         "  online detector      hit rate {:.1} % per ErrP, {:.2} false alarms per error-free minute",
         100.0 * s.hit_rate,
         s.false_alarms_per_min

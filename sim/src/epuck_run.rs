@@ -149,6 +149,9 @@ pub struct EpuckSummary {
     /// Shares of all detections made while turning, driving and stopped on
     /// a goal.
     pub phase_shares: [f64; 3],
+    /// Shares of the true detections whose ErrP judged a turn, a drive and
+    /// a stop.
+    pub judged_shares: [f64; 3],
     /// Hit rate per ErrP, pooled over every run.
     pub hit_rate: f64,
     /// False detections per minute of error-free time, pooled.
@@ -175,6 +178,10 @@ pub fn summarise(results: &[EpuckEpisodeResult]) -> EpuckSummary {
         phase_shares: {
             let total = sum(&|r| r.detected_errors as f64).max(1.0);
             [0, 1, 2].map(|k| sum(&|r| r.detected_by_phase[k] as f64) / total)
+        },
+        judged_shares: {
+            let total = sum(&|r| r.true_by_judged_phase.iter().sum::<usize>() as f64).max(1.0);
+            [0, 1, 2].map(|k| sum(&|r| r.true_by_judged_phase[k] as f64) / total)
         },
         hit_rate: 1.0 - sum(&|r| r.missed_errors as f64) / sum(&|r| r.errps_scored as f64),
         false_alarms_per_min: sum(&|r| r.false_detections as f64) / (sum(&|r| r.clean_secs) / 60.0),

@@ -173,6 +173,19 @@ struct ObstacleFile {
     angle_deg: f64,
 }
 
+/// A parameter error of `errp_bci` as a field error of the scenario's
+/// `[table]`.
+fn table_error(path: &Path, table: &str, e: errp_bci::BciError) -> SimError {
+    match e {
+        errp_bci::BciError::InvalidParameter {
+            name,
+            value,
+            expected,
+        } => field_error(path, &format!("{table}.{name}"), value, &expected),
+        other => SimError::Scenario(format!("{}: [{table}] {other}", path.display())),
+    }
+}
+
 /// `f` of the `[control]` table, if there is one.
 fn c_opt(c: &Option<ControlFile>, f: impl Fn(&ControlFile) -> Option<f64>) -> Option<f64> {
     c.as_ref().and_then(f)
@@ -295,14 +308,9 @@ impl EpuckScenario {
                     hit_rate: h,
                     false_alarms_per_min: fa,
                 };
-                target.validate().map_err(|e| match e {
-                    errp_bci::BciError::InvalidParameter {
-                        name,
-                        value,
-                        expected,
-                    } => bad(&format!("user.{name}"), value, &expected),
-                    other => SimError::Scenario(format!("{}: [user] {other}", path.display())),
-                })?;
+                target
+                    .validate()
+                    .map_err(|e| table_error(path, "user", e))?;
                 if fa.is_some() && file.control.as_ref().is_some_and(|c| c.t_e.is_some()) {
                     return Err(bad(
                         "control.t_e",
@@ -420,14 +428,7 @@ impl EpuckScenario {
                      literal reading compares each window with T_e on its own)",
                 ));
             }
-            p.validate().map_err(|e| match e {
-                errp_bci::BciError::InvalidParameter {
-                    name,
-                    value,
-                    expected,
-                } => bad(&format!("detector.{name}"), value, &expected),
-                other => SimError::Scenario(format!("{}: [detector] {other}", path.display())),
-            })?;
+            p.validate().map_err(|e| table_error(path, "detector", e))?;
         }
         // The device knows its decoder's accuracy from the calibration.
         params.control.assumed_accuracy = accuracy;

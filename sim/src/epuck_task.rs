@@ -12,7 +12,7 @@ use errp_bci::{
     rng::{derive_seed, stream},
 };
 use errp_robot::{
-    ContinuousControlParams, ContinuousController, EpuckParams, GoalLayout, Pose, StepKind,
+    ContinuousControlParams, ContinuousController, EpuckParams, GoalLayout, Phase, Pose, StepKind,
     WheelSpeeds, wrap_angle,
 };
 use serde::{Deserialize, Serialize};
@@ -142,6 +142,15 @@ pub const STEPS_PER_WINDOW: usize = 4;
 pub const WINDOW_STEP_SECS: f64 = errp_bci::WINDOW_STEP_SECS;
 /// The physics time step (s).
 pub const PHYSICS_DT_SECS: f64 = WINDOW_STEP_SECS / STEPS_PER_WINDOW as f64;
+/// 0 turning, 1 driving, 2 stopped.
+fn phase_index(phase: Phase) -> usize {
+    match phase {
+        Phase::Turning => 0,
+        Phase::Driving => 1,
+        Phase::Stopped { .. } => 2,
+    }
+}
+
 /// One physics step, for observers.
 #[derive(Debug, Clone, Copy)]
 pub struct PhysicsFrame {
@@ -223,6 +232,9 @@ pub struct EpuckEpisodeResult {
     pub detected_errors: usize,
     /// Of those, while turning, while driving, and while stopped on a goal.
     pub detected_by_phase: [usize; 3],
+    /// The true detections by what the user was judging when the ErrP
+    /// behind each was elicited: a turn, a drive, or a stop.
+    pub true_by_judged_phase: [usize; 3],
     /// Detections with no ErrP behind them (none within the detector's
     /// response span before them).
     pub false_detections: usize,
@@ -315,10 +327,12 @@ pub fn run_epuck_episode(
     let mut pose = world.pose();
     let mut tracked = tracker.observe(0.0, &pose);
     let mut errps: Vec<f64> = Vec::new(); // time zeros
+    let mut judged_in: Vec<usize> = Vec::new(); // the phase each ErrP judged
     let mut recent = 0; // first ErrP whose spans can still hold a window
     let mut detections: Vec<f64> = Vec::new();
     let mut detected_at = Vec::new();
     let mut by_phase = [0usize; 3];
+    let mut by_judged = [0usize; 3];
     let (mut hits, mut n_err_windows, mut false_alarms, mut n_clean_windows) = (0, 0, 0, 0);
     let mut clean_windows = 0usize;
     let mut path_m = 0.0;
@@ -332,6 +346,7 @@ pub fn run_epuck_episode(
             if let Some(e) = user.observe(time_secs, &tracked) {
                 if e.kind == AssessmentKind::Error {
                     errps.push(e.onset_secs);
+                    judged_in.push(phase_index(controller.phase()));
                 }
                 eeg.schedule(e.onset_secs, e.kind);
                 if watching && e.kind == AssessmentKind::Error {
@@ -393,7 +408,11 @@ pub fn run_epuck_episode(
             n_clean_windows += 1;
             false_alarms += usize::from(says_error);
         }
-        let real = errps_near.iter().any(|&o| span.contains(o, time_secs));
+        let judged = errps_near
+            .iter()
+            .rposition(|&o| span.contains(o, time_secs))
+            .map(|i| judged_in[recent + i]);
+        let real = judged.is_some();
         if used && !real {
             clean_windows += 1;
         }
@@ -406,6 +425,9 @@ pub fn run_epuck_episode(
                 StepKind::Linear => 1,
                 _ => 2,
             }] += 1;
+            if let Some(k) = judged {
+                by_judged[k] += 1;
+            }
             if watching {
                 let what = if obs.detected {
                     format!("stop {:.0} s", params.control.stop_secs)
@@ -489,6 +511,7 @@ pub fn run_epuck_episode(
         time_secs,
         detected_errors: detections.len(),
         detected_by_phase: by_phase,
+        true_by_judged_phase: by_judged,
         false_detections,
         missed_errors,
         errps: errps.len(),

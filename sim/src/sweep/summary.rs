@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use errp_bci::GoalSet;
 
 use crate::epuck_run::{PAPER_EPUCK, median};
-use crate::epuck_scenario::AnyScenario;
+use crate::epuck_scenario::{AnyScenario, parse_scenario};
 use crate::error::{Result, SimError};
 use crate::grid_run::mean_sd;
 use crate::stats::{StreamingPearson, pearson, wilson_interval};
@@ -491,7 +491,9 @@ pub fn sweep_plot(spec: &SweepSpec, report: &SweepReport, scenario: &AnyScenario
                 .filter(|(name, _, _)| *name == s.name)
                 .map(|(name, secs, _)| PaperPoint {
                     label: name.to_string(),
-                    accuracy: 0.7438,
+                    // The paper gives no accuracy for its continuous
+                    // decoder: drawn at the scenario's.
+                    accuracy: s.accuracy,
                     value: *secs,
                     sd: None,
                 })
@@ -500,7 +502,11 @@ pub fn sweep_plot(spec: &SweepSpec, report: &SweepReport, scenario: &AnyScenario
                 format!("E-puck task, {}", s.name),
                 "time to convergence, s (successful episodes)".to_string(),
                 paper,
-                format!("paper, {} (one run, at 0.7438)", s.name),
+                format!(
+                    "paper, {} (one run; drawn at the scenario's {})",
+                    s.name,
+                    format_number(s.accuracy)
+                ),
             )
         }
     };
@@ -528,12 +534,17 @@ pub fn sweep_plot(spec: &SweepSpec, report: &SweepReport, scenario: &AnyScenario
 pub fn finish_dir(dir: &Path, manifest: &Manifest) -> Result<SweepReport> {
     let spec = &manifest.spec;
     let mut report = summarise_dir(dir, spec)?;
-    let scenario = spec
-        .levels()?
-        .into_iter()
-        .next()
-        .map(|l| l.scenario)
-        .ok_or_else(|| SimError::Sweep("a sweep without levels".into()))?;
+    // The scenario as the file gives it (the e-puck's paper point is drawn
+    // at its accuracy), else the first level's.
+    let scenario = match parse_scenario(&spec.scenario_toml, &spec.scenario_path) {
+        Ok(s) => s,
+        Err(_) => spec
+            .levels()?
+            .into_iter()
+            .next()
+            .map(|l| l.scenario)
+            .ok_or_else(|| SimError::Sweep("a sweep without levels".into()))?,
+    };
     let plot = sweep_plot(spec, &report, &scenario);
     let plot_error =
         |e: plot::PlotError| SimError::Sweep(format!("plotting the sweep failed: {e}"));
