@@ -112,21 +112,6 @@ pub fn run_epuck_batch(
         .collect()
 }
 
-/// Median of `xs` (NaN if empty).
-pub fn median(xs: &[f64]) -> f64 {
-    if xs.is_empty() {
-        return f64::NAN;
-    }
-    let mut v = xs.to_vec();
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
-}
-
 /// Summary of many runs of one e-puck scenario.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EpuckSummary {
@@ -170,9 +155,9 @@ pub fn summarise(results: &[EpuckEpisodeResult]) -> EpuckSummary {
             .iter()
             .filter(|r| r.committed.is_some() && !r.reached())
             .count(),
-        median_secs: median(&col(&|r| r.time_secs)),
-        median_detected: median(&col(&|r| r.detected_errors as f64)),
-        median_false: median(&col(&|r| r.false_detections as f64)),
+        median_secs: crate::stats::median(&col(&|r| r.time_secs)),
+        median_detected: crate::stats::median(&col(&|r| r.detected_errors as f64)),
+        median_false: crate::stats::median(&col(&|r| r.false_detections as f64)),
         online: Accuracy::pooled(results.iter().map(|r| &r.online)),
         detections_per_sec: sum(&|r| r.detected_errors as f64) / sum(&|r| r.time_secs),
         phase_shares: {

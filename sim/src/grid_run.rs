@@ -22,21 +22,6 @@ pub struct GridRunReport {
     pub episodes: Vec<GridEpisodeResult>,
 }
 
-/// Mean and sample standard deviation.
-pub fn mean_sd(xs: &[f64]) -> (f64, f64) {
-    let n = xs.len() as f64;
-    if xs.is_empty() {
-        return (f64::NAN, f64::NAN);
-    }
-    let m = xs.iter().sum::<f64>() / n;
-    let sd = if xs.len() > 1 {
-        (xs.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
-    } else {
-        0.0
-    };
-    (m, sd)
-}
-
 impl GridRunReport {
     /// The decoder's accuracy pooled over every action of every episode.
     pub fn online_accuracy(&self) -> Accuracy {

@@ -12,7 +12,6 @@ use serde::{Deserialize, Serialize};
 
 use crate::calibration::CalibrationReport;
 use crate::error::{Result, SimError};
-use crate::scenario::PErrorChoice;
 
 /// Timing and limits of a grid episode.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -256,6 +255,16 @@ impl EegDecoder {
             },
         }
     }
+}
+
+/// How the EEG decoder's decision value becomes p(error).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PErrorChoice {
+    /// The paper's 1 / (1 + e^-y).
+    Sigmoid,
+    /// Platt scaling fitted on the calibration session (the default).
+    Platt,
 }
 
 /// How the decoder's decision value y becomes p(error).

@@ -32,7 +32,7 @@ pub use continuous_decoder::{
     run_continuous_calibration, run_online_calibration,
 };
 pub use epuck_run::{
-    EpuckSummary, PAPER_EPUCK, epuck_run_seed, finish_continuous_decoder, median,
+    EpuckSummary, PAPER_EPUCK, epuck_run_seed, finish_continuous_decoder,
     prepare_continuous_decoder, prepare_continuous_decoder_with, run_epuck_batch, run_epuck_once,
     summarise,
 };
@@ -44,18 +44,20 @@ pub use epuck_task::{
 pub use epuck_view::{EpuckRecorder, RUN_GAP_SECS, epuck_recording};
 pub use error::{Result, SimError};
 pub use grid_run::{
-    GridRunReport, decoder_from_calibration, mean_sd, pooled_accuracy, prepare_decoder,
-    run_grid_scenario,
+    GridRunReport, decoder_from_calibration, pooled_accuracy, prepare_decoder, run_grid_scenario,
 };
 pub use grid_task::{
     AssessmentDecoder, EegDecoder, EegSource, EpochBank, EpochBankParts, GridEpisodeResult,
-    GridStep, GridTaskParams, PErrorMapping, run_grid_episode,
+    GridStep, GridTaskParams, PErrorChoice, PErrorMapping, run_grid_episode,
 };
 pub use grid_view::{SIM_TIME, grid_recording, record_grid_run};
 pub use output::PendingFile;
 pub use record::RrdFile;
-pub use scenario::{DecoderChoice, EegMode, PErrorChoice, Scenario, free_pairs};
-pub use stats::{StreamingPearson, correlation_p_value, incomplete_beta, pearson, wilson_interval};
+pub use scenario::{DecoderChoice, EegMode, Scenario, free_pairs};
+pub use stats::{
+    StreamingPearson, correlation_p_value, incomplete_beta, mean_sd, median, pearson,
+    wilson_interval,
+};
 pub use sweep::{
     Axis, DecoderInfo, EPISODES, Level, LevelPoint, LevelSummary, MANIFEST, Manifest, PaperPoint,
     PlotError, Series, Shard, SweepObserver, SweepOptions, SweepOutcome, SweepPlot, SweepReport,

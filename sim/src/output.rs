@@ -81,6 +81,20 @@ impl Drop for PendingFile {
     }
 }
 
+/// Writes `bytes` to `path` through a temporary file renamed into place.
+pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    use std::io::Write;
+    let (pending, mut file) = PendingFile::create(path)?;
+    file.write_all(bytes)
+        .and_then(|()| file.sync_all())
+        .map_err(|source| SimError::Output {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    pending.commit()?;
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -14,7 +14,7 @@ use serde::Deserialize;
 use serde::de::DeserializeOwned;
 
 use crate::error::{Result, SimError};
-use crate::grid_task::GridTaskParams;
+use crate::grid_task::{GridTaskParams, PErrorChoice};
 
 /// Which decoder turns the user's assessments into p(error).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -85,16 +85,6 @@ pub enum EegMode {
     Stream,
     /// Drawn from a bank of epochs streamed in advance (fast, for sweeps).
     Bank,
-}
-
-/// How the EEG decoder's decision value becomes p(error).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum PErrorChoice {
-    /// The paper's 1 / (1 + e^-y).
-    Sigmoid,
-    /// Platt scaling fitted on the calibration session (the default).
-    Platt,
 }
 
 #[derive(Debug, Deserialize)]

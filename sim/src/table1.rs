@@ -6,9 +6,11 @@ use errp_robot::{Cell, Grid, QTable};
 use rayon::prelude::*;
 
 use crate::error::Result;
-use crate::grid_run::{mean_sd, prepare_decoder};
+use crate::grid_run::prepare_decoder;
+use crate::grid_task::PErrorChoice;
 use crate::grid_task::{GridEpisodeResult, GridTaskParams, run_grid_episode};
-use crate::scenario::{DecoderChoice, EegMode, PErrorChoice, Scenario, free_pairs};
+use crate::scenario::{DecoderChoice, EegMode, Scenario, free_pairs};
+use crate::stats::mean_sd;
 use crate::stats::pearson;
 
 /// The five fixed start/goal pairs (`scenarios/grid_fixed_goals.toml`).

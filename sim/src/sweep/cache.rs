@@ -11,8 +11,8 @@ use std::path::{Path, PathBuf};
 use errp_bci::TargetingResult;
 use serde::{Deserialize, Serialize};
 
-use super::run::write_atomic;
 use crate::error::Result;
+use crate::output::write_atomic;
 
 /// Where targeting results are kept (or nowhere).
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -25,7 +25,7 @@ use crate::grid_run::decoder_from_calibration;
 use crate::grid_task::{
     AssessmentDecoder, EegDecoder, EegSource, EpochBankParts, run_grid_episode,
 };
-use crate::output::PendingFile;
+use crate::output::write_atomic;
 use crate::scenario::{DecoderChoice, EegMode, Scenario};
 
 use super::cache::TargetCache;
@@ -115,19 +115,6 @@ impl Manifest {
 pub const MANIFEST: &str = "sweep.json";
 /// The episodes' file name.
 pub const EPISODES: &str = "episodes.csv";
-
-/// Writes `bytes` to `path` through a temporary file renamed into place.
-pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let (pending, mut file) = PendingFile::create(path)?;
-    file.write_all(bytes)
-        .and_then(|()| file.sync_all())
-        .map_err(|source| SimError::Output {
-            path: path.to_path_buf(),
-            source,
-        })?;
-    pending.commit()?;
-    Ok(())
-}
 
 /// What a sweep reports as it goes. Every method defaults to nothing;
 /// `()` watches nothing.

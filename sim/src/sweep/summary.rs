@@ -11,15 +11,16 @@ use std::path::{Path, PathBuf};
 
 use errp_bci::GoalSet;
 
-use crate::epuck_run::{PAPER_EPUCK, median};
+use crate::epuck_run::PAPER_EPUCK;
 use crate::epuck_scenario::{AnyScenario, parse_scenario};
 use crate::error::{Result, SimError};
-use crate::grid_run::mean_sd;
+use crate::output::write_atomic;
 use crate::stats::{StreamingPearson, pearson, wilson_interval};
+use crate::stats::{mean_sd, median};
 use crate::table1::PAPER;
 
 use super::plot::{self, LevelPoint, PaperPoint, Series, SweepPlot};
-use super::run::{EPISODES, Manifest, cost_column, write_atomic};
+use super::run::{EPISODES, Manifest, cost_column};
 use super::spec::{SweepSpec, SweepTask, format_number, value_text};
 
 /// The statistics of one level.

@@ -1,0 +1,90 @@
+#!/usr/bin/env bash
+# Golden outputs for restructurings: runs a fixed set of `errp` commands and
+# records what they print and write, so that a change that should keep
+# behaviour can show the same bytes before and after.
+#
+#   scripts/golden.sh record DIR        run the commands into DIR (built first)
+#   scripts/golden.sh compare DIR1 DIR2 same bytes? (recordings: `rerun rrd
+#                                       compare` when rerun is on PATH, since
+#                                       Rerun's own ids differ per run)
+#
+# Every command is seeded; the cache is off, so each run targets afresh.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+record() {
+  local out=$1
+  mkdir -p "$out"
+  cargo build --locked --quiet
+  local errp=target/debug/errp
+  # Rerun's batcher flushes on a timer, so chunk boundaries follow the wall
+  # clock; flushing on size alone makes recordings comparable.
+  export RERUN_FLUSH_TICK_SECS=1000000
+  local n=0
+  run() { # run NAME ARGS...: stdout to NAME.txt
+    local name=$1
+    shift
+    n=$((n + 1))
+    printf '  %2d %s\n' "$n" "$name" >&2
+    "$errp" "$@" > "$out/$name.txt"
+  }
+  run calibrate calibrate --accuracy 0.7438 --seed 1 --quiet \
+    --save "$out/calib.rrd" --export "$out/calib.edf"
+  run grid run scenarios/grid_fixed_goals.toml --seed 1 --quiet --save "$out/grid.rrd"
+  run epuck run scenarios/mexico_to_pisa.toml --seed 1 --quiet --save "$out/epuck.rrd"
+  run epuck-20 run scenarios/mexico_to_pisa.toml --runs 20 --quiet
+  run table1 table1 --seed 1 --quiet
+  run sweep-grid sweep --task grid --accuracy 0.6,0.8 --param strategy=greedy,info_gain \
+    --episodes 40 --seed 1 --no-cache --quiet --out "$out/sweep-grid"
+  run sweep-epuck sweep --task epuck --accuracy 0.8,0.95 --episodes 6 --seed 1 \
+    --no-cache --quiet --out "$out/sweep-epuck"
+  for k in 1 2; do
+    run "shard-$k" sweep --task grid --accuracy 0.6,0.8 --episodes 40 --seed 1 --no-cache \
+      --quiet --shard "$k/2" --out "$out/shard-$k"
+  done
+  run merge merge "$out/shard-1" "$out/shard-2" --out "$out/merged"
+  # The merge prints its output paths: make them relative.
+  sed -i "s#$out/##g" "$out"/*.txt
+  (cd "$out" && find . -type f ! -name '*.rrd' ! -name SHA256SUMS | LC_ALL=C sort |
+    xargs sha256sum > SHA256SUMS)
+  echo "recorded $(wc -l < "$out/SHA256SUMS") files in $out" >&2
+}
+
+compare() {
+  local a=$1 b=$2 status=0
+  if ! diff <(cut -c67- "$a/SHA256SUMS") <(cut -c67- "$b/SHA256SUMS") > /dev/null; then
+    echo "different file lists" >&2
+    status=1
+  fi
+  while read -r sum file; do
+    if ! grep -q "^$sum  $file\$" "$b/SHA256SUMS"; then
+      echo "differs: $file" >&2
+      status=1
+    fi
+  done < "$a/SHA256SUMS"
+  for rrd in "$a"/*.rrd; do
+    local name
+    name=$(basename "$rrd")
+    if command -v rerun > /dev/null; then
+      if ! rerun rrd compare --unordered "$rrd" "$b/$name" > /dev/null 2>&1; then
+        echo "differs: $name (rerun rrd compare --unordered)" >&2
+        status=1
+      fi
+    else
+      echo "skipped: $name (no rerun on PATH)" >&2
+    fi
+  done
+  if [ "$status" = 0 ]; then
+    echo "same: $(wc -l < "$a/SHA256SUMS") files and $(ls "$a"/*.rrd | wc -l) recordings" >&2
+  fi
+  return "$status"
+}
+
+case "${1:-}" in
+  record) record "$2" ;;
+  compare) compare "$2" "$3" ;;
+  *)
+    echo "usage: scripts/golden.sh record DIR | compare DIR1 DIR2" >&2
+    exit 2
+    ;;
+esac
