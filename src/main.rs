@@ -12,7 +12,8 @@ use clap::{Parser, Subcommand, ValueEnum};
 use errp_bci::{EdfWriter, GoalSet, OnlineStep, TargetingStep, subject, subjects};
 use errp_sim::{
     AnyScenario, EpuckRecorder, EpuckScenario, PAPER_EPUCK, epuck_recording, load_scenario,
-    prepare_continuous_decoder_with, run_epuck_batch, run_epuck_once, summarise,
+    load_scenario_with, prepare_continuous_decoder_with, run_epuck_batch, run_epuck_once,
+    summarise,
 };
 use errp_sim::{
     CalibrationRequest, DecoderChoice, EegMode, GridRunReport, PAPER, PAPER_POOLED, PendingFile,
@@ -354,7 +355,30 @@ fn calibrate(args: &CalibrateArgs) -> Result<()> {
 }
 
 fn run(args: &RunArgs) -> Result<()> {
-    match load_scenario(&args.scenario)? {
+    // Overrides are keys of the scenario file, set before it is parsed, so
+    // they are checked and carried through exactly as the file's own.
+    let mut overrides: Vec<(&str, toml::Value)> = Vec::new();
+    if let Some(a) = args.accuracy {
+        overrides.push(("user.accuracy", toml::Value::Float(a)));
+    }
+    let epuck = matches!(load_scenario(&args.scenario)?, AnyScenario::Epuck(_));
+    if !epuck {
+        if let Some(d) = args.decoder {
+            let name = match d {
+                DecoderArg::Eeg => "eeg",
+                DecoderArg::Oracle => "oracle",
+            };
+            overrides.push(("decoder", toml::Value::String(name.into())));
+        }
+        if let Some(e) = args.eeg {
+            let name = match e.mode() {
+                EegMode::Stream => "stream",
+                EegMode::Bank => "bank",
+            };
+            overrides.push(("eeg", toml::Value::String(name.into())));
+        }
+    }
+    match load_scenario_with(&args.scenario, &overrides)? {
         AnyScenario::Grid(s) => {
             if args.runs.is_some() {
                 bail!(
@@ -394,21 +418,8 @@ fn run_grid(args: &RunArgs, mut scenario: Scenario) -> Result<()> {
     if let Some(seed) = args.seed {
         scenario.seed = seed;
     }
-    if let Some(a) = args.accuracy {
-        scenario.accuracy = a;
-        scenario.user = format!("accuracy {a} (--accuracy)");
-    }
-    if let Some(d) = args.decoder {
-        scenario.decoder = match d {
-            DecoderArg::Eeg => DecoderChoice::Eeg,
-            DecoderArg::Oracle => DecoderChoice::Oracle,
-        };
-        if scenario.decoder == DecoderChoice::Eeg && scenario.accuracy >= 1.0 {
-            bail!("--decoder eeg needs an accuracy below 1; the scenario asks for 1");
-        }
-    }
-    if let Some(e) = args.eeg {
-        scenario.eeg = e.mode();
+    if args.accuracy.is_some() {
+        scenario.user.push_str(" (--accuracy)");
     }
     if let Some(p) = &args.save {
         check_extension(p, "rrd", "--save")?;
@@ -623,12 +634,6 @@ fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<()> {
     }
     if let Some(runs) = args.runs {
         scenario.runs = runs as usize;
-    }
-    if let Some(a) = args.accuracy {
-        // --accuracy replaces the scenario's decoder target, online or not.
-        scenario.accuracy = a;
-        scenario.online_target = None;
-        scenario.params.control.assumed_accuracy = a;
     }
     if let Some(p) = &args.save {
         check_extension(p, "rrd", "--save")?;

@@ -12,7 +12,7 @@ use serde::Deserialize;
 
 use crate::epuck_task::{EpuckEpisode, EpuckTaskParams};
 use crate::error::{Result, SimError};
-use crate::scenario::{Scenario, field_error, parse_toml, read_scenario, scenario_name};
+use crate::scenario::{Scenario, field_error, parse_toml, read_scenario, scenario_name, set_key};
 use crate::world::{ArenaSpec, Obstacle};
 
 /// A scenario of either task, as `errp run` takes it.
@@ -28,6 +28,38 @@ pub enum AnyScenario {
 pub fn load_scenario(path: impl AsRef<Path>) -> Result<AnyScenario> {
     let path = path.as_ref();
     parse_scenario(&read_scenario(path)?, path)
+}
+
+/// Reads a scenario file, sets `overrides` (dotted keys, as the file spells
+/// them: `user.accuracy`, `decoder`, ...) in its TOML, and validates the
+/// result: command-line overrides are parsed and checked exactly as if the
+/// file said them, so nothing derived from a value (the accuracy the device
+/// assumes, say) can be left behind. Setting `user.accuracy` drops the
+/// file's other ways of giving the decoder (`subject`, `goals`, `hit_rate`,
+/// `false_alarms_per_min`).
+pub fn load_scenario_with(
+    path: impl AsRef<Path>,
+    overrides: &[(&str, toml::Value)],
+) -> Result<AnyScenario> {
+    let path = path.as_ref();
+    if overrides.is_empty() {
+        return load_scenario(path);
+    }
+    let mut table: toml::Table = parse_toml(&read_scenario(path)?, path)?;
+    for (key, value) in overrides {
+        if *key == "user.accuracy"
+            && let Some(user) = table.get_mut("user").and_then(toml::Value::as_table_mut)
+        {
+            for other in ["subject", "goals", "hit_rate", "false_alarms_per_min"] {
+                user.remove(other);
+            }
+        }
+        set_key(&mut table, key, value.clone())
+            .map_err(|e| SimError::Scenario(format!("{}: {key}: {e}", path.display())))?;
+    }
+    let text = toml::to_string(&table)
+        .map_err(|e| SimError::Scenario(format!("{}: {e}", path.display())))?;
+    parse_scenario(&text, path)
 }
 
 /// Validates scenario text of either task; `path` names it in errors.

@@ -36,7 +36,7 @@ pub use epuck_run::{
     prepare_continuous_decoder, prepare_continuous_decoder_with, run_epuck_batch, run_epuck_once,
     summarise,
 };
-pub use epuck_scenario::{AnyScenario, EpuckScenario, load_scenario};
+pub use epuck_scenario::{AnyScenario, EpuckScenario, load_scenario, load_scenario_with};
 pub use epuck_task::{
     AvoidanceParams, EpuckEpisode, EpuckEpisodeResult, EpuckObserver, EpuckTaskParams,
     PHYSICS_DT_SECS, PhysicsFrame, WINDOW_STEP_SECS, WindowFrame, run_epuck_episode,

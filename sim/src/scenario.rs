@@ -15,6 +15,7 @@ use serde::de::DeserializeOwned;
 
 use crate::error::{Result, SimError};
 use crate::grid_task::{GridTaskParams, PErrorChoice};
+use toml::{Table, Value};
 
 /// Which decoder turns the user's assessments into p(error).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -180,6 +181,29 @@ pub(crate) fn parse_toml<T: DeserializeOwned>(text: &str, path: &Path) -> Result
     toml::from_str(text).map_err(|e| {
         SimError::Scenario(format!("{}: {}", path.display(), e.to_string().trim_end()))
     })
+}
+
+/// Sets `key` (dotted) in `table` to `value`, creating tables on the way.
+pub(crate) fn set_key(
+    table: &mut Table,
+    key: &str,
+    value: Value,
+) -> std::result::Result<(), String> {
+    let mut parts = key.split('.').peekable();
+    let mut t = table;
+    while let Some(part) = parts.next() {
+        if parts.peek().is_none() {
+            t.insert(part.to_string(), value);
+            return Ok(());
+        }
+        let entry = t
+            .entry(part.to_string())
+            .or_insert_with(|| Value::Table(Table::new()));
+        t = entry
+            .as_table_mut()
+            .ok_or_else(|| format!("`{part}` in `{key}` is not a table in the scenario"))?;
+    }
+    Err(format!("`{key}` is empty"))
 }
 
 /// The error for a bad `field` of the scenario at `path`.

@@ -173,3 +173,46 @@ fn an_epoch_bank_from_parts_equals_the_bank_streamed_at_its_ratio() {
     }
     assert!(worst < 1e-9, "largest relative difference {worst}");
 }
+
+/// Regression: `errp run --accuracy A` used to overwrite the parsed
+/// scenario's accuracy and leave the accuracy the info-gain planner assumes
+/// at the file's value. Overrides are now keys set before parsing.
+#[test]
+fn an_accuracy_override_reaches_the_info_gain_planner() {
+    let dir = std::env::temp_dir().join(format!("errp-override-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let grid = dir.join("grid.toml");
+    std::fs::write(
+        &grid,
+        "task = \"grid\"\n[user]\nsubject = \"S2\"\n[[episode]]\nstart = [0, 0]\ngoal = [4, 4]\n\
+         [control]\nstrategy = \"info_gain\"\n",
+    )
+    .unwrap();
+    let over = [("user.accuracy", toml::Value::Float(0.9))];
+    match errp_sim::load_scenario_with(&grid, &over).unwrap() {
+        errp_sim::AnyScenario::Grid(s) => {
+            assert_eq!(s.accuracy, 0.9);
+            assert_eq!(s.params.control.assumed_accuracy, 0.9);
+        }
+        _ => panic!("a grid scenario"),
+    }
+    let path = format!(
+        "{}/../scenarios/mexico_to_pisa.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    match errp_sim::load_scenario_with(&path, &over).unwrap() {
+        errp_sim::AnyScenario::Epuck(s) => {
+            assert_eq!(s.accuracy, 0.9);
+            assert_eq!(s.params.control.assumed_accuracy, 0.9);
+            assert!(s.online_target.is_none());
+        }
+        _ => panic!("an e-puck scenario"),
+    }
+    // An override is checked as the file's own value would be.
+    let bad = [("user.accuracy", toml::Value::Float(1.7))];
+    let e = errp_sim::load_scenario_with(&grid, &bad)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("user.accuracy") && e.contains("1.7"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

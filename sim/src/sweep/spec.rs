@@ -13,7 +13,7 @@ use toml::{Table, Value};
 
 use crate::epuck_scenario::{AnyScenario, is_epuck, parse_scenario};
 use crate::error::{Result, SimError};
-use crate::scenario::{parse_toml, read_scenario};
+use crate::scenario::{parse_toml, read_scenario, set_key};
 
 /// The two tasks a sweep can run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -353,25 +353,6 @@ pub fn read_task(path: &Path) -> Result<(SweepTask, String)> {
         SweepTask::Grid
     };
     Ok((task, text))
-}
-
-/// Sets `key` (dotted) in `table` to `value`, creating tables on the way.
-fn set_key(table: &mut Table, key: &str, value: Value) -> std::result::Result<(), String> {
-    let mut parts = key.split('.').peekable();
-    let mut t = table;
-    while let Some(part) = parts.next() {
-        if parts.peek().is_none() {
-            t.insert(part.to_string(), value);
-            return Ok(());
-        }
-        let entry = t
-            .entry(part.to_string())
-            .or_insert_with(|| Value::Table(Table::new()));
-        t = entry
-            .as_table_mut()
-            .ok_or_else(|| format!("`{part}` in `{key}` is not a table in the scenario"))?;
-    }
-    Err(format!("`{key}` is empty"))
 }
 
 impl SweepSpec {
