@@ -13,11 +13,6 @@ use crate::epuck_scenario::EpuckScenario;
 use crate::epuck_task::{EpuckEpisodeResult, EpuckObserver, run_epuck_episode};
 use crate::error::Result;
 
-/// The paper's two e-puck runs (sec. 5.3): (scenario name, seconds to the
-/// goal, error events).
-pub const PAPER_EPUCK: [(&str, f64, usize); 2] =
-    [("Mexico to Pisa", 60.0, 11), ("Lisbon to Tokyo", 121.0, 26)];
-
 /// Calibrates the scenario's continuous decoder (`progress` sees the search)
 /// and measures its online operating point with the scenario's detector.
 ///

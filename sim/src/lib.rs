@@ -16,6 +16,7 @@ mod grid_run;
 mod grid_task;
 mod grid_view;
 mod output;
+mod paper;
 mod record;
 mod scenario;
 mod stats;
@@ -32,9 +33,8 @@ pub use continuous_decoder::{
     run_continuous_calibration, run_online_calibration,
 };
 pub use epuck_run::{
-    EpuckSummary, PAPER_EPUCK, epuck_run_seed, finish_continuous_decoder,
-    prepare_continuous_decoder, prepare_continuous_decoder_with, run_epuck_batch, run_epuck_once,
-    summarise,
+    EpuckSummary, epuck_run_seed, finish_continuous_decoder, prepare_continuous_decoder,
+    prepare_continuous_decoder_with, run_epuck_batch, run_epuck_once, summarise,
 };
 pub use epuck_scenario::{AnyScenario, EpuckScenario, load_scenario, load_scenario_with};
 pub use epuck_task::{
@@ -52,6 +52,7 @@ pub use grid_task::{
 };
 pub use grid_view::{SIM_TIME, grid_recording, record_grid_run};
 pub use output::PendingFile;
+pub use paper::{PAPER, PAPER_EPUCK, PAPER_POOLED};
 pub use record::RrdFile;
 pub use scenario::{DecoderChoice, EegMode, Scenario, free_pairs};
 pub use stats::{
@@ -65,10 +66,7 @@ pub use sweep::{
     parse_accuracies, parse_axis, parse_values, read_task, run_sweep, summarise_dir, summary_csv,
     sweep_plot,
 };
-pub use table1::{
-    FIXED_PAIRS, PAPER, PAPER_POOLED, Table1Cell, Table1Options, accuracy_time_correlation,
-    run_table1,
-};
+pub use table1::{FIXED_PAIRS, Table1Cell, Table1Options, accuracy_time_correlation, run_table1};
 pub use tracker::{CameraTracker, TrackerParams};
 pub use user::{Elicited, Judgement, SeenMotion, SyntheticUser, UserParams};
 pub use world::{ArenaSpec, Obstacle, ProximitySensors, World};

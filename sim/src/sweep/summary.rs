@@ -11,13 +11,12 @@ use std::path::{Path, PathBuf};
 
 use errp_bci::GoalSet;
 
-use crate::epuck_run::PAPER_EPUCK;
 use crate::epuck_scenario::{AnyScenario, parse_scenario};
 use crate::error::{Result, SimError};
 use crate::output::write_atomic;
+use crate::paper::{PAPER, PAPER_EPUCK};
 use crate::stats::{StreamingPearson, pearson, wilson_interval};
 use crate::stats::{mean_sd, median};
-use crate::table1::PAPER;
 
 use super::plot::{self, LevelPoint, PaperPoint, Series, SweepPlot};
 use super::run::{EPISODES, Manifest, cost_column};
