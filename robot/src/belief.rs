@@ -29,7 +29,8 @@ impl Belief {
         self.log_p.is_empty()
     }
 
-    /// Bayes' rule: multiplies each goal's probability by its likelihood and
+    /// Bayes' rule, the recursive posterior of eq. (2) of the paper:
+    /// multiplies each goal's probability by its likelihood and
     /// renormalises. Likelihoods must be finite and >= 0, and not all 0.
     pub fn update(&mut self, likelihoods: &[f64]) -> Result<()> {
         if likelihoods.len() != self.log_p.len() {

@@ -195,6 +195,12 @@ impl ContinuousControlParams {
         self.sigma_deg.to_radians()
     }
 
+    /// The paper's detection rule read literally: p(error) >= T_e. The one
+    /// place T_e is compared with.
+    pub fn detects(&self, p_error: f64) -> bool {
+        p_error >= self.t_e
+    }
+
     /// N(0; 0, sigma), the peak of eq. (7)'s normal pdf (1.1399 for 20 deg).
     pub fn pdf_peak(&self) -> f64 {
         normal_pdf(0.0, self.sigma_rad())
@@ -222,7 +228,7 @@ pub fn turn_likelihood(
 ) -> f64 {
     let b = wrap_angle(bearing_rad);
     let left = b > 0.0; // (0, pi]; wrapped, so b <= pi
-    let error = p_error >= params.t_e;
+    let error = params.detects(p_error);
     if error && ((turn_direction > 0.0 && left) || (turn_direction < 0.0 && !left)) {
         params.k_turn
     } else {
@@ -236,7 +242,7 @@ pub fn turn_likelihood(
 /// theta_i - theta_t in radians (N is even, so its sign does not matter).
 pub fn linear_likelihood(params: &ContinuousControlParams, p_error: f64, bearing_rad: f64) -> f64 {
     let n = normal_pdf(wrap_angle(bearing_rad), params.sigma_rad());
-    if p_error < params.t_e {
+    if !params.detects(p_error) {
         1.0 + params.k_p * n
     } else {
         1.0 - params.k_n * n

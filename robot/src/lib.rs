@@ -12,7 +12,8 @@
 //! [`Twist`], [`integrate`]), the arena's goals ([`GoalLayout::cities`]),
 //! the potentials of eq. (5) ([`QuadraticPotential`]), the likelihoods of
 //! eq. (6) and (7) ([`turn_likelihood`], [`linear_likelihood`]) and the
-//! [`ContinuousController`] that turns, drives and stops the robot.
+//! [`ContinuousController`] that turns, drives and stops the robot, with
+//! the obstacle reflex under it ([`AvoidanceParams`]).
 //!
 //! Both controllers choose their actions by a [`Strategy`]: the paper's
 //! greedy one, or the [`expected_information_gain`] of the decoder's next
@@ -20,6 +21,7 @@
 //! a goal drawn from the belief, kept until the user objects or the belief
 //! moves away from it).
 
+mod avoidance;
 mod belief;
 mod continuous_control;
 mod continuous_likelihood;
@@ -33,6 +35,7 @@ mod potential;
 mod qvalues;
 mod strategy;
 
+pub use avoidance::AvoidanceParams;
 pub use belief::{Belief, log_sum_exp};
 pub use continuous_control::{ContinuousController, Observation, Phase, StepKind, StopReason};
 pub use continuous_likelihood::{ContinuousControlParams, linear_likelihood, turn_likelihood};

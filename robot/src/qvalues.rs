@@ -108,7 +108,8 @@ impl QTable {
         softmax(self.q(goal, cell), tau)
     }
 
-    /// The best action for `goal` at `cell` (first in [`GridAction::ALL`]
+    /// The best action for `goal` at `cell`, argmax_a Q*_i(s, a): the
+    /// optimal policy of eq. (1) of the paper (first in [`GridAction::ALL`]
     /// order on ties).
     pub fn greedy(&self, goal: Cell, cell: Cell) -> GridAction {
         let q = self.q(goal, cell);

@@ -38,11 +38,12 @@ pub use epuck_run::{
 };
 pub use epuck_scenario::{AnyScenario, EpuckScenario, load_scenario, load_scenario_with};
 pub use epuck_task::{
-    AvoidanceParams, EpuckEpisode, EpuckEpisodeResult, EpuckObserver, EpuckTaskParams,
-    PHYSICS_DT_SECS, PhysicsFrame, WINDOW_STEP_SECS, WindowFrame, run_epuck_episode,
+    EpuckEpisode, EpuckEpisodeResult, EpuckObserver, EpuckTaskParams, PHYSICS_DT_SECS,
+    PhysicsFrame, WINDOW_STEP_SECS, WindowFrame, run_epuck_episode,
 };
 pub use epuck_view::{EpuckRecorder, RUN_GAP_SECS, epuck_recording};
 pub use error::{Result, SimError};
+pub use errp_robot::AvoidanceParams;
 pub use grid_run::{
     GridRunReport, decoder_from_calibration, pooled_accuracy, prepare_decoder, run_grid_scenario,
 };
