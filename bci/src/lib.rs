@@ -22,6 +22,8 @@
 //!   operating point on a held-out recording ([`operating_point`]);
 //! * the subjects of Table 1 ([`subject`]) and EDF+ export ([`EdfWriter`]).
 
+#![warn(clippy::unwrap_used, clippy::print_stdout, clippy::iter_over_hash_type)]
+
 mod calibration;
 mod classify;
 mod continuous;

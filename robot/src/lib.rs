@@ -21,6 +21,8 @@
 //! a goal drawn from the belief, kept until the user objects or the belief
 //! moves away from it).
 
+#![warn(clippy::unwrap_used, clippy::print_stdout, clippy::iter_over_hash_type)]
+
 mod avoidance;
 mod belief;
 mod continuous_control;

@@ -4,6 +4,8 @@
 //! e-puck, rapier2d). It ties the EEG side ([`errp_bci`]) to the agent side
 //! ([`errp_robot`]) and writes what happened to `.rrd` files.
 
+#![warn(clippy::unwrap_used, clippy::print_stdout, clippy::iter_over_hash_type)]
+
 mod calibration;
 mod calibration_view;
 mod continuous_decoder;
