@@ -8,56 +8,51 @@
 
 mod calibration;
 mod calibration_view;
-mod continuous_decoder;
-mod epuck_run;
-mod epuck_scenario;
-mod epuck_task;
-mod epuck_view;
+mod epuck;
 mod error;
-mod grid_run;
-mod grid_task;
-mod grid_view;
+mod grid;
 mod output;
 mod paper;
 mod record;
-mod scenario;
 mod stats;
 mod sweep;
-mod table1;
-mod tracker;
-mod user;
-mod world;
 
 pub use calibration::{CalibrationReport, CalibrationRequest, calibrate_at, run_calibration};
 pub use calibration_view::{LATENCY_TIMELINE, calibration_recording, record_calibration};
-pub use continuous_decoder::{
+pub use epuck::decoder::{
     ContinuousDecoder, ContinuousReport, ContinuousRequest, OnlineReport, calibrate_continuous_at,
     run_continuous_calibration, run_online_calibration,
 };
-pub use epuck_run::{
-    EpuckSummary, epuck_run_seed, finish_continuous_decoder, prepare_continuous_decoder,
-    prepare_continuous_decoder_with, run_epuck_batch, run_epuck_once, summarise,
-};
-pub use epuck_scenario::{AnyScenario, EpuckScenario, load_scenario, load_scenario_with};
-pub use epuck_task::{
+pub use epuck::episode::{
     EpuckEpisode, EpuckEpisodeResult, EpuckObserver, EpuckTaskParams, PHYSICS_DT_SECS,
     PhysicsFrame, WINDOW_STEP_SECS, WindowFrame, run_epuck_episode,
 };
-pub use epuck_view::{EpuckRecorder, RUN_GAP_SECS, epuck_recording};
+pub use epuck::run::{
+    EpuckSummary, epuck_run_seed, finish_continuous_decoder, prepare_continuous_decoder,
+    prepare_continuous_decoder_with, run_epuck_batch, run_epuck_once, summarise,
+};
+pub use epuck::scenario::{AnyScenario, EpuckScenario, load_scenario, load_scenario_with};
+pub use epuck::tracker::{CameraTracker, TrackerParams};
+pub use epuck::user::{Elicited, Judgement, SeenMotion, SyntheticUser, UserParams};
+pub use epuck::view::{EpuckRecorder, RUN_GAP_SECS, epuck_recording};
+pub use epuck::world::{ArenaSpec, Obstacle, ProximitySensors, World};
 pub use error::{Result, SimError};
 pub use errp_robot::AvoidanceParams;
-pub use grid_run::{
-    GridRunReport, decoder_from_calibration, pooled_accuracy, prepare_decoder, run_grid_scenario,
-};
-pub use grid_task::{
+pub use grid::episode::{
     AssessmentDecoder, EegDecoder, EegSource, EpochBank, EpochBankParts, GridEpisodeResult,
     GridStep, GridTaskParams, PErrorChoice, PErrorMapping, run_grid_episode,
 };
-pub use grid_view::{SIM_TIME, grid_recording, record_grid_run};
+pub use grid::run::{
+    GridRunReport, decoder_from_calibration, pooled_accuracy, prepare_decoder, run_grid_scenario,
+};
+pub use grid::scenario::{DecoderChoice, EegMode, Scenario, free_pairs};
+pub use grid::table1::{
+    FIXED_PAIRS, Table1Cell, Table1Options, accuracy_time_correlation, run_table1,
+};
+pub use grid::view::{SIM_TIME, grid_recording, record_grid_run};
 pub use output::PendingFile;
 pub use paper::{PAPER, PAPER_EPUCK, PAPER_POOLED};
 pub use record::RrdFile;
-pub use scenario::{DecoderChoice, EegMode, Scenario, free_pairs};
 pub use stats::{
     StreamingPearson, correlation_p_value, incomplete_beta, mean_sd, median, pearson,
     wilson_interval,
@@ -69,7 +64,3 @@ pub use sweep::{
     parse_accuracies, parse_axis, parse_values, read_task, run_sweep, summarise_dir, summary_csv,
     sweep_plot,
 };
-pub use table1::{FIXED_PAIRS, Table1Cell, Table1Options, accuracy_time_correlation, run_table1};
-pub use tracker::{CameraTracker, TrackerParams};
-pub use user::{Elicited, Judgement, SeenMotion, SyntheticUser, UserParams};
-pub use world::{ArenaSpec, Obstacle, ProximitySensors, World};

@@ -16,17 +16,17 @@ use errp_robot::{Cell, Grid, QTable};
 use serde::{Deserialize, Serialize};
 
 use crate::calibration::{CalibrationReport, CalibrationRequest};
-use crate::continuous_decoder::{ContinuousDecoder, ContinuousRequest, calibrate_continuous_at};
-use crate::epuck_run::finish_continuous_decoder;
-use crate::epuck_scenario::{AnyScenario, EpuckScenario};
-use crate::epuck_task::run_epuck_episode;
+use crate::epuck::decoder::{ContinuousDecoder, ContinuousRequest, calibrate_continuous_at};
+use crate::epuck::episode::run_epuck_episode;
+use crate::epuck::run::finish_continuous_decoder;
+use crate::epuck::scenario::{AnyScenario, EpuckScenario};
 use crate::error::{Result, SimError};
-use crate::grid_run::decoder_from_calibration;
-use crate::grid_task::{
+use crate::grid::episode::{
     AssessmentDecoder, EegDecoder, EegSource, EpochBankParts, run_grid_episode,
 };
+use crate::grid::run::decoder_from_calibration;
+use crate::grid::scenario::{DecoderChoice, EegMode, Scenario};
 use crate::output::write_atomic;
-use crate::scenario::{DecoderChoice, EegMode, Scenario};
 
 use super::cache::TargetCache;
 use super::spec::{Level, Shard, SweepSpec, SweepTask, format_number, value_text};

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use errp_bci::GoalSet;
 
-use crate::epuck_scenario::{AnyScenario, parse_scenario};
+use crate::epuck::scenario::{AnyScenario, parse_scenario};
 use crate::error::{Result, SimError};
 use crate::output::write_atomic;
 use crate::paper::{PAPER, PAPER_EPUCK};
@@ -456,8 +456,8 @@ pub fn sweep_plot(spec: &SweepSpec, report: &SweepReport, scenario: &AnyScenario
     }
     let decoder = match scenario {
         AnyScenario::Grid(s) => match s.decoder {
-            crate::scenario::DecoderChoice::Oracle => "oracle decoder".to_string(),
-            crate::scenario::DecoderChoice::Eeg => {
+            crate::grid::scenario::DecoderChoice::Oracle => "oracle decoder".to_string(),
+            crate::grid::scenario::DecoderChoice::Eeg => {
                 format!("EEG decoder ({:?})", s.eeg).to_lowercase()
             }
         },

@@ -6,10 +6,10 @@ use errp_robot::{Cell, Grid, QTable};
 use rayon::prelude::*;
 
 use crate::error::Result;
-use crate::grid_run::prepare_decoder;
-use crate::grid_task::PErrorChoice;
-use crate::grid_task::{GridEpisodeResult, GridTaskParams, run_grid_episode};
-use crate::scenario::{DecoderChoice, EegMode, Scenario, free_pairs};
+use crate::grid::episode::PErrorChoice;
+use crate::grid::episode::{GridEpisodeResult, GridTaskParams, run_grid_episode};
+use crate::grid::run::prepare_decoder;
+use crate::grid::scenario::{DecoderChoice, EegMode, Scenario, free_pairs};
 use crate::stats::mean_sd;
 use crate::stats::pearson;
 

@@ -6,10 +6,10 @@ use errp_robot::{Grid, QTable};
 
 use crate::calibration::{CalibrationReport, CalibrationRequest, run_calibration};
 use crate::error::{Result, SimError};
-use crate::grid_task::{
+use crate::grid::episode::{
     AssessmentDecoder, EegDecoder, EpochBank, GridEpisodeResult, run_grid_episode,
 };
-use crate::scenario::{DecoderChoice, EegMode, Scenario};
+use crate::grid::scenario::{DecoderChoice, EegMode, Scenario};
 
 /// Everything a grid run produced.
 #[derive(Debug, Clone)]

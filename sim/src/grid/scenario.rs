@@ -14,7 +14,7 @@ use serde::Deserialize;
 use serde::de::DeserializeOwned;
 
 use crate::error::{Result, SimError};
-use crate::grid_task::{GridTaskParams, PErrorChoice};
+use crate::grid::episode::{GridTaskParams, PErrorChoice};
 use toml::{Table, Value};
 
 /// Which decoder turns the user's assessments into p(error).

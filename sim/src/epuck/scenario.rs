@@ -10,10 +10,12 @@ use errp_bci::{DetectorMode, DetectorParams, OnlineTarget, check_requested_accur
 use errp_robot::{GoalLayout, Pose, Strategy};
 use serde::Deserialize;
 
-use crate::epuck_task::{EpuckEpisode, EpuckTaskParams};
+use crate::epuck::episode::{EpuckEpisode, EpuckTaskParams};
+use crate::epuck::world::{ArenaSpec, Obstacle};
 use crate::error::{Result, SimError};
-use crate::scenario::{Scenario, field_error, parse_toml, read_scenario, scenario_name, set_key};
-use crate::world::{ArenaSpec, Obstacle};
+use crate::grid::scenario::{
+    Scenario, field_error, parse_toml, read_scenario, scenario_name, set_key,
+};
 
 /// A scenario of either task, as `errp run` takes it.
 #[derive(Debug, Clone)]

@@ -16,11 +16,11 @@ use rerun::{
     TextLog,
 };
 
-use crate::epuck_task::{EpuckObserver, PhysicsFrame, WindowFrame};
+use crate::epuck::episode::{EpuckObserver, PhysicsFrame, WindowFrame};
+use crate::epuck::world::{ArenaSpec, Obstacle};
 use crate::error::{Result, SimError};
-use crate::grid_view::SIM_TIME;
+use crate::grid::view::SIM_TIME;
 use crate::record::{RrdFile, log_decoder_series, record_error};
-use crate::world::{ArenaSpec, Obstacle};
 
 /// Pause between runs on the timeline (s).
 pub const RUN_GAP_SECS: f64 = 2.0;
@@ -295,7 +295,7 @@ impl EpuckObserver for EpuckRecorder<'_> {
         }
         // The EEG of the last 62.5 ms, sample by sample.
         let n = f.fcz_cz[0].len();
-        let fs = n as f64 / crate::epuck_task::WINDOW_STEP_SECS;
+        let fs = n as f64 / crate::epuck::episode::WINDOW_STEP_SECS;
         for (name, samples) in ["eeg/FCz", "eeg/Cz"].iter().zip(&f.fcz_cz) {
             for (k, v) in samples.iter().enumerate() {
                 self.at(f.time_secs - (n - 1 - k) as f64 / fs);

@@ -5,12 +5,12 @@
 use errp_bci::{Accuracy, OnlineStep, TargetingStep, rng::derive_seed};
 use rayon::prelude::*;
 
-use crate::continuous_decoder::{
+use crate::epuck::decoder::{
     ContinuousDecoder, ContinuousReport, ContinuousRequest, run_continuous_calibration,
     run_online_calibration,
 };
-use crate::epuck_scenario::EpuckScenario;
-use crate::epuck_task::{EpuckEpisodeResult, EpuckObserver, run_epuck_episode};
+use crate::epuck::episode::{EpuckEpisodeResult, EpuckObserver, run_epuck_episode};
+use crate::epuck::scenario::EpuckScenario;
 use crate::error::Result;
 
 /// Calibrates the scenario's continuous decoder (`progress` sees the search)

@@ -17,11 +17,11 @@ use errp_robot::{
 };
 use serde::{Deserialize, Serialize};
 
-use crate::continuous_decoder::ContinuousDecoder;
+use crate::epuck::decoder::ContinuousDecoder;
+use crate::epuck::tracker::{CameraTracker, TrackerParams};
+use crate::epuck::user::{SyntheticUser, UserParams};
+use crate::epuck::world::{ArenaSpec, World};
 use crate::error::{Result, SimError};
-use crate::tracker::{CameraTracker, TrackerParams};
-use crate::user::{SyntheticUser, UserParams};
-use crate::world::{ArenaSpec, World};
 
 /// Everything that shapes a continuous episode besides the decoder.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

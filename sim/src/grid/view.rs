@@ -9,7 +9,7 @@ use rerun::blueprint::{
 use rerun::{Boxes2D, Color, Image, Points2D, Scalars, SeriesLines, TextLog};
 
 use crate::error::Result;
-use crate::grid_run::GridRunReport;
+use crate::grid::run::GridRunReport;
 use crate::record::{RrdFile, log_decoder_series, record_error};
 
 /// The simulation timeline (s).
