@@ -16,8 +16,8 @@ use errp_sim::{
     summarise,
 };
 use errp_sim::{
-    CalibrationRequest, DecoderChoice, EegMode, GridRunReport, PAPER, PAPER_POOLED, PendingFile,
-    Scenario, Table1Options, accuracy_time_correlation, calibration_recording, grid_recording,
+    CalibrationRequest, DecoderChoice, EegMode, GridRunReport, GridScenario, PAPER, PAPER_POOLED,
+    PendingFile, Table1Options, accuracy_time_correlation, calibration_recording, grid_recording,
     mean_sd, prepare_decoder, record_calibration, record_grid_run, run_calibration,
     run_grid_scenario, run_table1,
 };
@@ -414,7 +414,7 @@ fn calibration_progress(quiet: bool) -> impl FnMut(&TargetingStep) {
     }
 }
 
-fn run_grid(args: &RunArgs, mut scenario: Scenario) -> Result<()> {
+fn run_grid(args: &RunArgs, mut scenario: GridScenario) -> Result<()> {
     if let Some(seed) = args.seed {
         scenario.seed = seed;
     }

@@ -45,7 +45,7 @@ pub use grid::episode::{
 pub use grid::run::{
     GridRunReport, decoder_from_calibration, pooled_accuracy, prepare_decoder, run_grid_scenario,
 };
-pub use grid::scenario::{DecoderChoice, EegMode, Scenario, free_pairs};
+pub use grid::scenario::{DecoderChoice, EegMode, GridScenario, free_pairs};
 pub use grid::table1::{
     FIXED_PAIRS, Table1Cell, Table1Options, accuracy_time_correlation, run_table1,
 };

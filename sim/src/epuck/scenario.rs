@@ -14,14 +14,14 @@ use crate::epuck::episode::{EpuckEpisode, EpuckTaskParams};
 use crate::epuck::world::{ArenaSpec, Obstacle};
 use crate::error::{Result, SimError};
 use crate::grid::scenario::{
-    Scenario, field_error, parse_toml, read_scenario, scenario_name, set_key,
+    GridScenario, field_error, parse_toml, read_scenario, scenario_name, set_key,
 };
 
 /// A scenario of either task, as `errp run` takes it.
 #[derive(Debug, Clone)]
 pub enum AnyScenario {
     /// The discrete 5x5 grid task (sec. 4).
-    Grid(Box<Scenario>),
+    Grid(Box<GridScenario>),
     /// The continuous e-puck task (sec. 5).
     Epuck(Box<EpuckScenario>),
 }
@@ -71,7 +71,9 @@ pub(crate) fn parse_scenario(text: &str, path: &Path) -> Result<AnyScenario> {
             text, path,
         )?)))
     } else {
-        Ok(AnyScenario::Grid(Box::new(Scenario::parse(text, path)?)))
+        Ok(AnyScenario::Grid(Box::new(GridScenario::parse(
+            text, path,
+        )?)))
     }
 }
 

@@ -9,13 +9,13 @@ use crate::error::{Result, SimError};
 use crate::grid::episode::{
     AssessmentDecoder, EegDecoder, EpochBank, GridEpisodeResult, run_grid_episode,
 };
-use crate::grid::scenario::{DecoderChoice, EegMode, Scenario};
+use crate::grid::scenario::{DecoderChoice, EegMode, GridScenario};
 
 /// Everything a grid run produced.
 #[derive(Debug, Clone)]
 pub struct GridRunReport {
     /// The scenario as run.
-    pub scenario: Scenario,
+    pub scenario: GridScenario,
     /// The calibration behind the EEG decoder (none for the oracle).
     pub calibration: Option<CalibrationReport>,
     /// One result per episode, in scenario order.
@@ -37,7 +37,7 @@ pub fn pooled_accuracy(episodes: &[GridEpisodeResult]) -> Accuracy {
 /// Builds the scenario's decoder: for the EEG decoder, a calibration session
 /// targeted at the scenario's accuracy (`progress` sees the search).
 pub fn prepare_decoder(
-    scenario: &Scenario,
+    scenario: &GridScenario,
     progress: impl FnMut(&TargetingStep),
 ) -> Result<(AssessmentDecoder, Option<CalibrationReport>)> {
     match scenario.decoder {
@@ -56,7 +56,7 @@ pub fn prepare_decoder(
 /// The scenario's decoder from its calibration (none for the oracle): the
 /// online EEG decoder, streamed or with its epoch bank built.
 pub fn decoder_from_calibration(
-    scenario: &Scenario,
+    scenario: &GridScenario,
     report: Option<&CalibrationReport>,
 ) -> Result<AssessmentDecoder> {
     let report = match (scenario.decoder, report) {
@@ -87,7 +87,7 @@ pub fn decoder_from_calibration(
 /// Runs every episode of `scenario` with `decoder`. Episode k uses the seed
 /// derived from (scenario seed, k); `record_steps` keeps every action.
 pub fn run_grid_scenario(
-    scenario: &Scenario,
+    scenario: &GridScenario,
     decoder: &AssessmentDecoder,
     record_steps: bool,
     mut on_episode: impl FnMut(usize, &GridEpisodeResult),

@@ -1,8 +1,8 @@
 //! Scenario files: what to run, validated on load.
 //!
 //! A scenario is TOML. `ScenarioFile` mirrors the file (serde, unknown keys
-//! rejected); [`Scenario::load`] checks every value and returns a checked
-//! [`Scenario`], or an error naming the file, the field, the value and the
+//! rejected); [`GridScenario::load`] checks every value and returns a checked
+//! [`GridScenario`], or an error naming the file, the field, the value and the
 //! accepted range.
 
 use std::path::{Path, PathBuf};
@@ -142,7 +142,7 @@ struct TimingFile {
 
 /// A validated grid scenario.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Scenario {
+pub struct GridScenario {
     /// The file it came from.
     pub path: PathBuf,
     /// Display name.
@@ -222,7 +222,7 @@ pub(crate) fn scenario_name(name: Option<String>, path: &Path) -> String {
     })
 }
 
-impl Scenario {
+impl GridScenario {
     /// Reads and validates a scenario file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
@@ -469,14 +469,14 @@ goal = [4, 4]
 "#;
 
     fn err(text: &str) -> String {
-        Scenario::parse(text, Path::new("scenarios/x.toml"))
+        GridScenario::parse(text, Path::new("scenarios/x.toml"))
             .unwrap_err()
             .to_string()
     }
 
     #[test]
     fn a_minimal_scenario_gets_the_papers_defaults() {
-        let s = Scenario::parse(OK, Path::new("x.toml")).unwrap();
+        let s = GridScenario::parse(OK, Path::new("x.toml")).unwrap();
         assert_eq!(s.params.control.tau, 0.3);
         assert_eq!(s.params.control.p_c, 0.9);
         assert_eq!(s.decoder, DecoderChoice::Eeg);
@@ -526,7 +526,8 @@ goal = [4, 4]
     fn the_oracle_may_be_perfect_the_eeg_decoder_may_not() {
         let perfect = OK.replace("0.7438", "1.0");
         assert!(
-            Scenario::parse(&format!("decoder = \"oracle\"\n{perfect}"), Path::new("x")).is_ok()
+            GridScenario::parse(&format!("decoder = \"oracle\"\n{perfect}"), Path::new("x"))
+                .is_ok()
         );
         assert!(err(&perfect).contains("user.accuracy"));
     }
@@ -534,8 +535,8 @@ goal = [4, 4]
     #[test]
     fn free_goals_are_drawn_from_the_seed() {
         let text = "task = \"grid\"\nseed = 4\n[user]\nsubject = \"S2\"\ngoals = \"free\"\n[free_goals]\ncount = 5\n";
-        let a = Scenario::parse(text, Path::new("x")).unwrap();
-        let b = Scenario::parse(text, Path::new("x")).unwrap();
+        let a = GridScenario::parse(text, Path::new("x")).unwrap();
+        let b = GridScenario::parse(text, Path::new("x")).unwrap();
         assert_eq!(a.episodes, b.episodes);
         assert_eq!(a.episodes.len(), 5);
         assert!(a.episodes.iter().all(|(s, g)| s != g));

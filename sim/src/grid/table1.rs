@@ -9,7 +9,7 @@ use crate::error::Result;
 use crate::grid::episode::PErrorChoice;
 use crate::grid::episode::{GridEpisodeResult, GridTaskParams, run_grid_episode};
 use crate::grid::run::prepare_decoder;
-use crate::grid::scenario::{DecoderChoice, EegMode, Scenario, free_pairs};
+use crate::grid::scenario::{DecoderChoice, EegMode, GridScenario, free_pairs};
 use crate::stats::mean_sd;
 use crate::stats::pearson;
 
@@ -96,7 +96,7 @@ pub fn run_table1(
                     &mut errp_bci::rng::stream(cell_seed, "table1/free-goals"),
                 ),
             };
-            let scenario = Scenario {
+            let scenario = GridScenario {
                 path: "table1".into(),
                 name: format!("{name} {goals:?}"),
                 description: String::new(),

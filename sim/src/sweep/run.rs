@@ -25,7 +25,7 @@ use crate::grid::episode::{
     AssessmentDecoder, EegDecoder, EegSource, EpochBankParts, run_grid_episode,
 };
 use crate::grid::run::decoder_from_calibration;
-use crate::grid::scenario::{DecoderChoice, EegMode, Scenario};
+use crate::grid::scenario::{DecoderChoice, EegMode, GridScenario};
 use crate::output::write_atomic;
 
 use super::cache::TargetCache;
@@ -163,7 +163,7 @@ pub enum SweepOutcome {
 /// One level, ready to run episodes.
 enum Runner {
     Grid {
-        scenario: Box<Scenario>,
+        scenario: Box<GridScenario>,
         decoder: Arc<AssessmentDecoder>,
         table: Arc<QTable>,
     },
@@ -209,7 +209,7 @@ struct Shared {
 }
 
 /// The key of a grid level's epoch bank: what its epochs depend on.
-fn bank_key(s: &Scenario) -> String {
+fn bank_key(s: &GridScenario) -> String {
     format!(
         "{:?}",
         (
