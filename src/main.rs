@@ -361,6 +361,8 @@ fn run(args: &RunArgs) -> Result<()> {
     if let Some(a) = args.accuracy {
         overrides.push(("user.accuracy", toml::Value::Float(a)));
     }
+    // The file as written is checked first, so that its own errors quote
+    // its own lines; the overrides are then set in a copy of its TOML.
     let epuck = matches!(load_scenario(&args.scenario)?, AnyScenario::Epuck(_));
     if !epuck {
         if let Some(d) = args.decoder {

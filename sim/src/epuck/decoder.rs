@@ -4,11 +4,11 @@
 
 use errp_bci::{
     Accuracy, Calibrated, ContinuousFeatures, ContinuousSetup, Detector, DetectorMode,
-    DetectorParams, EegGenerator, GeneratorParams, Montage, OnlineRecordingParams, OnlineStep,
-    OnlineTarget, OnlineTargeting, OperatingPoint, Preprocessor, ResponseSpan, SPAN_FRACTION,
-    SlidingWindow, SvmDecoder, SvmModel, TargetingParams, TargetingResult, TargetingStep,
-    calibrate_continuous, operating_point, record_online, response_span, rng::derive_seed,
-    target_continuous_accuracy, target_online,
+    DetectorParams, EegGenerator, GeneratorParams, Montage, OnlineRecording, OnlineRecordingParams,
+    OnlineStep, OnlineTarget, OnlineTargeting, OperatingPoint, Preprocessor, ResponseSpan,
+    SPAN_FRACTION, SlidingWindow, SvmDecoder, SvmModel, TargetingParams, TargetingResult,
+    TargetingStep, calibrate_continuous, operating_point, record_online, response_span,
+    rng::derive_seed, target_continuous_accuracy, target_online,
 };
 
 use crate::error::Result;
@@ -113,31 +113,21 @@ pub struct OnlineReport {
 }
 
 impl OnlineReport {
-    /// Records `params` of held-out EEG through the calibrated pipeline and
-    /// scores `detector` and the literal reading on it.
-    pub fn measure(
-        decoder: &ContinuousDecoder,
+    /// Scores `detector` at `t_e`, and the literal reading, on a held-out
+    /// `recording` of the calibrated pipeline.
+    pub fn from_recording(
+        recording: &OnlineRecording,
         detector: DetectorParams,
         t_e: f64,
-        params: &OnlineRecordingParams,
-        seed: u64,
     ) -> Result<Self> {
-        let recording = record_online(
-            &decoder.generator,
-            &decoder.montage,
-            &decoder.preprocessor,
-            &decoder.model,
-            params,
-            seed,
-        )?;
-        let window_span = response_span(&recording, t_e, SPAN_FRACTION);
+        let window_span = response_span(recording, t_e, SPAN_FRACTION);
         let point = operating_point(
-            &recording,
+            recording,
             Detector::new(detector, t_e)?,
             window_span.delayed(detector.delay_secs()),
         );
         let literal = operating_point(
-            &recording,
+            recording,
             Detector::new(DetectorParams::literal(), t_e)?,
             window_span,
         );
@@ -191,34 +181,18 @@ impl std::fmt::Display for OnlineReport {
 /// Calibrates the continuous decoder for an online operating point: the
 /// ErrP-to-noise ratio (and T_e, if false alarms are targeted) at which
 /// `detector`, run over the held-out recording of
-/// [`ContinuousDecoder::measure_online`], meets `target`. Every evaluation
-/// is a full calibration at the ratio tried. Returns the calibration at the
-/// ratio found and the search.
+/// [`ContinuousDecoder::record_held_out`], meets `target`. Every evaluation
+/// is a full calibration at the ratio tried and its held-out recording; the
+/// one the search picks becomes the decoder (measured online at the T_e
+/// found) and the report, so nothing is calibrated or recorded twice.
 pub fn run_online_calibration(
     request: &ContinuousRequest,
     target: OnlineTarget,
     detector: DetectorParams,
     t_e: f64,
     progress: impl FnMut(&OnlineStep),
-) -> Result<(ContinuousReport, OnlineTargeting)> {
-    let at = |ratio: f64| -> Result<ContinuousReport> {
-        let mut report = calibrate_continuous_at(
-            request,
-            TargetingResult {
-                requested: target.hit_rate,
-                ratio,
-                accuracy: Accuracy {
-                    correct: f64::NAN,
-                    error: f64::NAN,
-                    n_correct: 0,
-                    n_error: 0,
-                },
-                steps: Vec::new(),
-            },
-        )?;
-        report.targeting.accuracy = report.calibrated.accuracy;
-        Ok(report)
-    };
+) -> Result<(ContinuousDecoder, ContinuousReport, OnlineTargeting)> {
+    let mut evaluated: Vec<(f64, ContinuousReport, OnlineRecording)> = Vec::new();
     let search = target_online(
         target,
         detector,
@@ -227,20 +201,45 @@ pub fn run_online_calibration(
         0.02,
         request.search.max_evaluations,
         |ratio| -> Result<_> {
-            let d = ContinuousDecoder::from_report(&at(ratio)?);
-            Ok(record_online(
-                &d.generator,
-                &d.montage,
-                &d.preprocessor,
-                &d.model,
-                &OnlineRecordingParams::default(),
-                held_out_seed(request.seed),
-            )?)
+            let mut report = calibrate_continuous_at(
+                request,
+                TargetingResult {
+                    requested: target.hit_rate,
+                    ratio,
+                    accuracy: Accuracy {
+                        correct: f64::NAN,
+                        error: f64::NAN,
+                        n_correct: 0,
+                        n_error: 0,
+                    },
+                    steps: Vec::new(),
+                },
+            )?;
+            report.targeting.accuracy = report.calibrated.accuracy;
+            let recording =
+                ContinuousDecoder::from_report(&report).record_held_out(request.seed)?;
+            evaluated.push((ratio, report, recording.clone()));
+            Ok(recording)
         },
         progress,
     )?;
-    Ok((at(search.ratio)?, search))
+    let (_, report, recording) = evaluated
+        .into_iter()
+        .find(|(ratio, _, _)| ratio.to_bits() == search.ratio.to_bits())
+        .expect("the ratio found is one of the evaluations");
+    let mut decoder = ContinuousDecoder::from_report(&report);
+    decoder.online = Some(OnlineReport::from_recording(
+        &recording, detector, search.t_e,
+    )?);
+    Ok((decoder, report, search))
 }
+
+/// The span attributed to an ErrP by a decoder not measured online: the
+/// window ends at which its features can see the ErrP's peaks.
+const UNMEASURED_SPAN: ResponseSpan = ResponseSpan {
+    from_secs: 0.45,
+    to_secs: 1.1,
+};
 
 /// The seed of the held-out recording of a calibration seeded `seed`.
 fn held_out_seed(seed: u64) -> u64 {
@@ -280,17 +279,24 @@ impl ContinuousDecoder {
         }
     }
 
-    /// Measures the operating point of `detector` at threshold `t_e` on a
-    /// held-out recording drawn from `seed` and keeps it.
-    pub fn measure_online(&mut self, detector: DetectorParams, t_e: f64, seed: u64) -> Result<()> {
-        let report = OnlineReport::measure(
-            self,
-            detector,
-            t_e,
+    /// The held-out continuous recording of this pipeline for a calibration
+    /// seeded `seed`: [`OnlineRecordingParams::default`] of fresh EEG.
+    pub fn record_held_out(&self, seed: u64) -> Result<OnlineRecording> {
+        Ok(record_online(
+            &self.generator,
+            &self.montage,
+            &self.preprocessor,
+            &self.model,
             &OnlineRecordingParams::default(),
             held_out_seed(seed),
-        )?;
-        self.online = Some(report);
+        )?)
+    }
+
+    /// Measures the operating point of `detector` at threshold `t_e` on the
+    /// held-out recording for `seed` and keeps it.
+    pub fn measure_online(&mut self, detector: DetectorParams, t_e: f64, seed: u64) -> Result<()> {
+        let recording = self.record_held_out(seed)?;
+        self.online = Some(OnlineReport::from_recording(&recording, detector, t_e)?);
         Ok(())
     }
 
@@ -299,13 +305,9 @@ impl ContinuousDecoder {
     /// [`measure_online`](Self::measure_online) ran, else the span the
     /// features can see.
     pub fn detection_span(&self) -> ResponseSpan {
-        self.online.as_ref().map_or(
-            ResponseSpan {
-                from_secs: 0.45,
-                to_secs: 1.1,
-            },
-            |o| o.point.span,
-        )
+        self.online
+            .as_ref()
+            .map_or(UNMEASURED_SPAN, |o| o.point.span)
     }
 
     /// The threshold the detector runs at: the one its operating point was
@@ -317,13 +319,9 @@ impl ContinuousDecoder {
 
     /// The span over which single windows respond to an ErrP.
     pub fn window_span(&self) -> ResponseSpan {
-        self.online.as_ref().map_or(
-            ResponseSpan {
-                from_secs: 0.45,
-                to_secs: 1.1,
-            },
-            |o| o.window_span,
-        )
+        self.online
+            .as_ref()
+            .map_or(UNMEASURED_SPAN, |o| o.window_span)
     }
 
     /// Starts the online stream for one episode: EEG from `seed`, the

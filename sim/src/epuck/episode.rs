@@ -265,13 +265,14 @@ pub fn run_epuck_episode(
     let mut time_secs = 0.0;
     let mut pose = world.pose();
     let mut tracked = tracker.observe(0.0, &pose);
-    let mut errps: Vec<f64> = Vec::new(); // time zeros
-    let mut judged_in: Vec<usize> = Vec::new(); // the phase each ErrP judged
+    // Each ErrP's time zero, and the phase the user was judging.
+    let mut errps: Vec<(f64, usize)> = Vec::new();
     let mut recent = 0; // first ErrP whose spans can still hold a window
     let mut detections: Vec<f64> = Vec::new();
     let mut detected_at = Vec::new();
     let mut by_phase = [0usize; 3];
     let mut by_judged = [0usize; 3];
+    let mut false_detections = 0usize;
     let (mut hits, mut n_err_windows, mut false_alarms, mut n_clean_windows) = (0, 0, 0, 0);
     let mut clean_windows = 0usize;
     let mut path_m = 0.0;
@@ -284,8 +285,7 @@ pub fn run_epuck_episode(
         for _ in 0..STEPS_PER_WINDOW {
             if let Some(e) = user.observe(time_secs, &tracked) {
                 if e.kind == AssessmentKind::Error {
-                    errps.push(e.onset_secs);
-                    judged_in.push(phase_index(controller.phase()));
+                    errps.push((e.onset_secs, phase_index(controller.phase())));
                 }
                 eeg.schedule(e.onset_secs, e.kind);
                 if watching && e.kind == AssessmentKind::Error {
@@ -329,17 +329,17 @@ pub fn run_epuck_episode(
         let used = obs.step != StepKind::Idle;
 
         // Scoring of this window against the ErrPs the user produced.
-        while recent < errps.len() && errps[recent] < time_secs - horizon {
+        while recent < errps.len() && errps[recent].0 < time_secs - horizon {
             recent += 1;
         }
         let errps_near = &errps[recent..];
         let says_error = p_error >= t_e;
         let in_window_span = errps_near
             .iter()
-            .any(|&o| window_span.contains(o, time_secs));
-        let near_errp = errps_near
-            .iter()
-            .any(|&o| o <= time_secs && time_secs - o <= window_span.to_secs + WINDOW_STEP_SECS);
+            .any(|&(o, _)| window_span.contains(o, time_secs));
+        let near_errp = errps_near.iter().any(|&(o, _)| {
+            o <= time_secs && time_secs - o <= window_span.to_secs + WINDOW_STEP_SECS
+        });
         if in_window_span {
             n_err_windows += 1;
             hits += usize::from(says_error);
@@ -347,10 +347,12 @@ pub fn run_epuck_episode(
             n_clean_windows += 1;
             false_alarms += usize::from(says_error);
         }
+        // The latest ErrP whose detection span holds this window, if any.
         let judged = errps_near
             .iter()
-            .rposition(|&o| span.contains(o, time_secs))
-            .map(|i| judged_in[recent + i]);
+            .rev()
+            .find(|&&(o, _)| span.contains(o, time_secs))
+            .map(|&(_, phase)| phase);
         let real = judged.is_some();
         if used && !real {
             clean_windows += 1;
@@ -364,8 +366,9 @@ pub fn run_epuck_episode(
                 StepKind::Linear => 1,
                 _ => 2,
             }] += 1;
-            if let Some(k) = judged {
-                by_judged[k] += 1;
+            match judged {
+                Some(k) => by_judged[k] += 1,
+                None => false_detections += 1,
             }
             if watching {
                 let what = if obs.detected {
@@ -433,16 +436,12 @@ pub fn run_epuck_episode(
     // them with no detection in it.
     let scored: Vec<f64> = errps
         .iter()
-        .copied()
+        .map(|&(o, _)| o)
         .filter(|&o| o + span.to_secs <= time_secs)
         .collect();
     let missed_errors = scored
         .iter()
         .filter(|&&o| !detections.iter().any(|&t| span.contains(o, t)))
-        .count();
-    let false_detections = detections
-        .iter()
-        .filter(|&&t| !errps.iter().any(|&o| span.contains(o, t)))
         .count();
     Ok(EpuckEpisodeResult {
         goal: episode.goal,

@@ -40,15 +40,13 @@ pub fn prepare_continuous_decoder_with(
             Ok((finish_continuous_decoder(scenario, &report)?, report))
         }
         Some(target) => {
-            let (report, search) = run_online_calibration(
+            let (decoder, report, _) = run_online_calibration(
                 &request,
                 target,
                 scenario.params.detector,
                 scenario.params.control.t_e,
                 online_progress,
             )?;
-            let mut decoder = ContinuousDecoder::from_report(&report);
-            decoder.measure_online(scenario.params.detector, search.t_e, scenario.seed)?;
             Ok((decoder, report))
         }
     }
