@@ -10,17 +10,19 @@ use std::process::ExitCode;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
 use errp_bci::{EdfWriter, GoalSet, OnlineStep, TargetingStep, subject, subjects};
-use errp_sim::{
-    AnyScenario, EpuckRecorder, EpuckScenario, PAPER_EPUCK, epuck_recording, load_scenario,
-    load_scenario_with, prepare_continuous_decoder_with, run_epuck_batch, run_epuck_once,
-    summarise,
+use errp_sim::calibration::{
+    CalibrationRequest, calibration_recording, record_calibration, run_calibration,
 };
-use errp_sim::{
-    CalibrationRequest, DecoderChoice, EegMode, GridRunReport, GridScenario, PAPER, PAPER_POOLED,
-    PendingFile, Table1Options, accuracy_time_correlation, calibration_recording, grid_recording,
-    mean_sd, prepare_decoder, record_calibration, record_grid_run, run_calibration,
-    run_grid_scenario, run_table1,
+use errp_sim::epuck::{
+    EpuckRecorder, EpuckScenario, epuck_recording, prepare_continuous_decoder_with,
+    run_epuck_batch, run_epuck_once, summarise,
 };
+use errp_sim::grid::{
+    DecoderChoice, EegMode, GridRunReport, GridScenario, Table1Options, accuracy_time_correlation,
+    grid_recording, prepare_decoder, record_grid_run, run_grid_scenario, run_table1,
+};
+use errp_sim::{AnyScenario, PAPER_EPUCK, load_scenario, load_scenario_with};
+use errp_sim::{PAPER, PAPER_POOLED, PendingFile, mean_sd};
 
 /// Simulated shared control of a robot from EEG error potentials.
 #[derive(Parser)]
@@ -502,7 +504,7 @@ fn run_grid(args: &RunArgs, mut scenario: GridScenario) -> Result<()> {
     };
     let n = report.episodes.len();
     let reached = report.episodes.iter().filter(|r| r.reached()).count();
-    let col = |f: fn(&errp_sim::GridEpisodeResult) -> f64| {
+    let col = |f: fn(&errp_sim::grid::GridEpisodeResult) -> f64| {
         mean_sd(&report.episodes.iter().map(f).collect::<Vec<_>>())
     };
     let (am, asd) = col(|r| r.actions as f64);
@@ -541,7 +543,7 @@ fn table1(args: &Table1Args) -> Result<()> {
             DecoderArg::Oracle => DecoderChoice::Oracle,
         },
         eeg: args.eeg.mode(),
-        params: errp_sim::GridTaskParams::default(),
+        params: errp_sim::grid::GridTaskParams::default(),
     };
     let quiet = args.quiet;
     if !quiet {
@@ -577,7 +579,7 @@ fn table1(args: &Table1Args) -> Result<()> {
         } else {
             "free"
         };
-        let mut all: Vec<&errp_sim::GridEpisodeResult> = Vec::new();
+        let mut all: Vec<&errp_sim::grid::GridEpisodeResult> = Vec::new();
         for c in cells.iter().filter(|c| c.goals == set) {
             let paper = PAPER
                 .iter()
@@ -596,7 +598,7 @@ fn table1(args: &Table1Args) -> Result<()> {
             );
             all.extend(c.runs.iter());
         }
-        let stat = |f: &dyn Fn(&errp_sim::GridEpisodeResult) -> f64| {
+        let stat = |f: &dyn Fn(&errp_sim::grid::GridEpisodeResult) -> f64| {
             mean_sd(&all.iter().map(|r| f(r)).collect::<Vec<_>>())
         };
         let (paper_mean, paper_r, paper_p) = PAPER_POOLED

@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
-use errp_sim::{
+use errp_sweep::{
     DecoderInfo, Manifest, Shard, SweepObserver, SweepOptions, SweepOutcome, SweepReport,
     SweepSpec, SweepTask, TargetCache, finish_dir, merge_sweeps, parse_accuracies, parse_axis,
     read_task, run_sweep,

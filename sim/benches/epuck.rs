@@ -8,7 +8,9 @@
 use std::sync::LazyLock;
 
 use divan::{Bencher, black_box};
-use errp_sim::{ContinuousDecoder, EpuckScenario, prepare_continuous_decoder, run_epuck_episode};
+use errp_sim::epuck::{
+    ContinuousDecoder, EpuckScenario, prepare_continuous_decoder, run_epuck_episode,
+};
 
 fn main() {
     divan::main();

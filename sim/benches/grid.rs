@@ -5,9 +5,10 @@ use std::sync::LazyLock;
 
 use divan::{Bencher, black_box};
 use errp_robot::{Grid, QTable};
-use errp_sim::{
-    AssessmentDecoder, CalibrationRequest, EegDecoder, EpochBank, FIXED_PAIRS, GridTaskParams,
-    PErrorChoice, run_calibration, run_grid_episode,
+use errp_sim::calibration::{CalibrationRequest, run_calibration};
+use errp_sim::grid::{
+    AssessmentDecoder, EegDecoder, EpochBank, FIXED_PAIRS, GridTaskParams, PErrorChoice,
+    run_grid_episode,
 };
 
 fn main() {

@@ -10,7 +10,7 @@ use errp_bci::{
     Detector, DetectorMode, DetectorParams, OnlineRecordingParams, SPAN_FRACTION, operating_point,
     record_online, response_span,
 };
-use errp_sim::{ContinuousDecoder, ContinuousRequest, run_continuous_calibration};
+use errp_sim::epuck::{ContinuousDecoder, ContinuousRequest, run_continuous_calibration};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);

@@ -3,7 +3,7 @@
 //!
 //! `cargo run -p errp_sim --example epuck_trace -- scenarios/mexico_to_pisa.toml [seed]`
 
-use errp_sim::{
+use errp_sim::epuck::{
     EpuckObserver, EpuckScenario, WindowFrame, prepare_continuous_decoder, run_epuck_once,
 };
 

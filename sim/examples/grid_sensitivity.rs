@@ -10,10 +10,11 @@
 //! `cargo run -p errp_sim --example grid_sensitivity` (a few minutes).
 
 use errp_robot::{Grid, QParams, QTable};
-use errp_sim::{
-    AssessmentDecoder, CalibrationRequest, EegDecoder, FIXED_PAIRS, GridTaskParams, PErrorChoice,
-    mean_sd, run_calibration, run_grid_episode,
+use errp_sim::calibration::{CalibrationRequest, run_calibration};
+use errp_sim::grid::{
+    AssessmentDecoder, EegDecoder, FIXED_PAIRS, GridTaskParams, PErrorChoice, run_grid_episode,
 };
+use errp_sim::mean_sd;
 
 struct Variant {
     label: &'static str,

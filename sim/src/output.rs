@@ -82,7 +82,7 @@ impl Drop for PendingFile {
 }
 
 /// Writes `bytes` to `path` through a temporary file renamed into place.
-pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     use std::io::Write;
     let (pending, mut file) = PendingFile::create(path)?;
     file.write_all(bytes)

@@ -8,6 +8,13 @@ use rerun::{RecordingStream, RecordingStreamBuilder, blueprint::Blueprint};
 use crate::error::{Result, SimError};
 use crate::output::PendingFile;
 
+/// The simulation timeline of task recordings (s).
+pub const SIM_TIME: &str = "sim_time";
+
+/// The timeline of calibration recordings: time after the action (s), on
+/// which grand averages are drawn.
+pub const LATENCY_TIMELINE: &str = "latency";
+
 /// An `.rrd` file being recorded. Log to [`RrdFile::stream`]; call
 /// [`RrdFile::finish`] to flush it and move it into place.
 pub struct RrdFile {

@@ -3,7 +3,7 @@
 
 use errp_bci::{AssessmentKind, DetectorParams, EegGenerator, SlidingWindow};
 use errp_robot::{EpuckParams, Pose, Twist};
-use errp_sim::{
+use errp_sim::epuck::{
     ArenaSpec, EpuckObserver, EpuckScenario, PhysicsFrame, World, finish_continuous_decoder,
     prepare_continuous_decoder, run_epuck_batch, run_epuck_once, summarise,
 };
@@ -166,7 +166,7 @@ fn the_obstacle_reflex_keeps_the_robot_off_the_pillar() {
     s.params.max_secs = 90.0;
     let (decoder, _) = prepare_continuous_decoder(&s, |_| {}).unwrap();
     struct Clear {
-        obstacles: Vec<errp_sim::Obstacle>,
+        obstacles: Vec<errp_sim::epuck::Obstacle>,
         radius_m: f64,
         closest_m: f64,
     }

@@ -3,9 +3,9 @@
 
 use errp_bci::Accuracy;
 use errp_robot::{Cell, Grid, QTable};
-use errp_sim::{
-    AssessmentDecoder, CalibrationRequest, EegDecoder, FIXED_PAIRS, GridTaskParams, PErrorChoice,
-    run_calibration, run_grid_episode,
+use errp_sim::calibration::{CalibrationRequest, run_calibration};
+use errp_sim::grid::{
+    AssessmentDecoder, EegDecoder, FIXED_PAIRS, GridTaskParams, PErrorChoice, run_grid_episode,
 };
 
 fn eeg_decoder(accuracy: f64, seed: u64) -> AssessmentDecoder {
@@ -20,7 +20,11 @@ fn table(params: &GridTaskParams) -> QTable {
     QTable::compute(Grid::paper(), &params.control.q).unwrap()
 }
 
-fn episodes(decoder: &AssessmentDecoder, n: usize, seed: u64) -> Vec<errp_sim::GridEpisodeResult> {
+fn episodes(
+    decoder: &AssessmentDecoder,
+    n: usize,
+    seed: u64,
+) -> Vec<errp_sim::grid::GridEpisodeResult> {
     let params = GridTaskParams::default();
     let t = table(&params);
     (0..n)
@@ -31,8 +35,8 @@ fn episodes(decoder: &AssessmentDecoder, n: usize, seed: u64) -> Vec<errp_sim::G
         .collect()
 }
 
-fn pooled(results: &[errp_sim::GridEpisodeResult]) -> Accuracy {
-    errp_sim::pooled_accuracy(results)
+fn pooled(results: &[errp_sim::grid::GridEpisodeResult]) -> Accuracy {
+    errp_sim::grid::pooled_accuracy(results)
 }
 
 #[test]
@@ -84,11 +88,11 @@ fn same_seed_same_episode() {
 
 #[test]
 fn table1_gives_the_same_results_on_one_and_two_threads() {
-    let options = errp_sim::Table1Options {
+    let options = errp_sim::grid::Table1Options {
         repeats: 1,
         seed: 4,
-        decoder: errp_sim::DecoderChoice::Oracle,
-        eeg: errp_sim::EegMode::Stream,
+        decoder: errp_sim::grid::DecoderChoice::Oracle,
+        eeg: errp_sim::grid::EegMode::Stream,
         params: GridTaskParams::default(),
     };
     let on = |threads| {
@@ -96,7 +100,7 @@ fn table1_gives_the_same_results_on_one_and_two_threads() {
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| errp_sim::run_table1(&options, |_, _| {}).unwrap())
+            .install(|| errp_sim::grid::run_table1(&options, |_, _| {}).unwrap())
     };
     let (one, two) = (on(1), on(2));
     assert_eq!(one.len(), 8);
@@ -110,7 +114,7 @@ fn table1_gives_the_same_results_on_one_and_two_threads() {
 fn banked_epochs_give_the_streamed_accuracy_and_reach_the_goals() {
     let report = run_calibration(&CalibrationRequest::new(0.90, 7), |_| {}, None).unwrap();
     let eeg = EegDecoder::from_report(&report, PErrorChoice::Platt);
-    let bank = errp_sim::EpochBank::build(eeg, &GridTaskParams::default(), 400, 7).unwrap();
+    let bank = errp_sim::grid::EpochBank::build(eeg, &GridTaskParams::default(), 400, 7).unwrap();
     assert_eq!(bank.len(), 400);
     let decoder = AssessmentDecoder::EegBank(Box::new(bank));
     let results = episodes(&decoder, 20, 7);
@@ -140,9 +144,9 @@ fn a_decoder_without_errps_converges_to_the_right_goal_only_by_chance() {
         montage: setup.montage.clone(),
         preprocessor: c.session.preprocessor.clone(),
         model: c.model.clone(),
-        p_error: errp_sim::PErrorMapping::Platt(c.platt),
+        p_error: errp_sim::grid::PErrorMapping::Platt(c.platt),
     };
-    let bank = errp_sim::EpochBank::build(eeg, &GridTaskParams::default(), 300, 5).unwrap();
+    let bank = errp_sim::grid::EpochBank::build(eeg, &GridTaskParams::default(), 300, 5).unwrap();
     let decoder = AssessmentDecoder::EegBank(Box::new(bank));
     let results = episodes(&decoder, 50, 5);
     let right = results.iter().filter(|r| r.reached()).count();
@@ -156,8 +160,8 @@ fn an_epoch_bank_from_parts_equals_the_bank_streamed_at_its_ratio() {
     let report = run_calibration(&CalibrationRequest::new(0.75, 2), |_| {}, None).unwrap();
     let eeg = EegDecoder::from_report(&report, PErrorChoice::Platt);
     let params = GridTaskParams::default();
-    let direct = errp_sim::EpochBank::build(eeg.clone(), &params, 12, 2).unwrap();
-    let parts = errp_sim::EpochBankParts::build(eeg.source(), &params, 12, 2).unwrap();
+    let direct = errp_sim::grid::EpochBank::build(eeg.clone(), &params, 12, 2).unwrap();
+    let parts = errp_sim::grid::EpochBankParts::build(eeg.source(), &params, 12, 2).unwrap();
     let mixed = parts.bank(eeg);
     assert_eq!(mixed.len(), 12);
     let mut worst = 0.0f64;

@@ -10,3 +10,22 @@ pub(crate) mod tracker;
 pub(crate) mod user;
 pub(crate) mod view;
 pub(crate) mod world;
+
+pub use decoder::{
+    ContinuousDecoder, ContinuousReport, ContinuousRequest, OnlineReport, calibrate_continuous_at,
+    run_continuous_calibration, run_online_calibration,
+};
+pub use episode::{
+    EpuckEpisode, EpuckEpisodeResult, EpuckObserver, EpuckTaskParams, PHYSICS_DT_SECS,
+    PhysicsFrame, WINDOW_STEP_SECS, WindowFrame, run_epuck_episode,
+};
+pub use errp_robot::AvoidanceParams;
+pub use run::{
+    EpuckSummary, epuck_run_seed, finish_continuous_decoder, prepare_continuous_decoder,
+    prepare_continuous_decoder_with, run_epuck_batch, run_epuck_once, summarise,
+};
+pub use scenario::EpuckScenario;
+pub use tracker::{CameraTracker, TrackerParams};
+pub use user::{Elicited, Judgement, SeenMotion, SyntheticUser, UserParams};
+pub use view::{EpuckRecorder, RUN_GAP_SECS, epuck_recording};
+pub use world::{ArenaSpec, Obstacle, ProximitySensors, World};

@@ -19,7 +19,7 @@ use rerun::{
 use crate::epuck::episode::{EpuckObserver, PhysicsFrame, WindowFrame};
 use crate::epuck::world::{ArenaSpec, Obstacle};
 use crate::error::{Result, SimError};
-use crate::grid::view::SIM_TIME;
+use crate::record::SIM_TIME;
 use crate::record::{RrdFile, log_decoder_series, record_error};
 
 /// Pause between runs on the timeline (s).

@@ -6,3 +6,14 @@ pub(crate) mod run;
 pub(crate) mod scenario;
 pub(crate) mod table1;
 pub(crate) mod view;
+
+pub use episode::{
+    AssessmentDecoder, EegDecoder, EegSource, EpochBank, EpochBankParts, GridEpisodeResult,
+    GridStep, GridTaskParams, PErrorChoice, PErrorMapping, run_grid_episode,
+};
+pub use run::{
+    GridRunReport, decoder_from_calibration, pooled_accuracy, prepare_decoder, run_grid_scenario,
+};
+pub use scenario::{DecoderChoice, EegMode, GridScenario, free_pairs};
+pub use table1::{FIXED_PAIRS, Table1Cell, Table1Options, accuracy_time_correlation, run_table1};
+pub use view::{grid_recording, record_grid_run};

@@ -10,10 +10,8 @@ use rerun::{Boxes2D, Color, Image, Points2D, Scalars, SeriesLines, TextLog};
 
 use crate::error::Result;
 use crate::grid::run::GridRunReport;
-use crate::record::{RrdFile, log_decoder_series, record_error};
+use crate::record::{RrdFile, SIM_TIME, log_decoder_series, record_error};
 
-/// The simulation timeline (s).
-pub const SIM_TIME: &str = "sim_time";
 /// Pause between episodes on the timeline (s).
 const EPISODE_GAP_SECS: f64 = 2.0;
 

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 
 use divan::Bencher;
-use errp_sim::{
+use errp_sweep::{
     Shard, SweepOptions, SweepOutcome, SweepSpec, SweepTask, TargetCache, parse_accuracies,
     run_sweep,
 };

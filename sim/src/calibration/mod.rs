@@ -1,5 +1,9 @@
 //! A calibration run: accuracy targeting, then the calibration session at the
-//! ratio found, scored and trained like the paper's.
+//! ratio found, scored and trained like the paper's; and its recording.
+
+mod view;
+
+pub use view::{calibration_recording, record_calibration};
 
 use errp_bci::{
     Calibrated, CalibrationSetup, GeneratorParams, LdaDecoder, LdaModel, RawSink, SessionOptions,

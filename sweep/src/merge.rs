@@ -5,11 +5,11 @@ use std::fs::File;
 use std::io::{BufRead, BufReader, BufWriter, Lines, Write};
 use std::path::{Path, PathBuf};
 
-use crate::error::{Result, SimError};
-use crate::output::PendingFile;
+use errp_sim::PendingFile;
+use errp_sim::{Result, SimError};
 
-use super::run::{EPISODES, MANIFEST, Manifest, episodes_header};
-use super::summary::{SweepReport, finish_dir};
+use crate::run::{EPISODES, MANIFEST, Manifest, episodes_header};
+use crate::summary::{SweepReport, finish_dir};
 
 /// Merges the shard directories `dirs` (every shard of one sweep, in any
 /// order) into `out`: `episodes.csv` in sweep order, then the summary, plots

@@ -11,8 +11,8 @@ use std::path::{Path, PathBuf};
 use errp_bci::TargetingResult;
 use serde::{Deserialize, Serialize};
 
-use crate::error::Result;
-use crate::output::write_atomic;
+use errp_sim::Result;
+use errp_sim::write_atomic;
 
 /// Where targeting results are kept (or nowhere).
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -96,7 +96,7 @@ impl TargetCache {
 
     fn store(path: &Path, entry: &Entry) -> Result<()> {
         if let Some(parent) = path.parent() {
-            std::fs::create_dir_all(parent).map_err(|source| crate::SimError::Output {
+            std::fs::create_dir_all(parent).map_err(|source| errp_sim::SimError::Output {
                 path: parent.to_path_buf(),
                 source,
             })?;

@@ -11,16 +11,16 @@ use std::path::{Path, PathBuf};
 
 use errp_bci::GoalSet;
 
-use crate::epuck::scenario::{AnyScenario, parse_scenario};
-use crate::error::{Result, SimError};
-use crate::output::write_atomic;
-use crate::paper::{PAPER, PAPER_EPUCK};
-use crate::stats::{StreamingPearson, pearson, wilson_interval};
-use crate::stats::{mean_sd, median};
+use errp_sim::write_atomic;
+use errp_sim::{AnyScenario, parse_scenario};
+use errp_sim::{PAPER, PAPER_EPUCK};
+use errp_sim::{Result, SimError};
+use errp_sim::{StreamingPearson, pearson, wilson_interval};
+use errp_sim::{mean_sd, median};
 
-use super::plot::{self, LevelPoint, PaperPoint, Series, SweepPlot};
-use super::run::{EPISODES, Manifest, cost_column};
-use super::spec::{SweepSpec, SweepTask, format_number, value_text};
+use crate::plot::{self, LevelPoint, PaperPoint, Series, SweepPlot};
+use crate::run::{EPISODES, Manifest, cost_column};
+use crate::spec::{SweepSpec, SweepTask, format_number, value_text};
 
 /// The statistics of one level.
 #[derive(Debug, Clone, PartialEq)]
@@ -456,8 +456,8 @@ pub fn sweep_plot(spec: &SweepSpec, report: &SweepReport, scenario: &AnyScenario
     }
     let decoder = match scenario {
         AnyScenario::Grid(s) => match s.decoder {
-            crate::grid::scenario::DecoderChoice::Oracle => "oracle decoder".to_string(),
-            crate::grid::scenario::DecoderChoice::Eeg => {
+            errp_sim::grid::DecoderChoice::Oracle => "oracle decoder".to_string(),
+            errp_sim::grid::DecoderChoice::Eeg => {
                 format!("EEG decoder ({:?})", s.eeg).to_lowercase()
             }
         },
@@ -561,7 +561,7 @@ pub fn finish_dir(dir: &Path, manifest: &Manifest) -> Result<SweepReport> {
         report.files.push(dir.join(name));
     }
     manifest.write(dir)?;
-    report.files.push(dir.join(super::run::MANIFEST));
+    report.files.push(dir.join(crate::run::MANIFEST));
     report.files.push(dir.join(EPISODES));
     Ok(report)
 }

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use errp_sim::{
+use errp_sweep::{
     Manifest, Shard, SweepObserver, SweepOptions, SweepOutcome, SweepSpec, SweepTask, TargetCache,
     finish_dir, merge_sweeps, parse_accuracies, parse_axis, run_sweep,
 };

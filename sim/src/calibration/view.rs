@@ -11,10 +11,8 @@ use rerun::{Color, Image, LineStrips2D, Points2D, Scalars, SeriesLines, TextDocu
 
 use crate::calibration::CalibrationReport;
 use crate::error::{Result, SimError};
-use crate::record::{RrdFile, record_error};
+use crate::record::{LATENCY_TIMELINE, RrdFile, record_error};
 
-/// Timeline of the grand averages: latency after the action onset.
-pub const LATENCY_TIMELINE: &str = "latency";
 /// Side of the topography image (pixels).
 const MAP_PX: usize = 200;
 

@@ -11,9 +11,9 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 use toml::{Table, Value};
 
-use crate::epuck::scenario::{AnyScenario, is_epuck, parse_scenario};
-use crate::error::{Result, SimError};
-use crate::grid::scenario::{parse_toml, read_scenario, set_key};
+use errp_sim::{AnyScenario, is_epuck, parse_scenario};
+use errp_sim::{Result, SimError};
+use errp_sim::{parse_toml, read_scenario, set_key};
 
 /// The two tasks a sweep can run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]

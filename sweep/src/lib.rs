@@ -7,6 +7,12 @@
 //! interruptions. Rows stream to `episodes.csv` as they finish; a rerun of the
 //! same sweep resumes; `summary.csv`, `sweep.svg`, `sweep.png` and
 //! `sweep.json` are written whole at the end.
+//!
+//! Episodes are run by [`errp_sim`]'s task modules; this crate adds the
+//! levels, the ordered and resumable `episodes.csv`, the target cache,
+//! sharding and merging, the summaries and the plots.
+
+#![warn(clippy::unwrap_used, clippy::print_stdout, clippy::iter_over_hash_type)]
 
 mod cache;
 mod merge;

@@ -15,21 +15,20 @@ use errp_bci::{
 use errp_robot::{Cell, Grid, QTable};
 use serde::{Deserialize, Serialize};
 
-use crate::calibration::{CalibrationReport, CalibrationRequest};
-use crate::epuck::decoder::{ContinuousDecoder, ContinuousRequest, calibrate_continuous_at};
-use crate::epuck::episode::run_epuck_episode;
-use crate::epuck::run::finish_continuous_decoder;
-use crate::epuck::scenario::{AnyScenario, EpuckScenario};
-use crate::error::{Result, SimError};
-use crate::grid::episode::{
-    AssessmentDecoder, EegDecoder, EegSource, EpochBankParts, run_grid_episode,
-};
-use crate::grid::run::decoder_from_calibration;
-use crate::grid::scenario::{DecoderChoice, EegMode, GridScenario};
-use crate::output::write_atomic;
+use errp_sim::AnyScenario;
+use errp_sim::calibration::{CalibrationReport, CalibrationRequest};
+use errp_sim::epuck::EpuckScenario;
+use errp_sim::epuck::finish_continuous_decoder;
+use errp_sim::epuck::run_epuck_episode;
+use errp_sim::epuck::{ContinuousDecoder, ContinuousRequest, calibrate_continuous_at};
+use errp_sim::grid::decoder_from_calibration;
+use errp_sim::grid::{AssessmentDecoder, EegDecoder, EegSource, EpochBankParts, run_grid_episode};
+use errp_sim::grid::{DecoderChoice, EegMode, GridScenario};
+use errp_sim::write_atomic;
+use errp_sim::{Result, SimError};
 
-use super::cache::TargetCache;
-use super::spec::{Level, Shard, SweepSpec, SweepTask, format_number, value_text};
+use crate::cache::TargetCache;
+use crate::spec::{Level, Shard, SweepSpec, SweepTask, format_number, value_text};
 
 /// The calibrated decoder behind one or more levels, as `sweep.json` lists it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
