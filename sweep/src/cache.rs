@@ -105,3 +105,14 @@ impl TargetCache {
         write_atomic(path, text.as_bytes())
     }
 }
+
+impl errp_sim::calibration::TargetingCache for TargetCache {
+    fn get_or_search(
+        &self,
+        kind: &str,
+        request: &str,
+        search: &mut dyn FnMut() -> Result<TargetingResult>,
+    ) -> Result<(TargetingResult, bool)> {
+        TargetCache::get_or_search(self, kind, request, search)
+    }
+}

@@ -15,19 +15,22 @@
 #![warn(clippy::unwrap_used, clippy::print_stdout, clippy::iter_over_hash_type)]
 
 mod cache;
+mod manifest;
 mod merge;
 mod plot;
+mod prepare;
+mod rows;
 mod run;
 mod spec;
 mod summary;
+mod writer;
 
 pub use cache::TargetCache;
+pub use manifest::{DecoderInfo, EPISODES, MANIFEST, Manifest};
 pub use merge::merge_sweeps;
 pub use plot::{LevelPoint, PaperPoint, PlotError, Series, SweepPlot};
-pub use run::{
-    DecoderInfo, EPISODES, MANIFEST, Manifest, SweepObserver, SweepOptions, SweepOutcome,
-    cost_column, episodes_header, run_sweep,
-};
+pub use rows::{cost_column, episodes_header};
+pub use run::{SweepObserver, SweepOptions, SweepOutcome, run_sweep};
 pub use spec::{
     Axis, Level, Shard, SweepSpec, SweepTask, parse_accuracies, parse_axis, parse_values, read_task,
 };

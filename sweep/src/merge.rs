@@ -8,7 +8,8 @@ use std::path::{Path, PathBuf};
 use errp_sim::PendingFile;
 use errp_sim::{Result, SimError};
 
-use crate::run::{EPISODES, MANIFEST, Manifest, episodes_header};
+use crate::manifest::{EPISODES, MANIFEST, Manifest};
+use crate::rows::episodes_header;
 use crate::summary::{SweepReport, finish_dir};
 
 /// Merges the shard directories `dirs` (every shard of one sweep, in any

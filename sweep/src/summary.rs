@@ -18,8 +18,9 @@ use errp_sim::{Result, SimError};
 use errp_sim::{StreamingPearson, pearson, wilson_interval};
 use errp_sim::{mean_sd, median};
 
+use crate::manifest::{EPISODES, Manifest};
 use crate::plot::{self, LevelPoint, PaperPoint, Series, SweepPlot};
-use crate::run::{EPISODES, Manifest, cost_column};
+use crate::rows::cost_column;
 use crate::spec::{SweepSpec, SweepTask, format_number, value_text};
 
 /// The statistics of one level.
@@ -561,7 +562,7 @@ pub fn finish_dir(dir: &Path, manifest: &Manifest) -> Result<SweepReport> {
         report.files.push(dir.join(name));
     }
     manifest.write(dir)?;
-    report.files.push(dir.join(crate::run::MANIFEST));
+    report.files.push(dir.join(crate::manifest::MANIFEST));
     report.files.push(dir.join(EPISODES));
     Ok(report)
 }

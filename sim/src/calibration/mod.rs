@@ -106,3 +106,47 @@ pub fn calibrate_at(
         calibrated,
     })
 }
+
+/// Where targeting results are looked up before searching and kept after:
+/// the one place a sweep's on-disk cache plugs into the decoder preparation
+/// that `errp run`, Table 1 and sweeps share. The result of a search is a
+/// pure function of the request, so a cached result is the one the search
+/// would find.
+pub trait TargetingCache: Sync {
+    /// The targeting of `request` (text naming everything the search
+    /// depends on) of `kind` (the decoder: "grid-lda", "epuck-svm"): from
+    /// the cache if it holds it, else `search`'s result, then kept. The
+    /// flag is true for a cache hit.
+    fn get_or_search(
+        &self,
+        kind: &str,
+        request: &str,
+        search: &mut dyn FnMut() -> Result<TargetingResult>,
+    ) -> Result<(TargetingResult, bool)>;
+}
+
+/// No cache: every request is searched.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoCache;
+
+impl TargetingCache for NoCache {
+    fn get_or_search(
+        &self,
+        _kind: &str,
+        _request: &str,
+        search: &mut dyn FnMut() -> Result<TargetingResult>,
+    ) -> Result<(TargetingResult, bool)> {
+        Ok((search()?, false))
+    }
+}
+
+/// The text that names a targeting request in a [`TargetingCache`]:
+/// everything the search depends on.
+pub fn targeting_key(
+    setup: &impl std::fmt::Debug,
+    search: &TargetingParams,
+    accuracy: f64,
+    seed: u64,
+) -> String {
+    format!("{setup:?} {search:?} accuracy={accuracy:?} seed={seed}")
+}

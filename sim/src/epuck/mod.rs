@@ -21,8 +21,9 @@ pub use episode::{
 };
 pub use errp_robot::AvoidanceParams;
 pub use run::{
-    EpuckSummary, epuck_run_seed, finish_continuous_decoder, prepare_continuous_decoder,
-    prepare_continuous_decoder_with, run_epuck_batch, run_epuck_once, summarise,
+    EpuckSummary, PreparedEpuck, epuck_run_seed, finish_continuous_decoder,
+    prepare_continuous_decoder, prepare_continuous_decoder_with, prepare_epuck_decoder,
+    run_epuck_batch, run_epuck_once, summarise,
 };
 pub use scenario::EpuckScenario;
 pub use tracker::{CameraTracker, TrackerParams};

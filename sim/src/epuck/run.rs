@@ -2,11 +2,14 @@
 //! scenario's accuracy, then every run of the episode, each from its own
 //! derived seed (in parallel when no recording watches).
 
-use errp_bci::{Accuracy, OnlineStep, TargetingStep, rng::derive_seed};
+use errp_bci::{
+    Accuracy, OnlineStep, SvmDecoder, TargetingStep, rng::derive_seed, target_continuous_accuracy,
+};
 use rayon::prelude::*;
 
+use crate::calibration::{NoCache, TargetingCache, targeting_key};
 use crate::epuck::decoder::{
-    ContinuousDecoder, ContinuousReport, ContinuousRequest, run_continuous_calibration,
+    ContinuousDecoder, ContinuousReport, ContinuousRequest, calibrate_continuous_at,
     run_online_calibration,
 };
 use crate::epuck::episode::{EpuckEpisodeResult, EpuckObserver, run_epuck_episode};
@@ -33,11 +36,59 @@ pub fn prepare_continuous_decoder_with(
     progress: impl FnMut(&TargetingStep),
     online_progress: impl FnMut(&OnlineStep),
 ) -> Result<(ContinuousDecoder, ContinuousReport)> {
+    let prepared = prepare_epuck_decoder(scenario, &NoCache, progress, online_progress)?;
+    Ok((prepared.decoder, prepared.report))
+}
+
+/// An e-puck decoder, ready for runs.
+#[derive(Debug, Clone)]
+pub struct PreparedEpuck {
+    /// The decoder, with its online operating point measured.
+    pub decoder: ContinuousDecoder,
+    /// Its calibration.
+    pub report: ContinuousReport,
+    /// True if the targeting came from the cache.
+    pub cached: bool,
+}
+
+/// Builds the scenario's continuous decoder, the one path of every e-puck
+/// command. With an accuracy target: the ratio from `cache` (or searched;
+/// `progress` sees the search), the calibration session at it, then the
+/// operating point measured on a held-out recording. With an online target
+/// (`[user] hit_rate`), the search that `online_progress` sees, which
+/// measures the operating point at every step and is not cached.
+pub fn prepare_epuck_decoder(
+    scenario: &EpuckScenario,
+    cache: &dyn TargetingCache,
+    mut progress: impl FnMut(&TargetingStep),
+    online_progress: impl FnMut(&OnlineStep),
+) -> Result<PreparedEpuck> {
     let request = ContinuousRequest::new(scenario.accuracy, scenario.seed);
     match scenario.online_target {
         None => {
-            let report = run_continuous_calibration(&request, progress)?;
-            Ok((finish_continuous_decoder(scenario, &report)?, report))
+            let key = targeting_key(
+                &request.setup,
+                &request.search,
+                request.accuracy,
+                request.seed,
+            );
+            let (targeting, cached) = cache.get_or_search("epuck-svm", &key, &mut || {
+                Ok(target_continuous_accuracy(
+                    request.accuracy,
+                    &SvmDecoder::default(),
+                    &request.setup,
+                    &request.search,
+                    request.seed,
+                    &mut progress,
+                )?)
+            })?;
+            let report = calibrate_continuous_at(&request, targeting)?;
+            let decoder = finish_continuous_decoder(scenario, &report)?;
+            Ok(PreparedEpuck {
+                decoder,
+                report,
+                cached,
+            })
         }
         Some(target) => {
             let (decoder, report, _) = run_online_calibration(
@@ -47,7 +98,11 @@ pub fn prepare_continuous_decoder_with(
                 scenario.params.control.t_e,
                 online_progress,
             )?;
-            Ok((decoder, report))
+            Ok(PreparedEpuck {
+                decoder,
+                report,
+                cached: false,
+            })
         }
     }
 }

@@ -12,7 +12,8 @@ pub use episode::{
     GridStep, GridTaskParams, PErrorChoice, PErrorMapping, run_grid_episode,
 };
 pub use run::{
-    GridRunReport, decoder_from_calibration, pooled_accuracy, prepare_decoder, run_grid_scenario,
+    GridRunReport, GridShared, PreparedGrid, decoder_from_calibration, pooled_accuracy,
+    prepare_decoder, prepare_grid_decoder, run_grid_scenario,
 };
 pub use scenario::{DecoderChoice, EegMode, GridScenario, free_pairs};
 pub use table1::{FIXED_PAIRS, Table1Cell, Table1Options, accuracy_time_correlation, run_table1};

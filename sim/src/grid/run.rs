@@ -1,13 +1,22 @@
 //! Running a grid scenario: calibrate the decoder (EEG) or not (oracle), then
 //! every episode, each from its own derived seed.
 
-use errp_bci::{Accuracy, TargetingStep, rng::derive_seed};
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use errp_bci::{
+    Accuracy, GeneratorParams, LdaDecoder, SessionParts, TargetingStep, calibrate_session,
+    rng::derive_seed, target_accuracy_on,
+};
 use errp_robot::{Grid, QTable};
 
-use crate::calibration::{CalibrationReport, CalibrationRequest, run_calibration};
+use crate::calibration::{
+    CalibrationReport, CalibrationRequest, NoCache, TargetingCache, targeting_key,
+};
 use crate::error::{Result, SimError};
 use crate::grid::episode::{
-    AssessmentDecoder, EegDecoder, EpochBank, GridEpisodeResult, run_grid_episode,
+    AssessmentDecoder, EegDecoder, EegSource, EpochBank, EpochBankParts, GridEpisodeResult,
+    run_grid_episode,
 };
 use crate::grid::scenario::{DecoderChoice, EegMode, GridScenario};
 
@@ -35,22 +44,171 @@ pub fn pooled_accuracy(episodes: &[GridEpisodeResult]) -> Accuracy {
 }
 
 /// Builds the scenario's decoder: for the EEG decoder, a calibration session
-/// targeted at the scenario's accuracy (`progress` sees the search).
+/// targeted at the scenario's accuracy (`progress` sees the search). The
+/// path of `errp run` and Table 1: [`prepare_grid_decoder`] with nothing
+/// shared and no cache.
 pub fn prepare_decoder(
     scenario: &GridScenario,
     progress: impl FnMut(&TargetingStep),
 ) -> Result<(AssessmentDecoder, Option<CalibrationReport>)> {
-    match scenario.decoder {
-        DecoderChoice::Oracle => Ok((decoder_from_calibration(scenario, None)?, None)),
-        DecoderChoice::Eeg => {
-            let request = CalibrationRequest::new(scenario.accuracy, scenario.seed);
-            let report = run_calibration(&request, progress, None)?;
-            Ok((
-                decoder_from_calibration(scenario, Some(&report))?,
-                Some(report),
-            ))
+    let prepared = prepare_grid_decoder(scenario, &GridShared::default(), &NoCache, progress)?;
+    Ok((prepared.decoder, prepared.calibration))
+}
+
+/// A grid decoder, ready for episodes.
+#[derive(Debug, Clone)]
+pub struct PreparedGrid {
+    /// The decoder.
+    pub decoder: AssessmentDecoder,
+    /// Its calibration (none for the oracle).
+    pub calibration: Option<CalibrationReport>,
+    /// True if the targeting came from the cache.
+    pub cached: bool,
+}
+
+/// What the decoders of several grid scenarios can share, simulated once:
+/// the calibration session of each seed (as its noise and ERP parts, so
+/// that every accuracy mixes them at its own ratio) and the epoch banks.
+/// Empty, [`prepare_grid_decoder`] simulates what a scenario needs itself.
+#[derive(Debug, Default)]
+pub struct GridShared {
+    sessions: HashMap<u64, Arc<SessionParts>>,
+    banks: HashMap<String, Arc<EpochBankParts>>,
+}
+
+/// The key of a grid scenario's epoch bank: what its epochs depend on.
+fn bank_key(s: &GridScenario) -> String {
+    format!(
+        "{:?}",
+        (
+            s.seed,
+            s.bank_per_class,
+            s.params.interval_min_secs,
+            s.params.interval_max_secs
+        )
+    )
+}
+
+/// The calibration session of `seed`, streamed as its noise and ERP parts
+/// in parallel.
+fn simulate_session(accuracy: f64, seed: u64) -> Result<SessionParts> {
+    let setup = CalibrationRequest::new(accuracy, seed).setup;
+    let (noise, erp) = rayon::join(
+        || SessionParts::simulate_part(&setup, seed, false),
+        || SessionParts::simulate_part(&setup, seed, true),
+    );
+    Ok(SessionParts::from_parts(noise?, erp?)?)
+}
+
+/// The epoch bank parts of `s`, streamed through `session`'s preprocessing.
+fn build_bank(s: &GridScenario, session: &SessionParts) -> Result<EpochBankParts> {
+    let setup = CalibrationRequest::new(s.accuracy, s.seed).setup;
+    let source = EegSource {
+        generator: &setup.generator,
+        montage: &setup.montage,
+        preprocessor: session.preprocessor(),
+    };
+    EpochBankParts::build(source, &s.params, s.bank_per_class, s.seed)
+}
+
+impl GridShared {
+    /// Simulates once what `scenarios` share: one calibration session per
+    /// seed, one epoch bank per bank key (EEG decoders only).
+    pub fn build<'a>(scenarios: impl IntoIterator<Item = &'a GridScenario>) -> Result<Self> {
+        let mut shared = Self::default();
+        for s in scenarios {
+            if s.decoder != DecoderChoice::Eeg {
+                continue;
+            }
+            if let std::collections::hash_map::Entry::Vacant(slot) = shared.sessions.entry(s.seed) {
+                slot.insert(Arc::new(simulate_session(s.accuracy, s.seed)?));
+            }
+            let key = bank_key(s);
+            if s.eeg == EegMode::Bank && !shared.banks.contains_key(&key) {
+                let bank = build_bank(s, &shared.sessions[&s.seed])?;
+                shared.banks.insert(key, Arc::new(bank));
+            }
         }
+        Ok(shared)
     }
+}
+
+/// Builds the scenario's decoder, the one path of every grid command. For
+/// the EEG decoder: the calibration session (from `shared`, or simulated),
+/// the ErrP-to-noise ratio targeted for the scenario's accuracy (from
+/// `cache`, or searched; `progress` sees the search), the session at that
+/// ratio scored by cross-validation and trained on, then the online
+/// decoder, streamed or with its epoch bank (from `shared`, or built).
+pub fn prepare_grid_decoder(
+    scenario: &GridScenario,
+    shared: &GridShared,
+    cache: &dyn TargetingCache,
+    mut progress: impl FnMut(&TargetingStep),
+) -> Result<PreparedGrid> {
+    if scenario.decoder == DecoderChoice::Oracle {
+        return Ok(PreparedGrid {
+            decoder: decoder_from_calibration(scenario, None)?,
+            calibration: None,
+            cached: false,
+        });
+    }
+    let request = CalibrationRequest::new(scenario.accuracy, scenario.seed);
+    let simulated;
+    let parts = match shared.sessions.get(&scenario.seed) {
+        Some(parts) => parts.as_ref(),
+        None => {
+            simulated = simulate_session(scenario.accuracy, scenario.seed)?;
+            &simulated
+        }
+    };
+    let key = targeting_key(
+        &request.setup,
+        &request.search,
+        request.accuracy,
+        request.seed,
+    );
+    let lda = LdaDecoder::default();
+    let (targeting, cached) = cache.get_or_search("grid-lda", &key, &mut || {
+        Ok(target_accuracy_on(
+            parts,
+            request.accuracy,
+            &lda,
+            &request.setup,
+            &request.search,
+            request.seed,
+            &mut progress,
+        )?)
+    })?;
+    let calibrated = calibrate_session(
+        &lda,
+        parts.session_at(targeting.ratio),
+        request.setup.calibration.folds,
+        request.seed,
+    )?;
+    let report = CalibrationReport {
+        generator: GeneratorParams {
+            errp_to_noise: targeting.ratio,
+            ..request.setup.generator.clone()
+        },
+        targeting,
+        calibrated,
+    };
+    let eeg = EegDecoder::from_report(&report, scenario.p_error);
+    let decoder = match scenario.eeg {
+        EegMode::Stream => AssessmentDecoder::Eeg(Box::new(eeg)),
+        EegMode::Bank => {
+            let bank = match shared.banks.get(&bank_key(scenario)) {
+                Some(bank) => bank.bank(eeg),
+                None => build_bank(scenario, parts)?.bank(eeg),
+            };
+            AssessmentDecoder::EegBank(Box::new(bank))
+        }
+    };
+    Ok(PreparedGrid {
+        decoder,
+        calibration: Some(report),
+        cached,
+    })
 }
 
 /// The scenario's decoder from its calibration (none for the oracle): the
