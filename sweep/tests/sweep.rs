@@ -283,3 +283,29 @@ fn inference_degrades_as_the_decoder_gets_worse() {
     assert!(hi.2 > 14.0 && hi.2 < 30.0, "mean actions at 0.9: {}", hi.2);
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// A sweep calibrates each level's decoder exactly as `errp run` calibrates
+/// the same scenario: the same ratio and the same cross-validated accuracy,
+/// to the bit, whether the targeting came from the cache or not.
+#[test]
+fn a_sweep_calibrates_like_errp_run() {
+    let spec = spec(GRID_EEG, "0.65,0.8", &[], 1);
+    let out = temp_dir("same-calibration");
+    complete(&spec, &out, Shard::ALL, 2);
+    let manifest = Manifest::read(&out).unwrap();
+    for (level, info) in spec.levels().unwrap().iter().zip(&manifest.decoders) {
+        let errp_sim::AnyScenario::Grid(scenario) = &level.scenario else {
+            panic!("a grid level");
+        };
+        let (_, report) = errp_sim::grid::prepare_decoder(scenario, |_| {}).unwrap();
+        let report = report.expect("an EEG decoder is calibrated");
+        let a = report.calibrated.accuracy;
+        assert_eq!(
+            info.errp_to_noise.map(f64::to_bits),
+            Some(report.targeting.ratio.to_bits())
+        );
+        assert_eq!(info.cv_mean.map(f64::to_bits), Some(a.mean().to_bits()));
+        assert_eq!(info.cv_error.map(f64::to_bits), Some(a.error.to_bits()));
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}
