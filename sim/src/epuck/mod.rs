@@ -4,6 +4,7 @@
 
 pub(crate) mod decoder;
 pub(crate) mod episode;
+pub(crate) mod report;
 pub(crate) mod run;
 pub(crate) mod scenario;
 pub(crate) mod tracker;
@@ -20,6 +21,7 @@ pub use episode::{
     PhysicsFrame, WINDOW_STEP_SECS, WindowFrame, run_epuck_episode,
 };
 pub use errp_robot::AvoidanceParams;
+pub use report::{EpuckRunHeader, EpuckRunRow, EpuckSummaryReport};
 pub use run::{
     EpuckSummary, PreparedEpuck, epuck_run_seed, finish_continuous_decoder,
     prepare_continuous_decoder, prepare_continuous_decoder_with, prepare_epuck_decoder,

@@ -2,6 +2,7 @@
 //! episode, a scenario's runs, Table 1 and the recording.
 
 pub(crate) mod episode;
+pub(crate) mod report;
 pub(crate) mod run;
 pub(crate) mod scenario;
 pub(crate) mod table1;
@@ -11,6 +12,7 @@ pub use episode::{
     AssessmentDecoder, EegDecoder, EegSource, EpochBank, EpochBankParts, GridEpisodeResult,
     GridStep, GridTaskParams, PErrorChoice, PErrorMapping, run_grid_episode,
 };
+pub use report::{GridEpisodeHeader, GridEpisodeRow, Table1Report};
 pub use run::{
     GridRunReport, GridShared, PreparedGrid, decoder_from_calibration, pooled_accuracy,
     prepare_decoder, prepare_grid_decoder, run_grid_scenario,

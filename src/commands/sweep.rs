@@ -97,8 +97,8 @@ pub struct MergeArgs {
     out: PathBuf,
 }
 
-const BUILT_IN_GRID: &str = include_str!("../scenarios/grid_fixed_goals.toml");
-const BUILT_IN_EPUCK: &str = include_str!("../scenarios/mexico_to_pisa.toml");
+const BUILT_IN_GRID: &str = include_str!("../../scenarios/grid_fixed_goals.toml");
+const BUILT_IN_EPUCK: &str = include_str!("../../scenarios/mexico_to_pisa.toml");
 
 /// Now, for the elapsed times the program prints. Only the command line
 /// reads the clock; nothing it computes depends on it.

@@ -1,0 +1,142 @@
+//! The tables `errp run` prints for the e-puck task, as `Display` types so
+//! that what users read is tested.
+
+use std::fmt;
+
+use errp_robot::GoalLayout;
+
+use crate::epuck::episode::EpuckEpisodeResult;
+use crate::epuck::run::EpuckSummary;
+use crate::paper::PAPER_EPUCK;
+
+/// The header line of the per-run table ([`EpuckRunRow`]).
+pub struct EpuckRunHeader;
+
+impl fmt::Display for EpuckRunHeader {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{:>4}  {:<16} {:>8}  {:>8} {:>6} {:>6} {:>6}  {:>8} {:>8}  {:>5} {:>6}",
+            "run",
+            "converged on",
+            "time (s)",
+            "detected",
+            "false",
+            "missed",
+            "ErrPs",
+            "acc corr",
+            "acc err",
+            "hit %",
+            "FA/min"
+        )
+    }
+}
+
+/// One run's line of the table: run `index` (from 0), its result, and the
+/// layout that names its goals.
+pub struct EpuckRunRow<'a> {
+    /// The run's index, from 0.
+    pub index: usize,
+    /// Its result.
+    pub result: &'a EpuckEpisodeResult,
+    /// The goal layout, for the city names.
+    pub layout: &'a GoalLayout,
+}
+
+impl fmt::Display for EpuckRunRow<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let r = self.result;
+        let name = |c: usize| self.layout.goals()[c].name.clone();
+        let on = match r.committed {
+            Some(c) if c == r.goal => name(c),
+            Some(c) => format!("{} WRONG", name(c)),
+            None => "time-out".into(),
+        };
+        write!(
+            f,
+            "{:>4}  {:<16} {:>8.1}  {:>8} {:>6} {:>6} {:>6}  {:>8.1} {:>8.1}  {:>5.0} {:>6.2}",
+            self.index + 1,
+            on,
+            r.time_secs,
+            r.detected_errors,
+            r.false_detections,
+            r.missed_errors,
+            r.errps,
+            100.0 * r.online.correct,
+            100.0 * r.online.error,
+            100.0 * r.hit_rate(),
+            r.false_alarms_per_min()
+        )
+    }
+}
+
+/// The summary of an e-puck scenario's runs, beside the paper's run of the
+/// same name if it has one.
+pub struct EpuckSummaryReport<'a> {
+    /// The summary.
+    pub summary: &'a EpuckSummary,
+    /// The scenario's name (the paper's runs are found by it).
+    pub scenario: &'a str,
+    /// The user's goal.
+    pub goal: &'a str,
+    /// The decision threshold in force.
+    pub t_e: f64,
+}
+
+impl fmt::Display for EpuckSummaryReport<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let s = self.summary;
+        let paper = PAPER_EPUCK.iter().find(|p| p.0 == self.scenario);
+        let note = |v: Option<String>| v.map(|v| format!("   [paper: {v}]")).unwrap_or_default();
+        writeln!(f, "Summary over {} run(s):", s.runs)?;
+        writeln!(
+            f,
+            "  reached {}      {} / {} ({} converged on a wrong city)",
+            self.goal, s.reached, s.runs, s.wrong
+        )?;
+        writeln!(
+            f,
+            "  median time (s)      {:.1}{}",
+            s.median_secs,
+            note(paper.map(|p| format!("{:.0}", p.1)))
+        )?;
+        writeln!(
+            f,
+            "  median detected      {:.1}{}",
+            s.median_detected,
+            note(paper.map(|p| p.2.to_string()))
+        )?;
+        writeln!(f, "  median false         {:.1}", s.median_false)?;
+        writeln!(
+            f,
+            "  detections           {:.3} per second of run; {:.0} % turning, {:.0} % driving, \
+             {:.0} % on a goal   [paper: 0.18 and 0.21, mostly during turns]",
+            s.detections_per_sec,
+            100.0 * s.phase_shares[0],
+            100.0 * s.phase_shares[1],
+            100.0 * s.phase_shares[2]
+        )?;
+        writeln!(
+            f,
+            "  true detections      of ErrPs judging a turn {:.0} %, a drive {:.0} %, a stop {:.0} %",
+            100.0 * s.judged_shares[0],
+            100.0 * s.judged_shares[1],
+            100.0 * s.judged_shares[2]
+        )?;
+        writeln!(
+            f,
+            "  online detector      hit rate {:.1} % per ErrP, {:.2} false alarms per error-free minute",
+            100.0 * s.hit_rate,
+            s.false_alarms_per_min
+        )?;
+        writeln!(
+            f,
+            "  window accuracy      correct {:.2} %, error {:.2} % at T_e = {} ({} clean / {} ErrP windows)",
+            100.0 * s.online.correct,
+            100.0 * s.online.error,
+            self.t_e,
+            s.online.n_correct,
+            s.online.n_error
+        )
+    }
+}

@@ -1,0 +1,181 @@
+//! The tables `errp run` and `errp table1` print for the grid task, as
+//! `Display` types so that what users read is tested.
+
+use std::fmt;
+
+use errp_bci::GoalSet;
+
+use crate::grid::episode::GridEpisodeResult;
+use crate::grid::run::GridRunReport;
+use crate::grid::table1::{Table1Cell, accuracy_time_correlation};
+use crate::paper::{PAPER, PAPER_POOLED};
+use crate::stats::mean_sd;
+
+/// The header line of the per-episode table ([`GridEpisodeRow`]).
+pub struct GridEpisodeHeader;
+
+impl fmt::Display for GridEpisodeHeader {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{:>3}  {:>6} {:>6}  {:>13}  {:>7}  {:>8}  {:>9}  {:>8} {:>8} {:>8}",
+            "#",
+            "start",
+            "goal",
+            "committed",
+            "actions",
+            "net (s)",
+            "total (s)",
+            "acc corr",
+            "acc err",
+            "acc mean"
+        )
+    }
+}
+
+/// One episode's line of the table: episode `index` (from 0) and its result.
+pub struct GridEpisodeRow<'a>(pub usize, pub &'a GridEpisodeResult);
+
+impl fmt::Display for GridEpisodeRow<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let GridEpisodeRow(k, r) = *self;
+        let committed = match r.committed {
+            Some(c) if c == r.goal => format!("{c} ok"),
+            Some(c) => format!("{c} WRONG"),
+            None => "none".to_string(),
+        };
+        let pct = |v: f64| {
+            if v.is_nan() {
+                "-".to_string()
+            } else {
+                format!("{:.1}", 100.0 * v)
+            }
+        };
+        write!(
+            f,
+            "{:>3}  {:>6} {:>6}  {:>13}  {:>7}  {:>8.2}  {:>9.2}  {:>8} {:>8} {:>8}",
+            k + 1,
+            r.start.to_string(),
+            r.goal.to_string(),
+            committed,
+            r.actions,
+            r.net_secs,
+            r.total_secs,
+            pct(r.online.correct),
+            pct(r.online.error),
+            pct(r.online.mean())
+        )
+    }
+}
+
+/// The summary of a grid run: goals reached, actions and times (mean +- sd)
+/// and the pooled online accuracy.
+impl fmt::Display for GridRunReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let n = self.episodes.len();
+        let reached = self.episodes.iter().filter(|r| r.reached()).count();
+        let col = |g: fn(&GridEpisodeResult) -> f64| {
+            mean_sd(&self.episodes.iter().map(g).collect::<Vec<_>>())
+        };
+        let (am, asd) = col(|r| r.actions as f64);
+        let (nm, nsd) = col(|r| r.net_secs);
+        let (tm, tsd) = col(|r| r.total_secs);
+        let online = self.online_accuracy();
+        writeln!(f, "Summary over {n} episodes:")?;
+        writeln!(f, "  goals reached    {reached} / {n}")?;
+        writeln!(f, "  actions          {am:.1} +- {asd:.1}")?;
+        writeln!(f, "  net time (s)     {nm:.2} +- {nsd:.2}")?;
+        writeln!(f, "  total time (s)   {tm:.2} +- {tsd:.2}")?;
+        writeln!(
+            f,
+            "  online accuracy  correct {:.2} %, error {:.2} %, mean {:.2} % over {} actions",
+            100.0 * online.correct,
+            100.0 * online.error,
+            100.0 * online.mean(),
+            online.n_correct + online.n_error
+        )
+    }
+}
+
+/// Table 1 as `errp table1` prints it: one row per subject and goal set,
+/// ours beside the paper's, the pooled rows and the accuracy-time
+/// correlations.
+pub struct Table1Report<'a>(pub &'a [Table1Cell]);
+
+impl fmt::Display for Table1Report<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let cells = self.0;
+        writeln!(
+            f,
+            "{:<10} {:>8}  {:>18}  {:>22}  {:>24}  {:>22}",
+            "", "reached", "actions", "net time (s)", "total time (s)", "mean accuracy (%)"
+        )?;
+        writeln!(
+            f,
+            "{:<10} {:>8}  {:>18}  {:>22}  {:>24}  {:>22}",
+            "", "", "ours [paper]", "ours [paper]", "ours [paper]", "ours [paper]"
+        )?;
+        let ours = |(m, sd): (f64, f64), (pm, psd): (f64, f64), d: usize| {
+            format!("{m:.d$}+-{sd:.d$} [{pm:.d$}+-{psd:.d$}]")
+        };
+        for set in [GoalSet::Fixed, GoalSet::Free] {
+            let set_name = if set == GoalSet::Fixed {
+                "fixed"
+            } else {
+                "free"
+            };
+            let mut all: Vec<&GridEpisodeResult> = Vec::new();
+            for c in cells.iter().filter(|c| c.goals == set) {
+                let paper = PAPER
+                    .iter()
+                    .find(|p| p.0 == c.subject && p.1 == set)
+                    .map_or([f64::NAN; 8], |p| p.2);
+                let reached = c.runs.iter().filter(|r| r.reached()).count();
+                writeln!(
+                    f,
+                    "{:<10} {:>8}  {:>18}  {:>22}  {:>24}  {:>22}",
+                    format!("{} {set_name}", c.subject),
+                    format!("{reached}/{}", c.runs.len()),
+                    ours(c.stat(|r| r.actions as f64), (paper[0], paper[1]), 0),
+                    ours(c.stat(|r| r.net_secs), (paper[2], paper[3]), 2),
+                    ours(c.stat(|r| r.total_secs), (paper[4], paper[5]), 2),
+                    ours(c.stat(|r| 100.0 * r.online.mean()), (paper[6], paper[7]), 2),
+                )?;
+                all.extend(c.runs.iter());
+            }
+            let stat = |g: &dyn Fn(&GridEpisodeResult) -> f64| {
+                mean_sd(&all.iter().map(|r| g(r)).collect::<Vec<_>>())
+            };
+            let (paper_mean, paper_r, paper_p) = PAPER_POOLED
+                .iter()
+                .find(|p| p.0 == set)
+                .map(|p| (p.1, p.2, p.3))
+                .ok_or(fmt::Error)?;
+            let reached = all.iter().filter(|r| r.reached()).count();
+            writeln!(
+                f,
+                "{:<10} {:>8}  {:>18}  {:>22}  {:>24}  {:>22}",
+                format!("mean {set_name}"),
+                format!("{reached}/{}", all.len()),
+                ours(
+                    stat(&|r| r.actions as f64),
+                    (paper_mean[0], paper_mean[1]),
+                    0
+                ),
+                ours(stat(&|r| r.net_secs), (paper_mean[2], paper_mean[3]), 2),
+                ours(stat(&|r| r.total_secs), (paper_mean[4], paper_mean[5]), 2),
+                ours(
+                    stat(&|r| 100.0 * r.online.mean()),
+                    (paper_mean[6], paper_mean[7]),
+                    2
+                ),
+            )?;
+            let (r, p) = accuracy_time_correlation(cells, set);
+            writeln!(
+                f,
+                "           accuracy vs total time ({set_name} goals): r = {r:.2}, p = {p:.2e}   [paper: r = {paper_r}, p = {paper_p:.2e}]"
+            )?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,163 @@
+//! The arguments of `errp calibrate`, `errp run` and `errp table1`, and what
+//! the commands share: checks of file names and accuracies, progress lines.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Result, bail};
+use clap::ValueEnum;
+use errp_bci::TargetingStep;
+use errp_sim::grid::EegMode;
+
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum Goals {
+    /// The five goals shared by all subjects.
+    Fixed,
+    /// The goals each subject chose.
+    Free,
+}
+
+#[derive(clap::Args)]
+pub(crate) struct CalibrateArgs {
+    /// Requested mean accuracy (mean of the correct- and error-class rates),
+    /// strictly between 0.5 and 1. Default: 0.7438, the paper's mean over
+    /// subjects with the fixed goals.
+    #[arg(long, value_parser = parse_accuracy, conflicts_with = "subject", allow_negative_numbers = true)]
+    pub(crate) accuracy: Option<f64>,
+    /// Take the accuracy of a subject of Table 1 (S1..S4) instead.
+    #[arg(long)]
+    pub(crate) subject: Option<String>,
+    /// Which of the subject's accuracies: fixed or free goals.
+    #[arg(long, value_enum, default_value = "fixed", requires = "subject")]
+    pub(crate) goals: Goals,
+    /// Seed of the synthetic user and session.
+    #[arg(long, default_value_t = 1)]
+    pub(crate) seed: u64,
+    /// Record grand averages, a topography and the summary to this `.rrd`.
+    #[arg(long, value_name = "FILE.rrd")]
+    pub(crate) save: Option<PathBuf>,
+    /// Write the raw synthetic EEG + EOG of the session, with `error` /
+    /// `correct` annotations, to this EDF+ file.
+    #[arg(long, value_name = "FILE.edf")]
+    pub(crate) export: Option<PathBuf>,
+    /// Print only the results, not the search.
+    #[arg(long, short)]
+    pub(crate) quiet: bool,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum DecoderArg {
+    /// Synthetic EEG through the real preprocessing and decoder.
+    Eeg,
+    /// Assessments flipped with probability 1 - accuracy, no EEG.
+    Oracle,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub(crate) enum EegArg {
+    /// Synthesise each action's EEG when it happens.
+    Stream,
+    /// Draw preprocessed epochs from a bank streamed in advance.
+    Bank,
+}
+
+impl EegArg {
+    pub(crate) fn mode(self) -> EegMode {
+        match self {
+            EegArg::Stream => EegMode::Stream,
+            EegArg::Bank => EegMode::Bank,
+        }
+    }
+}
+
+#[derive(clap::Args)]
+pub(crate) struct RunArgs {
+    /// The scenario file (TOML), e.g. scenarios/mexico_to_pisa.toml or
+    /// scenarios/grid_fixed_goals.toml.
+    pub(crate) scenario: PathBuf,
+    /// Override the scenario's seed.
+    #[arg(long)]
+    pub(crate) seed: Option<u64>,
+    /// Override the scenario's decoder (grid scenarios).
+    #[arg(long, value_enum)]
+    pub(crate) decoder: Option<DecoderArg>,
+    /// Override the decoder's accuracy (mean of the per-class rates, in
+    /// (0.5, 1)).
+    #[arg(long, value_parser = parse_accuracy, allow_negative_numbers = true)]
+    pub(crate) accuracy: Option<f64>,
+    /// Override the number of runs (e-puck scenarios); each run has its own
+    /// seed derived from the scenario's.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=100_000))]
+    pub(crate) runs: Option<u64>,
+    /// Override how the EEG reaches the decoder: streamed or from a bank
+    /// (grid scenarios).
+    #[arg(long, value_enum)]
+    pub(crate) eeg: Option<EegArg>,
+    /// Record every episode to this `.rrd`. Grid: cursor, goal, posterior,
+    /// visited states, p(error), EEG at FCz, event log. E-puck: arena,
+    /// cities coloured by belief, robot, trajectory, detected errors, belief
+    /// bars and series, p(error) and T_e, EEG at FCz and Cz, event log.
+    #[arg(long, value_name = "FILE.rrd")]
+    pub(crate) save: Option<PathBuf>,
+    /// Print only the results.
+    #[arg(long, short)]
+    pub(crate) quiet: bool,
+}
+
+#[derive(clap::Args)]
+pub(crate) struct Table1Args {
+    /// Runs per start/goal pair (5 pairs per subject and goal set).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=1000))]
+    pub(crate) episodes: u64,
+    /// Base seed.
+    #[arg(long, default_value_t = 1)]
+    pub(crate) seed: u64,
+    /// EEG decoder (default) or oracle.
+    #[arg(long, value_enum, default_value = "eeg")]
+    pub(crate) decoder: DecoderArg,
+    /// Stream each action's EEG (default) or draw epochs from a bank of
+    /// 1000 per class streamed in advance (much faster).
+    #[arg(long, value_enum, default_value = "stream")]
+    pub(crate) eeg: EegArg,
+    /// Print only the results.
+    #[arg(long, short)]
+    pub(crate) quiet: bool,
+}
+
+pub(crate) fn parse_accuracy(s: &str) -> Result<f64, String> {
+    let v: f64 = s.trim().parse().map_err(|_| {
+        format!(
+            "{s:?} is not a number: give a mean accuracy strictly between 0.5 and 1 as a \
+                 fraction, e.g. 0.7438"
+        )
+    })?;
+    errp_bci::check_requested_accuracy(v).map_err(|_| {
+        format!(
+            "{s} is out of range: give a mean accuracy strictly between 0.5 (chance) and 1 \
+             as a fraction, e.g. 0.7438 for 74.38 %"
+        )
+    })?;
+    Ok(v)
+}
+
+pub(crate) fn check_extension(path: &Path, ext: &str, flag: &str) -> Result<()> {
+    if path.extension().and_then(|e| e.to_str()) != Some(ext) {
+        bail!(
+            "{flag} {}: the file name must end in .{ext}",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
+/// Prints each accuracy-targeting step to stderr, unless `quiet`.
+pub(crate) fn calibration_progress(quiet: bool) -> impl FnMut(&TargetingStep) {
+    move |s| {
+        if !quiet {
+            eprintln!(
+                "  calibrating: ErrP-to-noise {:.4} -> mean {:.2} %",
+                s.ratio,
+                100.0 * s.accuracy.mean()
+            );
+        }
+    }
+}

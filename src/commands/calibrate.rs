@@ -1,0 +1,138 @@
+//! `errp calibrate` and `errp subjects`.
+
+use anyhow::{Context, Result};
+use errp_bci::{EdfWriter, GoalSet, subject, subjects};
+use errp_sim::PendingFile;
+use errp_sim::calibration::{
+    CalibrationRequest, calibration_recording, record_calibration, run_calibration,
+};
+
+use crate::cli::{CalibrateArgs, Goals, check_extension};
+
+pub(crate) fn calibrate(args: &CalibrateArgs) -> Result<()> {
+    let (accuracy, who) = match &args.subject {
+        Some(name) => {
+            let s = subject(name).context("--subject")?;
+            let goals = match args.goals {
+                Goals::Fixed => GoalSet::Fixed,
+                Goals::Free => GoalSet::Free,
+            };
+            let a = s.accuracy(goals);
+            (
+                a,
+                format!("subject {} ({:?} goals)", s.name, goals).to_lowercase(),
+            )
+        }
+        None => (args.accuracy.unwrap_or(0.7438), "requested".to_string()),
+    };
+    if let Some(p) = &args.save {
+        check_extension(p, "rrd", "--save")?;
+    }
+    if let Some(p) = &args.export {
+        check_extension(p, "edf", "--export")?;
+    }
+    // Reserve the outputs first: an unwritable path fails before the work.
+    let mut edf = match &args.export {
+        Some(p) => {
+            let (pending, file) = PendingFile::create(p)?;
+            let montage = errp_bci::Montage::standard();
+            let writer = EdfWriter::new(std::io::BufWriter::new(file), &montage, 256.0)?;
+            Some((pending, writer))
+        }
+        None => None,
+    };
+    let rrd = match &args.save {
+        Some(p) => Some(calibration_recording(p)?),
+        None => None,
+    };
+
+    let mut request = CalibrationRequest::new(accuracy, args.seed);
+    request.grand_average = args.save.is_some();
+    if !args.quiet {
+        eprintln!(
+            "Targeting a mean accuracy of {:.2} % ({who}), seed {}:",
+            100.0 * accuracy,
+            args.seed
+        );
+    }
+    let quiet = args.quiet;
+    let progress = |s: &errp_bci::TargetingStep| {
+        if !quiet {
+            eprintln!(
+                "  ErrP-to-noise {:.4}: correct {:.2} %, error {:.2} %, mean {:.2} %",
+                s.ratio,
+                100.0 * s.accuracy.correct,
+                100.0 * s.accuracy.error,
+                100.0 * s.accuracy.mean()
+            );
+        }
+    };
+    let mut sink = |block: &errp_bci::EegBlock, events: &[errp_bci::Assessment]| match edf.as_mut()
+    {
+        Some((_, w)) => w.write(block, events),
+        None => Ok(()),
+    };
+    let report = run_calibration(
+        &request,
+        progress,
+        if args.export.is_some() {
+            Some(&mut sink)
+        } else {
+            None
+        },
+    )
+    .context("calibration failed")?;
+
+    let a = &report.calibrated.accuracy;
+    let m = &report.calibrated.model;
+    println!(
+        "Calibration session: {} actions ({} error, {} correct), {}-fold cross-validation",
+        a.n_correct + a.n_error,
+        a.n_error,
+        a.n_correct,
+        request.setup.calibration.folds
+    );
+    println!("  correct class  {:6.2} %", 100.0 * a.correct);
+    println!("  error class    {:6.2} %", 100.0 * a.error);
+    println!(
+        "  mean           {:6.2} %   ({who} {:.2} %, off by {:+.2} points)",
+        100.0 * a.mean(),
+        100.0 * accuracy,
+        100.0 * (a.mean() - accuracy)
+    );
+    println!(
+        "  ErrP-to-noise ratio {:.4}; decoder: {} PCA components, Ledoit-Wolf shrinkage {:.3}",
+        report.generator.errp_to_noise,
+        m.n_components(),
+        m.shrinkage()
+    );
+
+    if let Some((pending, writer)) = edf {
+        writer.finish()?;
+        let path = pending.commit()?;
+        println!(
+            "Wrote {} (EDF+, raw EEG + EOG, 256 Hz, annotated)",
+            path.display()
+        );
+    }
+    if let Some(file) = rrd {
+        let montage = errp_bci::Montage::standard();
+        let path = record_calibration(file, &report, &montage)?;
+        println!(
+            "Wrote {} (open with: rerun {})",
+            path.display(),
+            path.display()
+        );
+    }
+    Ok(())
+}
+
+pub(crate) fn print_subjects() {
+    println!("subject  fixed goals  free goals   (mean accuracy, Table 1)");
+    for s in subjects() {
+        println!(
+            "{:<8} {:>9.2} %  {:>8.2} %",
+            s.name, s.fixed_goals_pct, s.free_goals_pct
+        );
+    }
+}

@@ -1,0 +1,38 @@
+//! `errp table1`: Table 1 of the paper, re-run.
+
+use anyhow::Result;
+use errp_sim::grid::{DecoderChoice, Table1Options, Table1Report, run_table1};
+
+use crate::cli::{DecoderArg, Table1Args};
+
+pub(crate) fn table1(args: &Table1Args) -> Result<()> {
+    let options = Table1Options {
+        repeats: args.episodes as usize,
+        seed: args.seed,
+        decoder: match args.decoder {
+            DecoderArg::Eeg => DecoderChoice::Eeg,
+            DecoderArg::Oracle => DecoderChoice::Oracle,
+        },
+        eeg: args.eeg.mode(),
+        params: errp_sim::grid::GridTaskParams::default(),
+    };
+    let quiet = args.quiet;
+    if !quiet {
+        eprintln!(
+            "Table 1: 4 subjects x 2 goal sets x {} runs, seed {} (calibrating 8 decoders in parallel)",
+            5 * options.repeats,
+            options.seed
+        );
+    }
+    let cells = run_table1(&options, |label, s| {
+        if !quiet {
+            eprintln!(
+                "  {label}: ErrP-to-noise {:.4} -> {:.2} %",
+                s.ratio,
+                100.0 * s.accuracy.mean()
+            );
+        }
+    })?;
+    print!("{}", Table1Report(&cells));
+    Ok(())
+}
