@@ -23,6 +23,8 @@ mod output;
 mod paper;
 pub mod record;
 mod scenario_file;
+#[cfg(test)]
+mod snapshot;
 mod stats;
 
 pub use error::{Result, SimError};

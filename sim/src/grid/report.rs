@@ -179,3 +179,58 @@ impl fmt::Display for Table1Report<'_> {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use super::*;
+    use crate::grid::run::{prepare_decoder, run_grid_scenario};
+    use crate::grid::scenario::{DecoderChoice, EegMode, GridScenario};
+    use crate::grid::table1::{Table1Options, run_table1};
+    use crate::snapshot::assert_snapshot;
+
+    #[test]
+    fn a_grid_run_reads_as_printed() {
+        let text = r#"
+task = "grid"
+decoder = "oracle"
+seed = 3
+[user]
+accuracy = 0.8
+[[episode]]
+start = [0, 0]
+goal = [4, 4]
+[[episode]]
+start = [2, 2]
+goal = [0, 4]
+"#;
+        let scenario = GridScenario::parse(text, Path::new("snapshot.toml")).unwrap();
+        let (decoder, calibration) = prepare_decoder(&scenario, |_| {}).unwrap();
+        let mut out = format!("{GridEpisodeHeader}\n");
+        let episodes = run_grid_scenario(&scenario, &decoder, false, |k, r| {
+            out.push_str(&format!("{}\n", GridEpisodeRow(k, r)));
+        })
+        .unwrap();
+        let report = GridRunReport {
+            scenario,
+            calibration,
+            episodes,
+        };
+        out.push_str(&report.to_string());
+        assert_snapshot("grid_report", &out);
+    }
+
+    #[test]
+    fn table1_reads_as_printed() {
+        let options = Table1Options {
+            repeats: 1,
+            seed: 1,
+            decoder: DecoderChoice::Oracle,
+            eeg: EegMode::Bank,
+            params: crate::grid::episode::GridTaskParams::default(),
+        };
+        let cells = run_table1(&options, |_, _| {}).unwrap();
+        assert_snapshot("table1_oracle", &Table1Report(&cells).to_string());
+    }
+}
