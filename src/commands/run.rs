@@ -1,5 +1,7 @@
 //! `errp run`: a grid or an e-puck scenario, printed per episode and summarised.
 
+use std::path::Path;
+
 use anyhow::{Context, Result, bail};
 use errp_bci::OnlineStep;
 use errp_sim::epuck::{
@@ -70,13 +72,7 @@ pub(crate) fn run_grid(args: &RunArgs, mut scenario: GridScenario) -> Result<()>
     if args.accuracy.is_some() {
         scenario.user.push_str(" (--accuracy)");
     }
-    if let Some(p) = &args.save {
-        check_extension(p, "rrd", "--save")?;
-    }
-    let rrd = match &args.save {
-        Some(p) => Some(grid_recording(p)?),
-        None => None,
-    };
+    let rrd = open_recording(args, grid_recording)?;
     let quiet = args.quiet;
     if !quiet {
         eprintln!(
@@ -130,13 +126,7 @@ pub(crate) fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<(
     if let Some(runs) = args.runs {
         scenario.runs = runs as usize;
     }
-    if let Some(p) = &args.save {
-        check_extension(p, "rrd", "--save")?;
-    }
-    let rrd = match &args.save {
-        Some(p) => Some(epuck_recording(p)?),
-        None => None,
-    };
+    let rrd = open_recording(args, epuck_recording)?;
     let quiet = args.quiet;
     let decoder_text = match scenario.online_target {
         None => format!("decoder accuracy {:.2} %", 100.0 * scenario.accuracy),
@@ -247,4 +237,17 @@ pub(crate) fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<(
         );
     }
     Ok(())
+}
+
+/// The `--save` recording, checked and created before any work, so that a
+/// bad or unwritable path fails first.
+fn open_recording<T>(
+    args: &RunArgs,
+    open: impl FnOnce(&Path) -> errp_sim::Result<T>,
+) -> Result<Option<T>> {
+    let Some(path) = &args.save else {
+        return Ok(None);
+    };
+    check_extension(path, "rrd", "--save")?;
+    Ok(Some(open(path)?))
 }

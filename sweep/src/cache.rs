@@ -12,6 +12,7 @@ use errp_bci::TargetingResult;
 use serde::{Deserialize, Serialize};
 
 use errp_sim::Result;
+use errp_sim::calibration::TargetingCache;
 use errp_sim::write_atomic;
 
 /// Where targeting results are kept (or nowhere).
@@ -65,14 +66,28 @@ impl TargetCache {
         self.dir.as_deref()
     }
 
-    /// The result for `request` (a complete description of the search, e.g.
-    /// the Debug form of its setup, accuracy and seed) from the cache, or
-    /// from `search`, which is then stored. The flag is true on a hit.
-    pub fn get_or_search(
+    fn store(path: &Path, entry: &Entry) -> Result<()> {
+        if let Some(parent) = path.parent() {
+            std::fs::create_dir_all(parent).map_err(|source| errp_sim::SimError::Output {
+                path: parent.to_path_buf(),
+                source,
+            })?;
+        }
+        let text = serde_json::to_string(entry).expect("a targeting result serialises");
+        write_atomic(path, text.as_bytes())
+    }
+}
+
+impl TargetingCache for TargetCache {
+    /// Looks `request` up in `kind-HASH.json` under the cache directory
+    /// (the request text is kept in the file and must match); a miss
+    /// searches and stores the result atomically, and a store that fails
+    /// only costs the next run a search.
+    fn get_or_search(
         &self,
         kind: &str,
         request: &str,
-        search: impl FnOnce() -> Result<TargetingResult>,
+        search: &mut dyn FnMut() -> Result<TargetingResult>,
     ) -> Result<(TargetingResult, bool)> {
         let Some(dir) = &self.dir else {
             return Ok((search()?, false));
@@ -92,27 +107,5 @@ impl TargetCache {
         let entry = Entry { request, result };
         let _ = Self::store(&path, &entry);
         Ok((entry.result, false))
-    }
-
-    fn store(path: &Path, entry: &Entry) -> Result<()> {
-        if let Some(parent) = path.parent() {
-            std::fs::create_dir_all(parent).map_err(|source| errp_sim::SimError::Output {
-                path: parent.to_path_buf(),
-                source,
-            })?;
-        }
-        let text = serde_json::to_string(entry).expect("a targeting result serialises");
-        write_atomic(path, text.as_bytes())
-    }
-}
-
-impl errp_sim::calibration::TargetingCache for TargetCache {
-    fn get_or_search(
-        &self,
-        kind: &str,
-        request: &str,
-        search: &mut dyn FnMut() -> Result<TargetingResult>,
-    ) -> Result<(TargetingResult, bool)> {
-        TargetCache::get_or_search(self, kind, request, search)
     }
 }

@@ -140,13 +140,18 @@ impl TargetingCache for NoCache {
     }
 }
 
-/// The text that names a targeting request in a [`TargetingCache`]:
-/// everything the search depends on.
-pub fn targeting_key(
+/// The targeting of a request (its setup, search settings, accuracy and
+/// seed: everything the search depends on) for decoder `kind`, from `cache`
+/// or by `search`; true if it came from the cache.
+pub fn cached_targeting(
+    cache: &dyn TargetingCache,
+    kind: &str,
     setup: &impl std::fmt::Debug,
-    search: &TargetingParams,
+    search_params: &TargetingParams,
     accuracy: f64,
     seed: u64,
-) -> String {
-    format!("{setup:?} {search:?} accuracy={accuracy:?} seed={seed}")
+    search: &mut dyn FnMut() -> Result<TargetingResult>,
+) -> Result<(TargetingResult, bool)> {
+    let request = format!("{setup:?} {search_params:?} accuracy={accuracy:?} seed={seed}");
+    cache.get_or_search(kind, &request, search)
 }

@@ -94,18 +94,21 @@ impl fmt::Display for EpuckSummaryReport<'_> {
             "  reached {}      {} / {} ({} converged on a wrong city)",
             self.goal, s.reached, s.runs, s.wrong
         )?;
-        writeln!(
-            f,
-            "  median time (s)      {:.1}{}",
-            s.median_secs,
-            note(paper.map(|p| format!("{:.0}", p.1)))
-        )?;
-        writeln!(
-            f,
-            "  median detected      {:.1}{}",
-            s.median_detected,
-            note(paper.map(|p| p.2.to_string()))
-        )?;
+        let medians = [
+            (
+                "median time (s)",
+                s.median_secs,
+                paper.map(|p| format!("{:.0}", p.1)),
+            ),
+            (
+                "median detected",
+                s.median_detected,
+                paper.map(|p| p.2.to_string()),
+            ),
+        ];
+        for (label, value, paper) in medians {
+            writeln!(f, "  {label:<20} {value:.1}{}", note(paper))?;
+        }
         writeln!(f, "  median false         {:.1}", s.median_false)?;
         writeln!(
             f,
@@ -138,5 +141,71 @@ impl fmt::Display for EpuckSummaryReport<'_> {
             s.online.n_correct,
             s.online.n_error
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use errp_bci::Accuracy;
+
+    use super::*;
+    use crate::epuck::run::summarise;
+    use crate::snapshot::assert_snapshot;
+
+    fn result(committed: Option<usize>, time_secs: f64, detected: usize) -> EpuckEpisodeResult {
+        EpuckEpisodeResult {
+            goal: 24,
+            committed,
+            time_secs,
+            detected_errors: detected,
+            detected_by_phase: [
+                detected / 3,
+                detected / 2,
+                detected - detected / 3 - detected / 2,
+            ],
+            true_by_judged_phase: [2, 1, 3],
+            false_detections: 1,
+            missed_errors: 2,
+            errps: detected + 1,
+            errps_scored: detected,
+            clean_secs: 0.8 * time_secs,
+            online: Accuracy {
+                correct: 0.997,
+                error: 0.81,
+                n_correct: 900,
+                n_error: 60,
+            },
+            path_m: 3.1,
+            max_lateral_m_per_s: 0.0,
+            detections: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn the_run_table_and_summary_read_as_printed() {
+        let layout = GoalLayout::cities();
+        let results = [
+            result(Some(24), 61.25, 15),
+            result(Some(23), 48.0, 9),
+            result(None, 600.0, 120),
+        ];
+        let mut text = format!("{EpuckRunHeader}\n");
+        for (index, result) in results.iter().enumerate() {
+            let row = EpuckRunRow {
+                index,
+                result,
+                layout: &layout,
+            };
+            text.push_str(&format!("{row}\n"));
+        }
+        let summary = summarise(&results);
+        let report = EpuckSummaryReport {
+            summary: &summary,
+            scenario: "Mexico to Pisa",
+            goal: "Pisa",
+            t_e: 0.8,
+        };
+        text.push_str(&report.to_string());
+        assert_snapshot("epuck_report", &text);
     }
 }

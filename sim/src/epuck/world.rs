@@ -427,6 +427,18 @@ mod tests {
         }
     }
 
+    /// The paper's empty arena, with the default e-puck at (x, y), heading
+    /// `h`, stepped at 64 Hz.
+    fn free_world(x: f64, y: f64, h: f64) -> World {
+        World::new(
+            &ArenaSpec::paper(),
+            &EpuckParams::default(),
+            start(x, y, h),
+            1.0 / 64.0,
+        )
+        .unwrap()
+    }
+
     fn start(x: f64, y: f64, h: f64) -> Pose {
         Pose {
             x_m: x,
@@ -437,14 +449,7 @@ mod tests {
 
     #[test]
     fn a_free_robot_moves_along_its_heading_at_the_commanded_speed() {
-        let epuck = EpuckParams::default();
-        let mut w = World::new(
-            &ArenaSpec::paper(),
-            &epuck,
-            start(1.0, 1.0, 0.5),
-            1.0 / 64.0,
-        )
-        .unwrap();
+        let mut w = free_world(1.0, 1.0, 0.5);
         for _ in 0..64 {
             w.step(twist(0.1, 0.0));
         }
@@ -458,14 +463,7 @@ mod tests {
 
     #[test]
     fn a_robot_told_to_stay_still_stays_exactly_still() {
-        let epuck = EpuckParams::default();
-        let mut w = World::new(
-            &ArenaSpec::paper(),
-            &epuck,
-            start(1.0, 1.0, 0.2),
-            1.0 / 64.0,
-        )
-        .unwrap();
+        let mut w = free_world(1.0, 1.0, 0.2);
         for _ in 0..32 {
             w.step(twist(0.1, 0.3));
         }
@@ -483,14 +481,7 @@ mod tests {
 
     #[test]
     fn turning_in_place_does_not_translate() {
-        let epuck = EpuckParams::default();
-        let mut w = World::new(
-            &ArenaSpec::paper(),
-            &epuck,
-            start(1.0, 1.0, 0.0),
-            1.0 / 64.0,
-        )
-        .unwrap();
+        let mut w = free_world(1.0, 1.0, 0.0);
         for _ in 0..64 {
             w.step(twist(0.0, 1.0));
         }

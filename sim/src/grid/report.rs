@@ -196,14 +196,9 @@ mod tests {
 task = "grid"
 decoder = "oracle"
 seed = 3
+episode = [{ start = [0, 0], goal = [4, 4] }, { start = [2, 2], goal = [0, 4] }]
 [user]
 accuracy = 0.8
-[[episode]]
-start = [0, 0]
-goal = [4, 4]
-[[episode]]
-start = [2, 2]
-goal = [0, 4]
 "#;
         let scenario = GridScenario::parse(text, Path::new("snapshot.toml")).unwrap();
         let (decoder, calibration) = prepare_decoder(&scenario, |_| {}).unwrap();

@@ -11,7 +11,7 @@ use errp_bci::{
 use errp_robot::{Grid, QTable};
 
 use crate::calibration::{
-    CalibrationReport, CalibrationRequest, NoCache, TargetingCache, targeting_key,
+    CalibrationReport, CalibrationRequest, NoCache, TargetingCache, cached_targeting,
 };
 use crate::error::{Result, SimError};
 use crate::grid::episode::{
@@ -161,24 +161,26 @@ pub fn prepare_grid_decoder(
             &simulated
         }
     };
-    let key = targeting_key(
+    let lda = LdaDecoder::default();
+    let (targeting, cached) = cached_targeting(
+        cache,
+        "grid-lda",
         &request.setup,
         &request.search,
         request.accuracy,
         request.seed,
-    );
-    let lda = LdaDecoder::default();
-    let (targeting, cached) = cache.get_or_search("grid-lda", &key, &mut || {
-        Ok(target_accuracy_on(
-            parts,
-            request.accuracy,
-            &lda,
-            &request.setup,
-            &request.search,
-            request.seed,
-            &mut progress,
-        )?)
-    })?;
+        &mut || {
+            Ok(target_accuracy_on(
+                parts,
+                request.accuracy,
+                &lda,
+                &request.setup,
+                &request.search,
+                request.seed,
+                &mut progress,
+            )?)
+        },
+    )?;
     let calibrated = calibrate_session(
         &lda,
         parts.session_at(targeting.ratio),
