@@ -62,17 +62,10 @@ impl CalibrationParams {
             self.error_rate,
             "a probability in (0, 1)",
         )?;
-        check(
-            self.interval_min_secs >= 1.0 && self.interval_min_secs <= self.interval_max_secs,
-            "interval_min_secs",
+        check_intervals(
             self.interval_min_secs,
-            "at least 1 s (an epoch lasts 0.8 s) and at most interval_max_secs",
-        )?;
-        check(
-            self.interval_max_secs.is_finite(),
-            "interval_max_secs",
             self.interval_max_secs,
-            "a finite number of seconds",
+            "an epoch lasts 0.8 s",
         )?;
         check(
             self.eog_session_secs >= 15.0 && self.eog_session_secs.is_finite(),
@@ -171,39 +164,57 @@ impl GrandAverage {
     }
 }
 
+/// A calibration protocol, the part of a [`Setup`] that says what is
+/// recorded: [`CalibrationParams`] (the discrete session) or
+/// [`ContinuousCalibrationParams`](crate::ContinuousCalibrationParams) (the
+/// button-locked one).
+pub trait Protocol: std::fmt::Debug + Clone + PartialEq + Default {
+    /// Checks the protocol's parameters.
+    fn check(&self) -> Result<()>;
+}
+
+impl Protocol for CalibrationParams {
+    fn check(&self) -> Result<()> {
+        self.validate()
+    }
+}
+
 /// Everything that defines a simulated user and recording: the EEG model,
-/// the calibration protocol, the preprocessing and the montage.
+/// the calibration protocol `P`, the preprocessing and the montage.
 #[derive(Debug, Clone, PartialEq)]
-pub struct CalibrationSetup {
+pub struct Setup<P> {
     /// The synthetic EEG.
     pub generator: GeneratorParams,
     /// The calibration protocol.
-    pub calibration: CalibrationParams,
+    pub calibration: P,
     /// The preprocessing.
     pub preprocess: PreprocessParams,
     /// The montage.
     pub montage: Montage,
 }
 
-impl Default for CalibrationSetup {
+impl<P: Protocol> Default for Setup<P> {
     fn default() -> Self {
         Self {
             generator: GeneratorParams::default(),
-            calibration: CalibrationParams::default(),
+            calibration: P::default(),
             preprocess: PreprocessParams::default(),
             montage: Montage::standard(),
         }
     }
 }
 
-impl CalibrationSetup {
+impl<P: Protocol> Setup<P> {
     /// Checks every part.
     pub fn validate(&self) -> Result<()> {
         self.generator.validate()?;
-        self.calibration.validate()?;
+        self.calibration.check()?;
         self.preprocess.validate(self.generator.sfreq_hz)
     }
 }
+
+/// The setup of the discrete calibration session (sec. 2.2).
+pub type CalibrationSetup = Setup<CalibrationParams>;
 
 /// A simulated calibration session, preprocessed and cut into features.
 #[derive(Debug, Clone)]
@@ -593,6 +604,24 @@ pub fn stratified_folds(labels: &[bool], folds: usize, seed: u64) -> Vec<usize> 
         }
     }
     fold_of
+}
+
+/// Checks the bounds of the uniform interval between a protocol's events:
+/// the minimum at least 1 s (`why`) and at most the maximum, which is
+/// finite.
+pub(crate) fn check_intervals(min_secs: f64, max_secs: f64, why: &str) -> Result<()> {
+    check(
+        min_secs >= 1.0 && min_secs <= max_secs,
+        "interval_min_secs",
+        min_secs,
+        &format!("at least 1 s ({why}) and at most interval_max_secs"),
+    )?;
+    check(
+        max_secs.is_finite(),
+        "interval_max_secs",
+        max_secs,
+        "a finite number of seconds",
+    )
 }
 
 #[cfg(test)]

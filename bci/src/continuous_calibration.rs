@@ -6,16 +6,14 @@ use rand_distr::StandardNormal;
 use serde::{Deserialize, Serialize};
 
 use crate::calibration::{
-    Accuracy, Calibrated, CalibrationParams, CalibrationSession, CalibrationSetup, SessionOptions,
-    cv_seed, out_of_fold_decisions, simulate_session_with,
+    Accuracy, Calibrated, CalibrationParams, CalibrationSession, CalibrationSetup, Protocol,
+    SessionOptions, Setup, check_intervals, cv_seed, out_of_fold_decisions, simulate_session_with,
 };
 use crate::classify::Classifier;
 use crate::continuous::ContinuousFeatures;
 use crate::erp::AssessmentKind;
 use crate::error::{Result, check};
-use crate::generator::{Assessment, GeneratorParams};
-use crate::montage::Montage;
-use crate::preprocess::PreprocessParams;
+use crate::generator::Assessment;
 use crate::rng::{derive_seed, stream};
 use crate::svm::{SvmDecoder, SvmModel};
 
@@ -65,18 +63,10 @@ impl ContinuousCalibrationParams {
             self.per_class,
             "at least 10 examples of each class",
         )?;
-        check(
-            self.interval_min_secs >= 1.0 && self.interval_min_secs <= self.interval_max_secs,
-            "interval_min_secs",
+        check_intervals(
             self.interval_min_secs,
-            "at least 1 s (the paper's separation of trigger events) and at most \
-             interval_max_secs",
-        )?;
-        check(
-            self.interval_max_secs.is_finite(),
-            "interval_max_secs",
             self.interval_max_secs,
-            "a finite number of seconds",
+            "the paper's separation of trigger events",
         )?;
         check(
             self.trigger_jitter_ms.is_finite() && (0.0..=200.0).contains(&self.trigger_jitter_ms),
@@ -99,39 +89,17 @@ impl ContinuousCalibrationParams {
     }
 }
 
-/// A simulated user and recording for the continuous decoder: the EEG model,
-/// the calibration protocol, the preprocessing and the montage.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ContinuousSetup {
-    /// The synthetic EEG.
-    pub generator: GeneratorParams,
-    /// The calibration protocol.
-    pub calibration: ContinuousCalibrationParams,
-    /// The preprocessing.
-    pub preprocess: PreprocessParams,
-    /// The montage.
-    pub montage: Montage,
-}
-
-impl Default for ContinuousSetup {
-    fn default() -> Self {
-        Self {
-            generator: GeneratorParams::default(),
-            calibration: ContinuousCalibrationParams::default(),
-            preprocess: PreprocessParams::default(),
-            montage: Montage::standard(),
-        }
+impl Protocol for ContinuousCalibrationParams {
+    fn check(&self) -> Result<()> {
+        self.validate()
     }
 }
+
+/// A simulated user and recording for the continuous decoder: the EEG
+/// model, the button-locked protocol, the preprocessing and the montage.
+pub type ContinuousSetup = Setup<ContinuousCalibrationParams>;
 
 impl ContinuousSetup {
-    /// Checks every part.
-    pub fn validate(&self) -> Result<()> {
-        self.generator.validate()?;
-        self.calibration.validate()?;
-        self.preprocess.validate(self.generator.sfreq_hz)
-    }
-
     /// The same recording as a [`CalibrationSetup`] for
     /// [`simulate_session_with`], which reads only the EOG session length of
     /// its protocol.

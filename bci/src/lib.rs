@@ -49,8 +49,9 @@ mod targeting;
 
 pub use calibration::{
     Accuracy, Calibrated, CalibrationParams, CalibrationSession, CalibrationSetup, GrandAverage,
-    RawSink, SessionOptions, calibrate, calibrate_session, cross_validate, cv_seed, eog_session,
-    out_of_fold_decisions, schedule, simulate_session, simulate_session_with, stratified_folds,
+    Protocol, RawSink, SessionOptions, Setup, calibrate, calibrate_session, cross_validate,
+    cv_seed, eog_session, out_of_fold_decisions, schedule, simulate_session, simulate_session_with,
+    stratified_folds,
 };
 pub use classify::{Classifier, ErrorModel, Features, sigmoid};
 pub use continuous::ContinuousFeatures;

@@ -7,7 +7,7 @@ pub use view::{calibration_recording, record_calibration};
 
 use errp_bci::{
     Calibrated, CalibrationSetup, GeneratorParams, LdaDecoder, LdaModel, RawSink, SessionOptions,
-    TargetingParams, TargetingResult, TargetingStep, calibrate, target_accuracy,
+    Setup, TargetingParams, TargetingResult, TargetingStep, calibrate, target_accuracy,
 };
 
 use crate::error::Result;
@@ -28,6 +28,11 @@ pub struct CalibrationRequest {
 }
 
 impl CalibrationRequest {
+    /// This request's key in a [`TargetingCache`].
+    pub fn targeting_key(&self) -> String {
+        request_key(&self.setup, &self.search, self.accuracy, self.seed)
+    }
+
     /// A request with the paper's protocol and the default EEG model.
     pub fn new(accuracy: f64, seed: u64) -> Self {
         Self {
@@ -140,18 +145,14 @@ impl TargetingCache for NoCache {
     }
 }
 
-/// The targeting of a request (its setup, search settings, accuracy and
-/// seed: everything the search depends on) for decoder `kind`, from `cache`
-/// or by `search`; true if it came from the cache.
-pub fn cached_targeting(
-    cache: &dyn TargetingCache,
-    kind: &str,
-    setup: &impl std::fmt::Debug,
-    search_params: &TargetingParams,
+/// The text that names a targeting request in a [`TargetingCache`]: its
+/// setup, search settings, accuracy and seed, everything the search
+/// depends on.
+pub fn request_key<P: std::fmt::Debug>(
+    setup: &Setup<P>,
+    search: &TargetingParams,
     accuracy: f64,
     seed: u64,
-    search: &mut dyn FnMut() -> Result<TargetingResult>,
-) -> Result<(TargetingResult, bool)> {
-    let request = format!("{setup:?} {search_params:?} accuracy={accuracy:?} seed={seed}");
-    cache.get_or_search(kind, &request, search)
+) -> String {
+    format!("{setup:?} {search:?} accuracy={accuracy:?} seed={seed}")
 }

@@ -27,6 +27,11 @@ pub struct ContinuousRequest {
 }
 
 impl ContinuousRequest {
+    /// This request's key in a [`TargetingCache`](crate::calibration::TargetingCache).
+    pub fn targeting_key(&self) -> String {
+        crate::calibration::request_key(&self.setup, &self.search, self.accuracy, self.seed)
+    }
+
     /// A request with the paper's protocol and the default EEG model.
     pub fn new(accuracy: f64, seed: u64) -> Self {
         Self {

@@ -7,7 +7,7 @@ use errp_bci::{
 };
 use rayon::prelude::*;
 
-use crate::calibration::{NoCache, TargetingCache, cached_targeting};
+use crate::calibration::{NoCache, TargetingCache};
 use crate::epuck::decoder::{
     ContinuousDecoder, ContinuousReport, ContinuousRequest, calibrate_continuous_at,
     run_online_calibration,
@@ -66,14 +66,8 @@ pub fn prepare_epuck_decoder(
     let request = ContinuousRequest::new(scenario.accuracy, scenario.seed);
     match scenario.online_target {
         None => {
-            let (targeting, cached) = cached_targeting(
-                cache,
-                "epuck-svm",
-                &request.setup,
-                &request.search,
-                request.accuracy,
-                request.seed,
-                &mut || {
+            let (targeting, cached) =
+                cache.get_or_search("epuck-svm", &request.targeting_key(), &mut || {
                     Ok(target_continuous_accuracy(
                         request.accuracy,
                         &SvmDecoder::default(),
@@ -82,8 +76,7 @@ pub fn prepare_epuck_decoder(
                         request.seed,
                         &mut progress,
                     )?)
-                },
-            )?;
+                })?;
             let report = calibrate_continuous_at(&request, targeting)?;
             let decoder = finish_continuous_decoder(scenario, &report)?;
             Ok(PreparedEpuck {

@@ -10,9 +10,7 @@ use errp_bci::{
 };
 use errp_robot::{Grid, QTable};
 
-use crate::calibration::{
-    CalibrationReport, CalibrationRequest, NoCache, TargetingCache, cached_targeting,
-};
+use crate::calibration::{CalibrationReport, CalibrationRequest, NoCache, TargetingCache};
 use crate::error::{Result, SimError};
 use crate::grid::episode::{
     AssessmentDecoder, EegDecoder, EegSource, EpochBank, EpochBankParts, GridEpisodeResult,
@@ -162,14 +160,8 @@ pub fn prepare_grid_decoder(
         }
     };
     let lda = LdaDecoder::default();
-    let (targeting, cached) = cached_targeting(
-        cache,
-        "grid-lda",
-        &request.setup,
-        &request.search,
-        request.accuracy,
-        request.seed,
-        &mut || {
+    let (targeting, cached) =
+        cache.get_or_search("grid-lda", &request.targeting_key(), &mut || {
             Ok(target_accuracy_on(
                 parts,
                 request.accuracy,
@@ -179,8 +171,7 @@ pub fn prepare_grid_decoder(
                 request.seed,
                 &mut progress,
             )?)
-        },
-    )?;
+        })?;
     let calibrated = calibrate_session(
         &lda,
         parts.session_at(targeting.ratio),
