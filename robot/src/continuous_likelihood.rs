@@ -6,7 +6,7 @@ use std::f64::consts::PI;
 use serde::{Deserialize, Serialize};
 
 use crate::epuck::EpuckParams;
-use crate::error::{Result, RobotError};
+use crate::error::{Result, RobotError, check};
 use crate::pose::wrap_angle;
 use crate::strategy::Strategy;
 
@@ -99,14 +99,8 @@ impl Default for ContinuousControlParams {
 impl ContinuousControlParams {
     /// Checks every field; messages name the field and the accepted range.
     pub fn validate(&self) -> Result<()> {
-        let check = |ok: bool, name: &str, v: f64, range: &str| {
-            if ok && v.is_finite() {
-                Ok(())
-            } else {
-                Err(RobotError::Parameter(format!(
-                    "{name} = {v} must be {range}"
-                )))
-            }
+        let check = |ok: bool, name: &'static str, v: f64, range: &str| {
+            check(ok && v.is_finite(), name, v, range)
         };
         let open01 = |v: f64| v > 0.0 && v < 1.0;
         let half_open01 = |v: f64| v > 0.0 && v <= 1.0;
@@ -175,11 +169,13 @@ impl ContinuousControlParams {
             "> 0",
         )?;
         if self.strategy == Strategy::Thompson {
-            return Err(RobotError::Parameter(format!(
-                "strategy = {} must be greedy or info_gain: thompson is grid-only \
-                 (the e-puck controller draws no random numbers)",
-                self.strategy
-            )));
+            return Err(RobotError::InvalidParameter {
+                name: "strategy",
+                value: format!("{:?}", self.strategy.name()),
+                expected: "\"greedy\" or \"info_gain\": thompson is grid-only (the e-puck \
+                           controller draws no random numbers)"
+                    .into(),
+            });
         }
         check(
             self.assumed_accuracy > 0.5 && self.assumed_accuracy <= 1.0,

@@ -8,7 +8,7 @@
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Result, RobotError};
+use crate::error::{Result, check};
 use crate::pose::{Pose, wrap_angle};
 
 /// Physical constants of the e-puck (Mondada et al. 2009; GCtronic e-puck
@@ -56,32 +56,27 @@ impl Default for EpuckParams {
 impl EpuckParams {
     /// Checks every field; messages name the field and the accepted range.
     pub fn validate(&self) -> Result<()> {
-        let positive = |name: &str, v: f64| {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(RobotError::Parameter(format!(
-                    "{name} = {v} must be a finite number > 0"
-                )))
-            }
+        let positive = |name: &'static str, v: f64| {
+            check(v.is_finite() && v > 0.0, name, v, "a finite number > 0")
         };
         positive("wheel_diameter_m", self.wheel_diameter_m)?;
         positive("axle_length_m", self.axle_length_m)?;
         positive("max_steps_per_sec", self.max_steps_per_sec)?;
         positive("body_diameter_m", self.body_diameter_m)?;
         positive("mass_kg", self.mass_kg)?;
-        if self.steps_per_turn == 0 {
-            return Err(RobotError::Parameter(
-                "steps_per_turn = 0 must be >= 1".into(),
-            ));
-        }
+        check(
+            self.steps_per_turn >= 1,
+            "steps_per_turn",
+            self.steps_per_turn,
+            "at least 1",
+        )?;
         let n = self.wheel_speed_noise;
-        if !(n.is_finite() && (0.0..1.0).contains(&n)) {
-            return Err(RobotError::Parameter(format!(
-                "wheel_speed_noise = {n} must be in [0, 1)"
-            )));
-        }
-        Ok(())
+        check(
+            n.is_finite() && (0.0..1.0).contains(&n),
+            "wheel_speed_noise",
+            n,
+            "a fraction in [0, 1)",
+        )
     }
 
     /// Top wheel (and straight-line) speed, m/s: revolutions per second times

@@ -5,7 +5,20 @@ use thiserror::Error;
 /// Everything that can go wrong in `errp_robot`.
 #[derive(Debug, Error)]
 pub enum RobotError {
-    /// A parameter is outside its accepted range.
+    /// A parameter is outside its accepted range: loaders map `name` to
+    /// their own spelling of the field (`control.tau`) instead of checking
+    /// the range again.
+    #[error("{name} = {value} is invalid: expected {expected}")]
+    InvalidParameter {
+        /// The field, as the parameter struct names it.
+        name: &'static str,
+        /// The value given.
+        value: String,
+        /// The accepted range, in words.
+        expected: String,
+    },
+    /// Parameters that are each valid do not fit together, or a layout
+    /// cannot be built.
     #[error("invalid parameter: {0}")]
     Parameter(String),
     /// A likelihood vector cannot update a belief.
@@ -15,3 +28,22 @@ pub enum RobotError {
 
 /// Shorthand for results in this crate.
 pub type Result<T, E = RobotError> = std::result::Result<T, E>;
+
+/// An [`RobotError::InvalidParameter`] unless `ok` (and, for numbers, the
+/// value is finite: NaN and infinities are never accepted).
+pub(crate) fn check(
+    ok: bool,
+    name: &'static str,
+    value: impl std::fmt::Display,
+    expected: &str,
+) -> Result<()> {
+    if ok {
+        Ok(())
+    } else {
+        Err(RobotError::InvalidParameter {
+            name,
+            value: value.to_string(),
+            expected: expected.to_string(),
+        })
+    }
+}

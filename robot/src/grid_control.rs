@@ -5,7 +5,7 @@ use rand::Rng;
 use serde::{Deserialize, Serialize};
 
 use crate::belief::Belief;
-use crate::error::{Result, RobotError};
+use crate::error::{Result, RobotError, check};
 use crate::grid::{Cell, Grid, GridAction};
 use crate::qvalues::{QParams, QTable};
 use crate::strategy::{Strategy, gain_from_logs};
@@ -47,20 +47,31 @@ impl Default for GridControlParams {
 impl GridControlParams {
     /// Checks every field; messages name the field and the accepted range.
     pub fn validate(&self) -> Result<()> {
-        let bad = |m: String| Err(RobotError::Parameter(m));
-        if !(self.tau.is_finite() && self.tau > 0.0) {
-            return bad(format!("tau = {} must be a finite number > 0", self.tau));
-        }
-        if !(self.epsilon.is_finite() && (0.0..=1.0).contains(&self.epsilon)) {
-            return bad(format!("epsilon = {} must be in [0, 1]", self.epsilon));
-        }
-        if !(self.p_c.is_finite() && self.p_c > 0.0 && self.p_c < 1.0) {
-            return bad(format!("p_c = {} must be in (0, 1)", self.p_c));
-        }
+        check(
+            self.tau.is_finite() && self.tau > 0.0,
+            "tau",
+            self.tau,
+            "a number > 0 (the paper: 0.3)",
+        )?;
+        check(
+            self.epsilon.is_finite() && (0.0..=1.0).contains(&self.epsilon),
+            "epsilon",
+            self.epsilon,
+            "a probability in [0, 1]",
+        )?;
+        check(
+            self.p_c.is_finite() && self.p_c > 0.0 && self.p_c < 1.0,
+            "p_c",
+            self.p_c,
+            "a probability in (0, 1) (the paper: 0.9)",
+        )?;
         let a = self.assumed_accuracy;
-        if !(a.is_finite() && a > 0.5 && a <= 1.0) {
-            return bad(format!("assumed_accuracy = {a} must be in (0.5, 1]"));
-        }
+        check(
+            a.is_finite() && a > 0.5 && a <= 1.0,
+            "assumed_accuracy",
+            a,
+            "a mean accuracy in (0.5, 1]",
+        )?;
         self.q.validate()
     }
 }

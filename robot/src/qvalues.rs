@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Result, RobotError};
+use crate::error::{Result, check};
 use crate::grid::{Cell, Grid, GridAction};
 
 /// The reward model behind Q*_i. The paper says the Q-values come from
@@ -32,20 +32,27 @@ impl Default for QParams {
 impl QParams {
     /// Checks every field.
     pub fn validate(&self) -> Result<()> {
-        let bad = |m: String| Err(RobotError::Parameter(m));
-        if !(self.discount.is_finite() && (0.0..1.0).contains(&self.discount)) {
-            return bad(format!("discount = {} must be in [0, 1)", self.discount));
-        }
-        if !self.goal_reward.is_finite() || !self.wrong_goal_reward.is_finite() {
-            return bad("rewards must be finite".into());
-        }
-        if self.goal_reward <= self.wrong_goal_reward {
-            return bad(format!(
-                "goal_reward = {} must exceed wrong_goal_reward = {}",
-                self.goal_reward, self.wrong_goal_reward
-            ));
-        }
-        Ok(())
+        check(
+            self.discount.is_finite() && (0.0..1.0).contains(&self.discount),
+            "discount",
+            self.discount,
+            "a number in [0, 1)",
+        )?;
+        check(
+            self.wrong_goal_reward.is_finite(),
+            "wrong_goal_reward",
+            self.wrong_goal_reward,
+            "a finite number",
+        )?;
+        check(
+            self.goal_reward.is_finite() && self.goal_reward > self.wrong_goal_reward,
+            "goal_reward",
+            self.goal_reward,
+            &format!(
+                "a finite number above wrong_goal_reward ({})",
+                self.wrong_goal_reward
+            ),
+        )
     }
 }
 

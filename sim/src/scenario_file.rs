@@ -130,3 +130,16 @@ pub(crate) fn scenario_name(name: Option<String>, path: &Path) -> String {
             .map_or("scenario".into(), |s| s.to_string_lossy().into())
     })
 }
+
+/// A robot parameter error of the scenario at `path`, named as the file
+/// spells it: `control.tau` for `tau` under `[control]`.
+pub(crate) fn robot_error(path: &Path, table: &str, e: errp_robot::RobotError) -> SimError {
+    match e {
+        errp_robot::RobotError::InvalidParameter {
+            name,
+            value,
+            expected,
+        } => field_error(path, &format!("{table}.{name}"), value, &expected),
+        other => SimError::Scenario(format!("{}: [{table}] {other}", path.display())),
+    }
+}

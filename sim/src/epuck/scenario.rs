@@ -12,7 +12,7 @@ use serde::Deserialize;
 use crate::epuck::episode::{EpuckEpisode, EpuckTaskParams};
 use crate::epuck::world::{ArenaSpec, Obstacle};
 use crate::error::{Result, SimError};
-use crate::scenario_file::{field_error, parse_toml, read_scenario, scenario_name};
+use crate::scenario_file::{field_error, parse_toml, read_scenario, robot_error, scenario_name};
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -397,7 +397,7 @@ impl EpuckScenario {
         params
             .control
             .validate()
-            .map_err(|e| SimError::Scenario(format!("{}: [control] {e}", path.display())))?;
+            .map_err(|e| robot_error(path, "control", e))?;
 
         if let Some(t) = &file.tracker {
             if let Some(v) = t.rate_hz {
@@ -678,8 +678,15 @@ accuracy = 0.7438
             assert!(e.contains(value), "{value}: {e}");
             assert!(e.contains("expected"), "{e}");
         }
+        // Ranges are the robot's own (ContinuousControlParams::validate),
+        // reported under the file's name for the field.
         let e = err(&format!("{OK}[control]\nt_e = 1.5\n"));
-        assert!(e.contains("scenarios/x.toml") && e.contains("t_e"), "{e}");
+        assert!(
+            e.contains("scenarios/x.toml")
+                && e.contains("`control.t_e` = 1.5")
+                && e.contains("(0, 1]"),
+            "{e}"
+        );
         let e = err(&OK.replace("accuracy = 0.7438", "accuracy = 0.7438\nfov_deg = 0.0"));
         assert!(e.contains("fov_deg"), "{e}");
     }

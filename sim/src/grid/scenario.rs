@@ -14,7 +14,7 @@ use serde::Deserialize;
 
 use crate::error::Result;
 use crate::grid::episode::{GridTaskParams, PErrorChoice};
-use crate::scenario_file::{field_error, parse_toml, read_scenario, scenario_name};
+use crate::scenario_file::{field_error, parse_toml, read_scenario, robot_error, scenario_name};
 
 /// Which decoder turns the user's assessments into p(error).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -250,37 +250,10 @@ impl GridScenario {
         }
         // The device knows its decoder's accuracy from the calibration.
         params.control.assumed_accuracy = accuracy;
-        let c = &params.control;
-        if !(c.tau.is_finite() && c.tau > 0.0) {
-            return Err(bad(
-                "control.tau",
-                c.tau.to_string(),
-                "a number > 0 (the paper: 0.3)",
-            ));
-        }
-        if !(c.epsilon.is_finite() && (0.0..=1.0).contains(&c.epsilon)) {
-            return Err(bad(
-                "control.epsilon",
-                c.epsilon.to_string(),
-                "a probability in [0, 1]",
-            ));
-        }
-        if !(c.p_c.is_finite() && c.p_c > 0.0 && c.p_c < 1.0) {
-            return Err(bad(
-                "control.p_c",
-                c.p_c.to_string(),
-                "a probability in (0, 1) (the paper: 0.9)",
-            ));
-        }
-        if !(c.q.discount.is_finite() && (0.0..1.0).contains(&c.q.discount)) {
-            return Err(bad(
-                "control.discount",
-                c.q.discount.to_string(),
-                "a number in [0, 1)",
-            ));
-        }
-        c.q.validate()
-            .map_err(|e| bad("control", "rewards".into(), &e.to_string()))?;
+        params
+            .control
+            .validate()
+            .map_err(|e| robot_error(path, "control", e))?;
         if let Some(t) = &file.timing {
             let d = GridTaskParams::default();
             params.interval_min_secs = t.interval_min_secs.unwrap_or(d.interval_min_secs);
