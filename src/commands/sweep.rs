@@ -11,8 +11,8 @@ use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
 use errp_sweep::{
     DecoderInfo, Manifest, Shard, SweepObserver, SweepOptions, SweepOutcome, SweepReport,
-    SweepSpec, SweepTask, TargetCache, finish_dir, merge_sweeps, parse_accuracies, parse_axis,
-    read_task, run_sweep,
+    SweepSpec, SweepTask, TargetCache, aliases, finish_dir, merge_sweeps, parse_accuracies,
+    parse_axis, read_task, run_sweep,
 };
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
@@ -53,7 +53,7 @@ pub struct SweepArgs {
     /// (repeatable; every combination runs). Grid: tau, epsilon, p_c,
     /// strategy, max_actions, ...; e-puck: t_e, p_c, k_n, sigma_deg,
     /// strategy, fov_deg, ...; or any dotted path into the scenario file.
-    #[arg(long = "param", value_name = "NAME=VALUES")]
+    #[arg(long = "param", value_name = "NAME=VALUES", long_help = param_help())]
     params: Vec<String>,
     /// Episodes per level.
     #[arg(long, default_value_t = 200)]
@@ -369,4 +369,16 @@ pub fn merge(args: &MergeArgs) -> Result<()> {
     let report = merge_sweeps(&args.dirs, Path::new(&args.out))?;
     print_report(&report);
     Ok(())
+}
+
+/// The long help of `--param`, listing every short name (from the sweep's
+/// own table, so the two cannot disagree).
+fn param_help() -> String {
+    format!(
+        "Also sweep a scenario parameter, NAME=start:stop:step or NAME=a,b,c \
+         (repeatable; every combination runs). NAME is a dotted path into the scenario \
+         file (e.g. control.tau) or a short name.\n\nGrid: {}\n\nE-puck: {}",
+        aliases(SweepTask::Grid),
+        aliases(SweepTask::Epuck)
+    )
 }

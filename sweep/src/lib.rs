@@ -32,6 +32,7 @@ pub use plot::{LevelPoint, PaperPoint, PlotError, Series, SweepPlot};
 pub use rows::{cost_column, episodes_header};
 pub use run::{SweepObserver, SweepOptions, SweepOutcome, run_sweep};
 pub use spec::{
-    Axis, Level, Shard, SweepSpec, SweepTask, parse_accuracies, parse_axis, parse_values, read_task,
+    Axis, Level, Shard, SweepSpec, SweepTask, aliases, parse_accuracies, parse_axis, parse_values,
+    read_task, sweepable,
 };
 pub use summary::{LevelSummary, SweepReport, finish_dir, summarise_dir, summary_csv, sweep_plot};

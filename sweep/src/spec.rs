@@ -245,66 +245,68 @@ pub fn parse_accuracies(text: &str) -> Result<Vec<f64>> {
     Ok(out)
 }
 
-/// Short names of the sweepable parameters of each task, and where they live
-/// in the scenario file. Any other parameter is named by its dotted path.
-fn alias(task: SweepTask, name: &str) -> Option<&'static str> {
-    let grid: &[(&str, &str)] = &[
-        ("tau", "control.tau"),
-        ("epsilon", "control.epsilon"),
-        ("p_c", "control.p_c"),
-        ("discount", "control.discount"),
-        ("goal_reward", "control.goal_reward"),
-        ("wrong_goal_reward", "control.wrong_goal_reward"),
-        ("strategy", "control.strategy"),
-        ("interval_min_secs", "timing.interval_min_secs"),
-        ("interval_max_secs", "timing.interval_max_secs"),
-        ("epoch_secs", "timing.epoch_secs"),
-        ("max_actions", "timing.max_actions"),
-        ("decoder", "decoder"),
-        ("p_error", "p_error"),
-        ("eeg", "eeg"),
-        ("bank_per_class", "bank_per_class"),
-    ];
-    let epuck: &[(&str, &str)] = &[
-        ("t_e", "control.t_e"),
-        ("k_turn", "control.k_turn"),
-        ("k_p", "control.k_p"),
-        ("k_n", "control.k_n"),
-        ("sigma_deg", "control.sigma_deg"),
-        ("p_c", "control.p_c"),
-        ("stop_secs", "control.stop_secs"),
-        ("drive_speed_fraction", "control.drive_speed_fraction"),
-        ("turn_speed_fraction", "control.turn_speed_fraction"),
-        ("strategy", "control.strategy"),
-        ("fov_deg", "user.fov_deg"),
-        ("reaction_latency_ms", "user.reaction_latency_ms"),
-        ("reelicit_secs", "user.reelicit_secs"),
-        ("max_secs", "max_secs"),
-        ("rate_hz", "tracker.rate_hz"),
-        ("position_noise_cm", "tracker.position_noise_cm"),
-        ("heading_noise_deg", "tracker.heading_noise_deg"),
-    ];
-    let table = match task {
-        SweepTask::Grid => grid,
-        SweepTask::Epuck => epuck,
-    };
-    table.iter().find(|(n, _)| *n == name).map(|(_, k)| *k)
+/// The short names of the grid task's sweepable parameters, and where they
+/// live in the scenario file. Any other parameter is named by its dotted
+/// path.
+const GRID_PARAMS: &[(&str, &str)] = &[
+    ("tau", "control.tau"),
+    ("epsilon", "control.epsilon"),
+    ("p_c", "control.p_c"),
+    ("discount", "control.discount"),
+    ("goal_reward", "control.goal_reward"),
+    ("wrong_goal_reward", "control.wrong_goal_reward"),
+    ("strategy", "control.strategy"),
+    ("interval_min_secs", "timing.interval_min_secs"),
+    ("interval_max_secs", "timing.interval_max_secs"),
+    ("epoch_secs", "timing.epoch_secs"),
+    ("max_actions", "timing.max_actions"),
+    ("decoder", "decoder"),
+    ("p_error", "p_error"),
+    ("eeg", "eeg"),
+    ("bank_per_class", "bank_per_class"),
+];
+
+/// The same for the e-puck task.
+const EPUCK_PARAMS: &[(&str, &str)] = &[
+    ("t_e", "control.t_e"),
+    ("k_turn", "control.k_turn"),
+    ("k_p", "control.k_p"),
+    ("k_n", "control.k_n"),
+    ("sigma_deg", "control.sigma_deg"),
+    ("p_c", "control.p_c"),
+    ("stop_secs", "control.stop_secs"),
+    ("drive_speed_fraction", "control.drive_speed_fraction"),
+    ("turn_speed_fraction", "control.turn_speed_fraction"),
+    ("strategy", "control.strategy"),
+    ("fov_deg", "user.fov_deg"),
+    ("reaction_latency_ms", "user.reaction_latency_ms"),
+    ("reelicit_secs", "user.reelicit_secs"),
+    ("max_secs", "max_secs"),
+    ("rate_hz", "tracker.rate_hz"),
+    ("position_noise_cm", "tracker.position_noise_cm"),
+    ("heading_noise_deg", "tracker.heading_noise_deg"),
+];
+
+/// The sweepable parameters of `task`: (short name, dotted key).
+pub fn sweepable(task: SweepTask) -> &'static [(&'static str, &'static str)] {
+    match task {
+        SweepTask::Grid => GRID_PARAMS,
+        SweepTask::Epuck => EPUCK_PARAMS,
+    }
 }
 
-/// The short names accepted for `task`, for error messages.
-fn aliases(task: SweepTask) -> &'static str {
-    match task {
-        SweepTask::Grid => {
-            "tau, epsilon, p_c, discount, goal_reward, wrong_goal_reward, strategy, \
-             interval_min_secs, interval_max_secs, epoch_secs, max_actions, decoder, p_error, \
-             eeg, bank_per_class"
-        }
-        SweepTask::Epuck => {
-            "t_e, k_turn, k_p, k_n, sigma_deg, p_c, stop_secs, drive_speed_fraction, \
-             turn_speed_fraction, strategy, fov_deg, reaction_latency_ms, reelicit_secs, \
-             max_secs, rate_hz, position_noise_cm, heading_noise_deg"
-        }
-    }
+/// The dotted key of short name `name` for `task`.
+fn alias(task: SweepTask, name: &str) -> Option<&'static str> {
+    sweepable(task)
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, k)| *k)
+}
+
+/// The short names accepted for `task`, for error messages and help.
+pub fn aliases(task: SweepTask) -> String {
+    let names: Vec<&str> = sweepable(task).iter().map(|(n, _)| *n).collect();
+    names.join(", ")
 }
 
 /// Parses one `--param NAME=VALUES` for `task`.
