@@ -15,6 +15,7 @@
 #![warn(clippy::unwrap_used, clippy::print_stdout, clippy::iter_over_hash_type)]
 
 mod cache;
+mod figure;
 mod manifest;
 mod merge;
 mod plot;
@@ -23,9 +24,11 @@ mod rows;
 mod run;
 mod spec;
 mod summary;
+mod table;
 mod writer;
 
 pub use cache::TargetCache;
+pub use figure::sweep_plot;
 pub use manifest::{DecoderInfo, EPISODES, MANIFEST, Manifest};
 pub use merge::merge_sweeps;
 pub use plot::{LevelPoint, PaperPoint, PlotError, Series, SweepPlot};
@@ -35,4 +38,5 @@ pub use spec::{
     Axis, Level, Shard, SweepSpec, SweepTask, aliases, parse_accuracies, parse_axis, parse_values,
     read_task, sweepable,
 };
-pub use summary::{LevelSummary, SweepReport, finish_dir, summarise_dir, summary_csv, sweep_plot};
+pub use summary::{LevelSummary, SweepReport, finish_dir, summarise_dir};
+pub use table::summary_csv;

@@ -4,24 +4,22 @@
 //! not grow with the number of episodes, and a merged sweep is summarised by
 //! the same code as an unsharded one.
 
-use std::fmt;
 use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 
-use errp_bci::GoalSet;
-
+use errp_sim::parse_scenario;
 use errp_sim::write_atomic;
-use errp_sim::{AnyScenario, parse_scenario};
-use errp_sim::{PAPER, PAPER_EPUCK};
 use errp_sim::{Result, SimError};
-use errp_sim::{StreamingPearson, pearson, wilson_interval};
+use errp_sim::{StreamingPearson, pearson};
 use errp_sim::{mean_sd, median};
 
+use crate::figure::sweep_plot;
 use crate::manifest::{EPISODES, Manifest};
-use crate::plot::{self, LevelPoint, PaperPoint, Series, SweepPlot};
+use crate::plot::{self};
 use crate::rows::cost_column;
-use crate::spec::{SweepSpec, SweepTask, format_number, value_text};
+use crate::spec::{SweepSpec, SweepTask};
+use crate::table::summary_csv;
 
 /// The statistics of one level.
 #[derive(Debug, Clone, PartialEq)]
@@ -271,263 +269,6 @@ impl Acc {
 /// The mean of a (sum, count) pair; NaN for none.
 fn mean_of((sum, n): (f64, usize)) -> f64 {
     if n == 0 { f64::NAN } else { sum / n as f64 }
-}
-
-/// A statistic in the summary: 6 decimals, empty when undefined.
-fn stat(x: f64) -> String {
-    if x.is_finite() {
-        let s = format!("{x:.6}");
-        let s = s.trim_end_matches('0').trim_end_matches('.');
-        if s == "-0" { "0".into() } else { s.to_string() }
-    } else {
-        String::new()
-    }
-}
-
-/// The text of `summary.csv`.
-pub fn summary_csv(spec: &SweepSpec, report: &SweepReport) -> String {
-    let cost = cost_column(spec.task);
-    let mut cols = vec!["level".to_string(), "accuracy".into()];
-    cols.extend(spec.axes.iter().map(|a| a.name.clone()));
-    cols.extend(
-        [
-            "episodes",
-            "success_rate",
-            "success_lo95",
-            "success_hi95",
-            "wrong_goal_rate",
-            "no_commit_rate",
-        ]
-        .map(String::from),
-    );
-    cols.extend(["mean", "sd", "median"].map(|s| format!("{cost}_{s}")));
-    cols.push("online_accuracy".into());
-    cols.push(format!("r_online_{cost}"));
-    cols.push(format!("p_online_{cost}"));
-    let epuck = spec.task == SweepTask::Epuck;
-    if epuck {
-        cols.extend(["hit_rate", "false_alarms_per_min"].map(String::from));
-    }
-    let mut out = cols.join(",");
-    out.push('\n');
-    for l in &report.levels {
-        let (_, values) = spec.level_values(l.level);
-        let n = l.episodes as f64;
-        let (lo, hi) = wilson_interval(l.successes, l.episodes);
-        let mut f = vec![l.level.to_string(), format_number(l.accuracy)];
-        f.extend(values.iter().map(value_text));
-        f.extend([
-            l.episodes.to_string(),
-            stat(l.success_rate()),
-            stat(lo),
-            stat(hi),
-            stat(l.wrong as f64 / n),
-            stat(l.no_commit as f64 / n),
-            stat(l.cost.0),
-            stat(l.cost.1),
-            stat(l.cost.2),
-            stat(l.online_accuracy),
-            stat(l.r_p.0),
-            stat(l.r_p.1),
-        ]);
-        if epuck {
-            f.extend([stat(l.detector.0), stat(l.detector.1)]);
-        }
-        out.push_str(&f.join(","));
-        out.push('\n');
-    }
-    out
-}
-
-impl fmt::Display for SweepReport {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let cost = match self.task {
-            SweepTask::Grid => "actions",
-            SweepTask::Epuck => "time (s)",
-        };
-        let width = self
-            .levels
-            .iter()
-            .map(|l| l.series.len())
-            .max()
-            .unwrap_or(0)
-            .max(6);
-        let with_series = self.levels.iter().any(|l| !l.series.is_empty());
-        if with_series {
-            write!(f, "{:<width$}  ", "series")?;
-        }
-        let epuck = self.task == SweepTask::Epuck;
-        write!(
-            f,
-            "{:>8} {:>6} {:>8} {:>15} {:>17} {:>7} {:>7} {:>6} {:>7}",
-            "accuracy",
-            "n",
-            "success",
-            "95% CI",
-            format!("{cost} mean ± sd"),
-            "median",
-            "online",
-            "r",
-            "p"
-        )?;
-        if epuck {
-            write!(f, " {:>6} {:>8}", "hits", "FA/min")?;
-        }
-        writeln!(f)?;
-        for l in &self.levels {
-            let (lo, hi) = wilson_interval(l.successes, l.episodes);
-            if with_series {
-                write!(f, "{:<width$}  ", l.series)?;
-            }
-            let num = |x: f64, d: usize| {
-                if x.is_finite() {
-                    format!("{x:.d$}")
-                } else {
-                    "-".into()
-                }
-            };
-            write!(
-                f,
-                "{:>8} {:>6} {:>7.1}% {:>15} {:>17} {:>7} {:>7} {:>6} {:>7}",
-                format_number(l.accuracy),
-                l.episodes,
-                100.0 * l.success_rate(),
-                format!("[{:.1}, {:.1}]", 100.0 * lo, 100.0 * hi),
-                format!("{} ± {}", num(l.cost.0, 1), num(l.cost.1, 1)),
-                num(l.cost.2, 1),
-                num(l.online_accuracy, 3),
-                num(l.r_p.0, 2),
-                num(l.r_p.1, 3),
-            )?;
-            if epuck {
-                write!(
-                    f,
-                    " {:>6} {:>8}",
-                    num(l.detector.0, 3),
-                    num(l.detector.1, 2)
-                )?;
-            }
-            writeln!(f)?;
-        }
-        for (label, n, (r, p)) in &self.series {
-            let name = if label.is_empty() {
-                "all levels".to_string()
-            } else {
-                label.clone()
-            };
-            writeln!(
-                f,
-                "{name}: online accuracy vs {cost} over {n} successful episodes: r = {r:.3}, p = {}",
-                if p.is_finite() {
-                    format!("{p:.3e}")
-                } else {
-                    "-".into()
-                }
-            )?;
-        }
-        Ok(())
-    }
-}
-
-/// The plot of a sweep, with the paper's figures where they apply.
-pub fn sweep_plot(spec: &SweepSpec, report: &SweepReport, scenario: &AnyScenario) -> SweepPlot {
-    let mut series: Vec<Series> = Vec::new();
-    for l in &report.levels {
-        let (lo, hi) = wilson_interval(l.successes, l.episodes);
-        let point = LevelPoint {
-            accuracy: l.accuracy,
-            success_rate: l.success_rate(),
-            success_lo: lo,
-            success_hi: hi,
-            mean: l.cost.0,
-            sd: l.cost.1,
-            median: l.cost.2,
-            n: l.episodes,
-        };
-        match series.iter_mut().find(|s| s.label == l.series) {
-            Some(s) => s.points.push(point),
-            None => series.push(Series {
-                label: l.series.clone(),
-                points: vec![point],
-            }),
-        }
-    }
-    for s in &mut series {
-        s.points.sort_by(|a, b| a.accuracy.total_cmp(&b.accuracy));
-    }
-    let decoder = match scenario {
-        AnyScenario::Grid(s) => match s.decoder {
-            errp_sim::grid::DecoderChoice::Oracle => "oracle decoder".to_string(),
-            errp_sim::grid::DecoderChoice::Eeg => {
-                format!("EEG decoder ({:?})", s.eeg).to_lowercase()
-            }
-        },
-        AnyScenario::Epuck(_) => "sliding-window SVM decoder".to_string(),
-    };
-    let (task, cost_label, paper, paper_label) = match scenario {
-        AnyScenario::Grid(_) => (
-            "Grid task".to_string(),
-            "actions to convergence (successful episodes)".to_string(),
-            PAPER
-                .iter()
-                .map(|(name, set, row)| PaperPoint {
-                    label: format!(
-                        "{name} {}",
-                        if *set == GoalSet::Fixed {
-                            "fixed"
-                        } else {
-                            "free"
-                        }
-                    ),
-                    accuracy: row[6] / 100.0,
-                    value: row[0],
-                    sd: Some(row[1]),
-                })
-                .collect::<Vec<_>>(),
-            "paper, Table 1 (S1-S4, fixed and free goals)".to_string(),
-        ),
-        AnyScenario::Epuck(s) => {
-            let paper: Vec<PaperPoint> = PAPER_EPUCK
-                .iter()
-                .filter(|(name, _, _)| *name == s.name)
-                .map(|(name, secs, _)| PaperPoint {
-                    label: name.to_string(),
-                    // The paper gives no accuracy for its continuous
-                    // decoder: drawn at the scenario's.
-                    accuracy: s.accuracy,
-                    value: *secs,
-                    sd: None,
-                })
-                .collect();
-            (
-                format!("E-puck task, {}", s.name),
-                "time to convergence, s (successful episodes)".to_string(),
-                paper,
-                format!(
-                    "paper, {} (one run; drawn at the scenario's {})",
-                    s.name,
-                    format_number(s.accuracy)
-                ),
-            )
-        }
-    };
-    SweepPlot {
-        title: format!(
-            "{task}: {} accuracies{} x {} episodes, {decoder}, seed {}",
-            spec.accuracies.len(),
-            if series.len() > 1 {
-                format!(" x {} settings", series.len())
-            } else {
-                String::new()
-            },
-            spec.episodes,
-            spec.seed
-        ),
-        cost_label,
-        series,
-        paper,
-        paper_label,
-    }
 }
 
 /// Writes `summary.csv`, `sweep.svg`, `sweep.png` and the final `sweep.json`

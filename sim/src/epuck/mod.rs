@@ -7,6 +7,7 @@ pub(crate) mod episode;
 pub(crate) mod report;
 pub(crate) mod run;
 pub(crate) mod scenario;
+pub(crate) mod schema;
 pub(crate) mod tracker;
 pub(crate) mod user;
 pub(crate) mod view;

@@ -6,134 +6,13 @@
 use std::path::{Path, PathBuf};
 
 use errp_bci::{DetectorMode, DetectorParams, OnlineTarget, check_requested_accuracy};
-use errp_robot::{GoalLayout, Pose, Strategy};
-use serde::Deserialize;
+use errp_robot::{GoalLayout, Pose};
 
 use crate::epuck::episode::{EpuckEpisode, EpuckTaskParams};
+use crate::epuck::schema::{EpuckFile, StartFile, c_opt};
 use crate::epuck::world::{ArenaSpec, Obstacle};
 use crate::error::{Result, SimError};
 use crate::scenario_file::{field_error, parse_toml, read_scenario, robot_error, scenario_name};
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct EpuckFile {
-    task: String,
-    #[serde(default)]
-    name: Option<String>,
-    #[serde(default)]
-    description: Option<String>,
-    #[serde(default = "default_seed")]
-    seed: u64,
-    start: StartFile,
-    #[serde(default = "default_heading")]
-    start_heading_deg: f64,
-    goal: String,
-    #[serde(default = "default_runs")]
-    runs: usize,
-    #[serde(default = "default_max_secs")]
-    max_secs: f64,
-    user: UserFile,
-    #[serde(default)]
-    control: Option<ControlFile>,
-    #[serde(default)]
-    tracker: Option<TrackerFile>,
-    #[serde(default)]
-    avoidance: Option<AvoidanceFile>,
-    #[serde(default)]
-    detector: Option<DetectorFile>,
-    #[serde(default)]
-    arena: Option<ArenaFile>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct DetectorFile {
-    mode: Option<DetectorMode>,
-    smooth_windows: Option<usize>,
-    refractory_secs: Option<f64>,
-}
-
-fn default_seed() -> u64 {
-    1
-}
-fn default_heading() -> f64 {
-    90.0
-}
-fn default_runs() -> usize {
-    1
-}
-fn default_max_secs() -> f64 {
-    600.0
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(untagged)]
-enum StartFile {
-    City(String),
-    Cm([f64; 2]),
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct UserFile {
-    accuracy: Option<f64>,
-    hit_rate: Option<f64>,
-    false_alarms_per_min: Option<f64>,
-    fov_deg: Option<f64>,
-    reaction_latency_ms: Option<f64>,
-    reelicit_secs: Option<f64>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ControlFile {
-    t_e: Option<f64>,
-    k_turn: Option<f64>,
-    k_p: Option<f64>,
-    k_n: Option<f64>,
-    sigma_deg: Option<f64>,
-    p_c: Option<f64>,
-    stop_secs: Option<f64>,
-    drive_speed_fraction: Option<f64>,
-    turn_speed_fraction: Option<f64>,
-    goal_hold_secs: Option<f64>,
-    veto_window_secs: Option<f64>,
-    strategy: Option<Strategy>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct TrackerFile {
-    rate_hz: Option<f64>,
-    position_noise_cm: Option<f64>,
-    heading_noise_deg: Option<f64>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct AvoidanceFile {
-    enabled: Option<bool>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ArenaFile {
-    #[serde(default)]
-    obstacle: Vec<ObstacleFile>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ObstacleFile {
-    shape: String,
-    center_cm: [f64; 2],
-    #[serde(default)]
-    size_cm: Option<[f64; 2]>,
-    #[serde(default)]
-    radius_cm: Option<f64>,
-    #[serde(default)]
-    angle_deg: f64,
-}
 
 /// A parameter error of `errp_bci` as a field error of the scenario's
 /// `[table]`.
@@ -146,11 +25,6 @@ fn table_error(path: &Path, table: &str, e: errp_bci::BciError) -> SimError {
         } => field_error(path, &format!("{table}.{name}"), value, &expected),
         other => SimError::Scenario(format!("{}: [{table}] {other}", path.display())),
     }
-}
-
-/// `f` of the `[control]` table, if there is one.
-fn c_opt(c: &Option<ControlFile>, f: impl Fn(&ControlFile) -> Option<f64>) -> Option<f64> {
-    c.as_ref().and_then(f)
 }
 
 /// A validated e-puck scenario.

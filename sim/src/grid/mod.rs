@@ -1,6 +1,7 @@
 //! The discrete grid task (sec. 3-4 of the paper): scenario files, one
 //! episode, a scenario's runs, Table 1 and the recording.
 
+pub(crate) mod decoder;
 pub(crate) mod episode;
 pub(crate) mod report;
 pub(crate) mod run;
@@ -8,10 +9,11 @@ pub(crate) mod scenario;
 pub(crate) mod table1;
 pub(crate) mod view;
 
-pub use episode::{
-    AssessmentDecoder, EegDecoder, EegSource, EpochBank, EpochBankParts, GridEpisodeResult,
-    GridStep, GridTaskParams, PErrorChoice, PErrorMapping, run_grid_episode,
+pub use decoder::{
+    AssessmentDecoder, EegDecoder, EegSource, EpochBank, EpochBankParts, PErrorChoice,
+    PErrorMapping,
 };
+pub use episode::{GridEpisodeResult, GridStep, GridTaskParams, run_grid_episode};
 pub use report::{GridEpisodeHeader, GridEpisodeRow, Table1Report};
 pub use run::{
     GridRunReport, GridShared, PreparedGrid, decoder_from_calibration, pooled_accuracy,

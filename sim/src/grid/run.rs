@@ -12,10 +12,8 @@ use errp_robot::{Grid, QTable};
 
 use crate::calibration::{CalibrationReport, CalibrationRequest, NoCache, TargetingCache};
 use crate::error::{Result, SimError};
-use crate::grid::episode::{
-    AssessmentDecoder, EegDecoder, EegSource, EpochBank, EpochBankParts, GridEpisodeResult,
-    run_grid_episode,
-};
+use crate::grid::decoder::{AssessmentDecoder, EegDecoder, EegSource, EpochBank, EpochBankParts};
+use crate::grid::episode::{GridEpisodeResult, run_grid_episode};
 use crate::grid::scenario::{DecoderChoice, EegMode, GridScenario};
 
 /// Everything a grid run produced.

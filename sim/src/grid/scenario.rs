@@ -13,7 +13,8 @@ use rand::Rng;
 use serde::Deserialize;
 
 use crate::error::Result;
-use crate::grid::episode::{GridTaskParams, PErrorChoice};
+use crate::grid::decoder::PErrorChoice;
+use crate::grid::episode::GridTaskParams;
 use crate::scenario_file::{field_error, parse_toml, read_scenario, robot_error, scenario_name};
 
 /// Which decoder turns the user's assessments into p(error).

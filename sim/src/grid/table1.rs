@@ -6,7 +6,7 @@ use errp_robot::{Cell, Grid, QTable};
 use rayon::prelude::*;
 
 use crate::error::Result;
-use crate::grid::episode::PErrorChoice;
+use crate::grid::decoder::PErrorChoice;
 use crate::grid::episode::{GridEpisodeResult, GridTaskParams, run_grid_episode};
 use crate::grid::run::prepare_decoder;
 use crate::grid::scenario::{DecoderChoice, EegMode, GridScenario, free_pairs};

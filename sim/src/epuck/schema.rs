@@ -1,0 +1,139 @@
+//! The TOML schema of an e-puck scenario file: what each table may hold,
+//! before any value is checked (sim/src/epuck/scenario.rs checks them and
+//! converts centimetres and degrees to SI).
+
+use errp_bci::DetectorMode;
+use errp_robot::Strategy;
+use serde::Deserialize;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct EpuckFile {
+    pub(crate) task: String,
+    #[serde(default)]
+    pub(crate) name: Option<String>,
+    #[serde(default)]
+    pub(crate) description: Option<String>,
+    #[serde(default = "default_seed")]
+    pub(crate) seed: u64,
+    pub(crate) start: StartFile,
+    #[serde(default = "default_heading")]
+    pub(crate) start_heading_deg: f64,
+    pub(crate) goal: String,
+    #[serde(default = "default_runs")]
+    pub(crate) runs: usize,
+    #[serde(default = "default_max_secs")]
+    pub(crate) max_secs: f64,
+    pub(crate) user: UserFile,
+    #[serde(default)]
+    pub(crate) control: Option<ControlFile>,
+    #[serde(default)]
+    pub(crate) tracker: Option<TrackerFile>,
+    #[serde(default)]
+    pub(crate) avoidance: Option<AvoidanceFile>,
+    #[serde(default)]
+    pub(crate) detector: Option<DetectorFile>,
+    #[serde(default)]
+    pub(crate) arena: Option<ArenaFile>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct DetectorFile {
+    pub(crate) mode: Option<DetectorMode>,
+    pub(crate) smooth_windows: Option<usize>,
+    pub(crate) refractory_secs: Option<f64>,
+}
+
+pub(crate) fn default_seed() -> u64 {
+    1
+}
+
+pub(crate) fn default_heading() -> f64 {
+    90.0
+}
+
+pub(crate) fn default_runs() -> usize {
+    1
+}
+
+pub(crate) fn default_max_secs() -> f64 {
+    600.0
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+pub(crate) enum StartFile {
+    City(String),
+    Cm([f64; 2]),
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct UserFile {
+    pub(crate) accuracy: Option<f64>,
+    pub(crate) hit_rate: Option<f64>,
+    pub(crate) false_alarms_per_min: Option<f64>,
+    pub(crate) fov_deg: Option<f64>,
+    pub(crate) reaction_latency_ms: Option<f64>,
+    pub(crate) reelicit_secs: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct ControlFile {
+    pub(crate) t_e: Option<f64>,
+    pub(crate) k_turn: Option<f64>,
+    pub(crate) k_p: Option<f64>,
+    pub(crate) k_n: Option<f64>,
+    pub(crate) sigma_deg: Option<f64>,
+    pub(crate) p_c: Option<f64>,
+    pub(crate) stop_secs: Option<f64>,
+    pub(crate) drive_speed_fraction: Option<f64>,
+    pub(crate) turn_speed_fraction: Option<f64>,
+    pub(crate) goal_hold_secs: Option<f64>,
+    pub(crate) veto_window_secs: Option<f64>,
+    pub(crate) strategy: Option<Strategy>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct TrackerFile {
+    pub(crate) rate_hz: Option<f64>,
+    pub(crate) position_noise_cm: Option<f64>,
+    pub(crate) heading_noise_deg: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct AvoidanceFile {
+    pub(crate) enabled: Option<bool>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct ArenaFile {
+    #[serde(default)]
+    pub(crate) obstacle: Vec<ObstacleFile>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct ObstacleFile {
+    pub(crate) shape: String,
+    pub(crate) center_cm: [f64; 2],
+    #[serde(default)]
+    pub(crate) size_cm: Option<[f64; 2]>,
+    #[serde(default)]
+    pub(crate) radius_cm: Option<f64>,
+    #[serde(default)]
+    pub(crate) angle_deg: f64,
+}
+
+/// `f` of the `[control]` table, if there is one.
+pub(crate) fn c_opt(
+    c: &Option<ControlFile>,
+    f: impl Fn(&ControlFile) -> Option<f64>,
+) -> Option<f64> {
+    c.as_ref().and_then(f)
+}

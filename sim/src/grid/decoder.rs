@@ -1,0 +1,346 @@
+//! The grid task's decoders: the oracle, the EEG decoder on a live stream or
+//! on a bank of pre-streamed epochs, and the mapping of LDA scores to
+//! p(error).
+
+use errp_bci::{
+    Assessment, AssessmentKind, Components, EegGenerator, EpochWindow, ErrorModel, GeneratorParams,
+    LdaModel, Montage, PlattScaling, Preprocessor, rng::derive_seed, rng::stream,
+};
+use rand::Rng;
+use serde::{Deserialize, Serialize};
+
+use crate::calibration::CalibrationReport;
+use crate::error::{Result, SimError};
+use crate::grid::episode::GridTaskParams;
+
+/// What turns the user's assessment into p(error).
+#[derive(Debug, Clone)]
+pub enum AssessmentDecoder {
+    /// No EEG: the assessment is reported flipped with probability
+    /// 1 - accuracy, as p(error) = accuracy (decoded error) or 1 - accuracy
+    /// (decoded correct), the calibrated output of such a decoder.
+    Oracle {
+        /// Probability of reporting the assessment right.
+        accuracy: f64,
+    },
+    /// Synthetic EEG through the real preprocessing and decoder, as trained
+    /// on a calibration session; each action's EEG is streamed (the whole
+    /// inter-action interval) when the action happens.
+    Eeg(Box<EegDecoder>),
+    /// The same decoder applied to epochs drawn from a bank of synthetic
+    /// epochs streamed and preprocessed in advance (one per class of
+    /// assessment): the decoder still reads real synthetic EEG for every
+    /// action, but no EEG is synthesised during the episode. For Monte Carlo
+    /// speed; epochs are reused across episodes.
+    EegBank(Box<EpochBank>),
+}
+
+/// Preprocessed epochs of each assessment class, ready to be decoded.
+#[derive(Debug, Clone)]
+pub struct EpochBank {
+    /// The decoder that reads them.
+    pub decoder: EegDecoder,
+    pub(crate) error: Vec<(Vec<f64>, Vec<f64>)>,
+    pub(crate) correct: Vec<(Vec<f64>, Vec<f64>)>,
+}
+
+impl EpochBank {
+    /// Streams `per_class` error and `per_class` correct assessments (in a
+    /// seeded random order, at the task's inter-action intervals) through the
+    /// generator and the preprocessor and keeps each epoch's features and
+    /// its FCz trace.
+    pub fn build(
+        decoder: EegDecoder,
+        params: &GridTaskParams,
+        per_class: usize,
+        seed: u64,
+    ) -> Result<Self> {
+        let (error, correct) = stream_pools(
+            decoder.source(),
+            params,
+            per_class,
+            seed,
+            Components::default(),
+        )?;
+        Ok(Self {
+            decoder,
+            error,
+            correct,
+        })
+    }
+
+    /// Epochs per class.
+    /// Epoch `i` of a class: its features and its FCz trace.
+    pub fn epoch(&self, error: bool, i: usize) -> (&[f64], &[f64]) {
+        let (x, fcz) = if error {
+            &self.error[i]
+        } else {
+            &self.correct[i]
+        };
+        (x, fcz)
+    }
+
+    /// Epochs per class.
+    pub fn len(&self) -> usize {
+        self.error.len().min(self.correct.len())
+    }
+
+    /// True if the bank holds no epochs.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// The epochs of [`EpochBank::build`] streamed once in two parts that add up
+/// to the bank at any ErrP-to-noise ratio r: background + artifacts, and the
+/// ERPs at ratio 1 (the preprocessing and the features are linear). For
+/// sweeps, whose levels share a calibration session and so the preprocessor,
+/// and differ only in r.
+#[derive(Debug, Clone)]
+pub struct EpochBankParts {
+    noise: Pools,
+    erp: Pools,
+}
+
+impl EpochBankParts {
+    /// Streams both parts from `source` (its ratio is not used).
+    pub fn build(
+        source: EegSource<'_>,
+        params: &GridTaskParams,
+        per_class: usize,
+        seed: u64,
+    ) -> Result<Self> {
+        let generator = GeneratorParams {
+            errp_to_noise: 1.0,
+            ..source.generator.clone()
+        };
+        let unit = EegSource {
+            generator: &generator,
+            ..source
+        };
+        let part = |erp: bool| {
+            let components = Components {
+                background: !erp,
+                artifacts: !erp,
+                erp,
+            };
+            stream_pools(unit, params, per_class, seed, components)
+        };
+        let (noise, erp) = rayon::join(|| part(false), || part(true));
+        Ok(Self {
+            noise: noise?,
+            erp: erp?,
+        })
+    }
+
+    /// The bank `decoder` reads, at its generator's ratio: what
+    /// [`EpochBank::build`] gives (to rounding) if `decoder`'s preprocessor is
+    /// the one the parts were streamed with.
+    pub fn bank(&self, decoder: EegDecoder) -> EpochBank {
+        let r = decoder.generator.errp_to_noise;
+        let mix = |noise: &[(Vec<f64>, Vec<f64>)], erp: &[(Vec<f64>, Vec<f64>)]| {
+            noise
+                .iter()
+                .zip(erp)
+                .map(|((xn, fn_), (xe, fe))| {
+                    (
+                        xn.iter().zip(xe).map(|(a, b)| a + r * b).collect(),
+                        fn_.iter().zip(fe).map(|(a, b)| a + r * b).collect(),
+                    )
+                })
+                .collect()
+        };
+        EpochBank {
+            error: mix(&self.noise.0, &self.erp.0),
+            correct: mix(&self.noise.1, &self.erp.1),
+            decoder,
+        }
+    }
+}
+
+/// Streams the epochs of a bank with the generator's `components`.
+fn stream_pools(
+    source: EegSource<'_>,
+    params: &GridTaskParams,
+    per_class: usize,
+    seed: u64,
+    components: Components,
+) -> Result<Pools> {
+    if per_class == 0 {
+        return Err(SimError::Scenario(
+            "an epoch bank needs at least one epoch per class".into(),
+        ));
+    }
+    let mut stream_eeg = OnlineEeg::start(source, derive_seed(seed, "grid/bank", 0), components)?;
+    let mut rng = stream(seed, "grid/bank/order");
+    let mut error = Vec::with_capacity(per_class);
+    let mut correct = Vec::with_capacity(per_class);
+    while error.len() < per_class || correct.len() < per_class {
+        let want_error = if error.len() == per_class {
+            false
+        } else if correct.len() == per_class {
+            true
+        } else {
+            rng.random_bool(0.5)
+        };
+        let interval = rng.random_range(params.interval_min_secs..=params.interval_max_secs);
+        let epoch = stream_eeg.epoch(want_error, interval, true);
+        if want_error {
+            error.push(epoch);
+        } else {
+            correct.push(epoch);
+        }
+    }
+    Ok((error, correct))
+}
+
+/// The calibrated EEG pipeline used online.
+#[derive(Debug, Clone)]
+pub struct EegDecoder {
+    /// The synthetic user's EEG model (at the calibrated ErrP-to-noise ratio).
+    pub generator: GeneratorParams,
+    /// The montage.
+    pub montage: Montage,
+    /// Preprocessing fitted on the calibration session's EOG recording.
+    pub preprocessor: Preprocessor,
+    /// The decoder trained on the calibration session.
+    pub model: LdaModel,
+    /// How decision values become p(error).
+    pub p_error: PErrorMapping,
+}
+
+impl EegDecoder {
+    /// The online decoder a calibration produced, with p(error) mapped as
+    /// `choice` says.
+    pub fn from_report(report: &CalibrationReport, choice: PErrorChoice) -> Self {
+        Self {
+            generator: report.generator.clone(),
+            montage: Montage::standard(),
+            preprocessor: report.calibrated.session.preprocessor.clone(),
+            model: report.calibrated.model.clone(),
+            p_error: match choice {
+                PErrorChoice::Sigmoid => PErrorMapping::Sigmoid,
+                PErrorChoice::Platt => PErrorMapping::Platt(report.calibrated.platt),
+            },
+        }
+    }
+}
+
+/// How the EEG decoder's decision value becomes p(error).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PErrorChoice {
+    /// The paper's 1 / (1 + e^-y).
+    Sigmoid,
+    /// Platt scaling fitted on the calibration session (the default).
+    Platt,
+}
+
+/// How the decoder's decision value y becomes p(error).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum PErrorMapping {
+    /// The paper's p = 1 / (1 + e^-y) (sec. 2.2.1).
+    Sigmoid,
+    /// Platt scaling fitted on the calibration session's out-of-fold
+    /// decisions: p = 1 / (1 + e^-(a y + b)).
+    Platt(PlattScaling),
+}
+
+/// The decoder's p(error) and class for one epoch's features.
+pub(crate) fn decide(d: &EegDecoder, features: &[f64]) -> (f64, bool) {
+    let y = d.model.decision(features);
+    let p = match d.p_error {
+        PErrorMapping::Sigmoid => errp_bci::sigmoid(y),
+        PErrorMapping::Platt(s) => s.p_error(y),
+    };
+    (p, y >= 0.0)
+}
+
+/// What an EEG stream needs: the user's EEG model, the montage and the
+/// decoder's preprocessing.
+#[derive(Debug, Clone, Copy)]
+pub struct EegSource<'a> {
+    /// The synthetic user's EEG model.
+    pub generator: &'a GeneratorParams,
+    /// The montage.
+    pub montage: &'a Montage,
+    /// The preprocessing fitted at calibration.
+    pub preprocessor: &'a Preprocessor,
+}
+
+/// A continuous EEG stream through the decoder's preprocessing.
+pub(crate) struct OnlineEeg {
+    generator: EegGenerator,
+    preprocessor: Preprocessor,
+    window: EpochWindow,
+    fcz_row: usize,
+}
+
+impl OnlineEeg {
+    /// Starts a stream and lets the filters settle.
+    pub(crate) fn start(d: EegSource<'_>, seed: u64, components: Components) -> Result<Self> {
+        let fs = d.generator.sfreq_hz;
+        let mut generator =
+            EegGenerator::new(d.generator.clone(), d.montage, seed)?.with_components(components);
+        let mut preprocessor = d.preprocessor.clone();
+        preprocessor.reset();
+        preprocessor.process(&generator.generate((errp_bci::WARM_UP_SECS * fs) as usize));
+        let fcz = d.montage.index("FCz")?;
+        let fcz_row = preprocessor
+            .outputs()
+            .iter()
+            .position(|&o| o == fcz)
+            .unwrap_or(0);
+        Ok(Self {
+            generator,
+            preprocessor,
+            window: EpochWindow::paper(fs),
+            fcz_row,
+        })
+    }
+
+    /// Schedules an assessment now, streams the EEG up to the next action
+    /// (the whole inter-action interval, so filters see continuous EEG) and
+    /// returns the epoch's features and, if asked, its preprocessed FCz.
+    pub(crate) fn epoch(
+        &mut self,
+        error: bool,
+        interval_secs: f64,
+        keep_fcz: bool,
+    ) -> (Vec<f64>, Vec<f64>) {
+        let fs = self.generator.params().sfreq_hz;
+        let onset = self.generator.now_secs();
+        self.generator.schedule(Assessment {
+            onset_secs: onset,
+            kind: if error {
+                AssessmentKind::Error
+            } else {
+                AssessmentKind::Correct
+            },
+        });
+        let n = ((interval_secs * fs).round() as usize).max(self.window.span());
+        let raw = self.generator.generate(n);
+        let clean = self.preprocessor.process(&raw);
+        let features = self.window.extract(&clean, 0);
+        let fcz = if keep_fcz {
+            clean.channel(self.fcz_row)[..self.window.span()].to_vec()
+        } else {
+            Vec::new()
+        };
+        (features, fcz)
+    }
+}
+
+impl EegDecoder {
+    /// The stream this decoder reads.
+    pub fn source(&self) -> EegSource<'_> {
+        EegSource {
+            generator: &self.generator,
+            montage: &self.montage,
+            preprocessor: &self.preprocessor,
+        }
+    }
+}
+
+/// Preprocessed epochs of both classes.
+type Pools = (Vec<(Vec<f64>, Vec<f64>)>, Vec<(Vec<f64>, Vec<f64>)>);
