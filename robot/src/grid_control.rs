@@ -82,7 +82,7 @@ const THOMPSON_OBJECTION: f64 = 0.5;
 
 /// Thompson gives up its drawn goal when the goal's probability falls below
 /// this fraction of the most probable goal's. Measured in the closed loop
-/// (`tests/grid_strategies.rs`, 200 and 1000 episodes, decoder accuracy 0.8
+/// (`tests/it/grid_strategies.rs`, 200 and 1000 episodes, decoder accuracy 0.8
 /// and 0.65) against 0 (never), 1/25, 1/10, 1/4, 3/4 and 1: 1/2 and 3/4 were
 /// best and close; 1 (give up as soon as another goal leads) is worse.
 const THOMPSON_GIVE_UP_RATIO: f64 = 0.5;

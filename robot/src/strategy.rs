@@ -37,7 +37,7 @@ pub enum Strategy {
     /// the cursor dither between candidates and rarely reach one, where
     /// goal-reached can be judged.
     ///
-    /// Measured in the closed loop (`tests/grid_strategies.rs`, an oracle
+    /// Measured in the closed loop (`tests/it/grid_strategies.rs`, an oracle
     /// decoder, 200 episodes) it is still worse than greedy: at accuracy 0.8
     /// every strategy finds the goal, greedy in 37.5 actions on average,
     /// Thompson in 55.1 (84.2 redrawing every action); at 0.65 greedy finds

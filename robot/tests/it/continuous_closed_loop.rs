@@ -13,14 +13,14 @@ const DT_SECS: f64 = 0.0125;
 const STEPS_PER_WINDOW: usize = 5;
 
 /// How a run ended.
-struct Run {
-    converged: Option<usize>,
-    secs: f64,
-    pose: Pose,
+pub(crate) struct Run {
+    pub(crate) converged: Option<usize>,
+    pub(crate) secs: f64,
+    pub(crate) pose: Pose,
     /// Detected errors (each stopped a turn or a drive).
-    detections: usize,
+    pub(crate) detections: usize,
     /// Every goal the robot set off for or stopped on, in order.
-    targets: Vec<usize>,
+    pub(crate) targets: Vec<usize>,
 }
 
 /// The oracle's p(error) for the last window: 0.95 if the motion was wrong
@@ -44,7 +44,7 @@ fn oracle_p(c: &ContinuousController, pose: &Pose, heading_change_rad: f64, trut
 
 /// Runs the paper's (greedy) controller until convergence or `max_secs`;
 /// `truth = None` means a decoder that never reports an error (p = 0.05).
-fn run(start: Pose, truth: Option<usize>, max_secs: f64) -> Run {
+pub(crate) fn run(start: Pose, truth: Option<usize>, max_secs: f64) -> Run {
     run_with(ContinuousControlParams::default(), start, truth, max_secs)
 }
 
@@ -111,7 +111,7 @@ fn names(targets: &[usize]) -> Vec<String> {
     targets.iter().map(|&i| l.goal(i).name.clone()).collect()
 }
 
-fn goal_pose(name: &str, heading_rad: f64) -> (Pose, usize) {
+pub(crate) fn goal_pose(name: &str, heading_rad: f64) -> (Pose, usize) {
     let l = GoalLayout::cities();
     let i = l.index_of(name).unwrap();
     let g = l.goal(i);

@@ -4,12 +4,11 @@
 //! calibration is deterministic. Seeded; tolerances stated.
 
 use errp_bci::{
-    ContinuousCalibrationParams, ContinuousSetup, ErrorModel, GeneratorParams, SessionOptions,
-    SvmDecoder, TargetingParams, calibrate_continuous, simulate_continuous_session,
-    target_continuous_accuracy,
+    ContinuousSetup, ErrorModel, GeneratorParams, SessionOptions, SvmDecoder, TargetingParams,
+    calibrate_continuous, simulate_continuous_session, target_continuous_accuracy,
 };
 
-fn setup_at(ratio: f64) -> ContinuousSetup {
+pub(crate) fn setup_at(ratio: f64) -> ContinuousSetup {
     ContinuousSetup {
         generator: GeneratorParams {
             errp_to_noise: ratio,
@@ -19,7 +18,7 @@ fn setup_at(ratio: f64) -> ContinuousSetup {
     }
 }
 
-fn rows(x: &errp_bci::Features) -> impl Iterator<Item = Vec<f64>> + '_ {
+pub(crate) fn rows(x: &errp_bci::Features) -> impl Iterator<Item = Vec<f64>> + '_ {
     (0..x.nrows()).map(|i| x.row(i).iter().copied().collect())
 }
 
@@ -84,29 +83,7 @@ fn trained_decoder_rates_fresh_error_windows_higher() {
     );
 }
 
-#[test]
-fn calibration_is_deterministic() {
-    let setup = ContinuousSetup {
-        calibration: ContinuousCalibrationParams {
-            per_class: 40,
-            ..ContinuousCalibrationParams::default()
-        },
-        ..setup_at(1.0)
-    };
-    let a = calibrate_continuous(&SvmDecoder::default(), &setup, 5).unwrap();
-    let b = calibrate_continuous(&SvmDecoder::default(), &setup, 5).unwrap();
-    assert_eq!(a.accuracy, b.accuracy);
-    assert_eq!(a.platt, b.platt);
-    assert_eq!(a.platt, a.model.platt());
-    let fixed: Vec<f64> = (0..512).map(|k| (k as f64 * 0.37).sin()).collect();
-    assert_eq!(a.model.decision(&fixed), b.model.decision(&fixed));
-    for x in rows(&a.session.features).take(10) {
-        assert_eq!(a.model.decision(&x), b.model.decision(&x));
-    }
-    assert_eq!(a.model.n_features(), 512);
-}
-
-/// Measurements for the report: `cargo test -p errp_bci --test continuous
+/// Measurements for the report: `cargo test -p errp_bci --test it continuous
 /// -- --ignored --nocapture`.
 #[test]
 #[ignore = "prints measurements"]
