@@ -15,6 +15,27 @@ pub const SIM_TIME: &str = "sim_time";
 /// which grand averages are drawn.
 pub const LATENCY_TIMELINE: &str = "latency";
 
+/// Entity paths that the task recordings share, so that views, loggers and
+/// readers (tests/python) agree; each view keeps its own task's paths beside
+/// its blueprint.
+pub mod paths {
+    /// The decoder's output and threshold, under one time-series view.
+    pub const DECODER: &str = "/decoder";
+    /// p(error) of each decision.
+    pub const P_ERROR: &str = "decoder/p_error";
+    /// The decision threshold (0.5, or T_e).
+    pub const THRESHOLD: &str = "decoder/threshold";
+    /// A few preprocessed EEG channels, each at `eeg/NAME`.
+    pub const EEG: &str = "/eeg";
+    /// The text log of events.
+    pub const LOG: &str = "log";
+}
+
+/// The entity path of preprocessed EEG channel `name` (e.g. "FCz").
+pub fn eeg_channel(name: &str) -> String {
+    format!("eeg/{name}")
+}
+
 /// An `.rrd` file being recorded. Log to [`RrdFile::stream`]; call
 /// [`RrdFile::finish`] to flush it and move it into place.
 pub struct RrdFile {
@@ -74,13 +95,13 @@ pub(crate) fn log_decoder_series(
 ) -> std::result::Result<(), rerun::RecordingStreamError> {
     use rerun::{Color, SeriesLines};
     rec.log_static(
-        "decoder/p_error",
+        paths::P_ERROR,
         &SeriesLines::new()
             .with_names(["p(error)"])
             .with_colors([Color::from_rgb(200, 40, 40)]),
     )?;
     rec.log_static(
-        "decoder/threshold",
+        paths::THRESHOLD,
         &SeriesLines::new()
             .with_names([threshold_name])
             .with_colors([Color::from_rgb(120, 120, 120)]),

@@ -19,8 +19,7 @@ use rerun::{
 use crate::epuck::episode::{EpuckObserver, PhysicsFrame, WindowFrame};
 use crate::epuck::world::{ArenaSpec, Obstacle};
 use crate::error::{Result, SimError};
-use crate::record::SIM_TIME;
-use crate::record::{RrdFile, log_decoder_series, record_error};
+use crate::record::{RrdFile, SIM_TIME, eeg_channel, log_decoder_series, paths, record_error};
 
 /// Pause between runs on the timeline (s).
 pub const RUN_GAP_SECS: f64 = 2.0;
@@ -33,7 +32,9 @@ fn blueprint() -> Blueprint {
             Spatial2DView::new("Arena (cm): e-puck, trajectory, detected errors")
                 .with_origin("/arena")
                 .into(),
-            TextLogView::new("Events").with_origin("/log").into(),
+            TextLogView::new("Events")
+                .with_origin(format!("/{}", paths::LOG))
+                .into(),
         ])
         .into(),
         Vertical::new([
@@ -44,10 +45,10 @@ fn blueprint() -> Blueprint {
                 .with_origin("/belief/city")
                 .into(),
             TimeSeriesView::new("p(error) and T_e")
-                .with_origin("/decoder")
+                .with_origin(paths::DECODER)
                 .into(),
             TimeSeriesView::new("EEG (uV, preprocessed)")
-                .with_origin("/eeg")
+                .with_origin(paths::EEG)
                 .into(),
         ])
         .into(),
@@ -179,7 +180,7 @@ impl<'a> EpuckRecorder<'a> {
         self.steps = 0;
         self.last_secs = 0.0;
         self.rec.set_duration_secs(SIM_TIME, self.offset_secs);
-        let r = self.rec.log("log", &TextLog::new(start_goal_and_user));
+        let r = self.rec.log(paths::LOG, &TextLog::new(start_goal_and_user));
         self.keep(r);
         let r = self
             .rec
@@ -272,16 +273,14 @@ impl EpuckObserver for EpuckRecorder<'_> {
             let r = self.rec.log(path, &Scalars::single(p));
             self.keep(r);
         }
-        let r = self.rec.log("decoder/p_error", &Scalars::single(f.p_error));
+        let r = self.rec.log(paths::P_ERROR, &Scalars::single(f.p_error));
         self.keep(r);
         // What the detector compared with T_e (the smoothed p(error)).
         let r = self
             .rec
             .log("decoder/evidence", &Scalars::single(f.evidence));
         self.keep(r);
-        let r = self
-            .rec
-            .log("decoder/threshold", &Scalars::single(self.t_e));
+        let r = self.rec.log(paths::THRESHOLD, &Scalars::single(self.t_e));
         self.keep(r);
         if f.detected {
             self.detections.push(cm(f.tracked.x_m, f.tracked.y_m));
@@ -296,10 +295,11 @@ impl EpuckObserver for EpuckRecorder<'_> {
         // The EEG of the last 62.5 ms, sample by sample.
         let n = f.fcz_cz[0].len();
         let fs = n as f64 / crate::epuck::episode::WINDOW_STEP_SECS;
-        for (name, samples) in ["eeg/FCz", "eeg/Cz"].iter().zip(&f.fcz_cz) {
+        for (name, samples) in ["FCz", "Cz"].iter().zip(&f.fcz_cz) {
+            let path = eeg_channel(name);
             for (k, v) in samples.iter().enumerate() {
                 self.at(f.time_secs - (n - 1 - k) as f64 / fs);
-                let r = self.rec.log(*name, &Scalars::single(*v));
+                let r = self.rec.log(path.as_str(), &Scalars::single(*v));
                 self.keep(r);
             }
         }
@@ -308,7 +308,7 @@ impl EpuckObserver for EpuckRecorder<'_> {
     fn on_event(&mut self, time_secs: f64, text: &str, warn: bool) {
         self.at(time_secs);
         let r = self.rec.log(
-            "log",
+            paths::LOG,
             &TextLog::new(text).with_level(if warn { "WARN" } else { "INFO" }),
         );
         self.keep(r);

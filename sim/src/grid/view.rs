@@ -10,7 +10,7 @@ use rerun::{Boxes2D, Color, Image, Points2D, Scalars, SeriesLines, TextLog};
 
 use crate::error::Result;
 use crate::grid::run::GridRunReport;
-use crate::record::{RrdFile, SIM_TIME, log_decoder_series, record_error};
+use crate::record::{RrdFile, SIM_TIME, eeg_channel, log_decoder_series, paths, record_error};
 
 /// Pause between episodes on the timeline (s).
 const EPISODE_GAP_SECS: f64 = 2.0;
@@ -21,16 +21,18 @@ fn blueprint() -> Blueprint {
             Spatial2DView::new("Grid: cursor, goal, posterior")
                 .with_origin("/grid")
                 .into(),
-            TextLogView::new("Events").with_origin("/log").into(),
+            TextLogView::new("Events")
+                .with_origin(format!("/{}", paths::LOG))
+                .into(),
         ])
         .into(),
         Vertical::new([
             TimeSeriesView::new("p(error) per action")
-                .with_origin("/decoder")
+                .with_origin(paths::DECODER)
                 .into(),
             TimeSeriesView::new("Belief").with_origin("/belief").into(),
             TimeSeriesView::new("EEG at FCz (uV, preprocessed)")
-                .with_origin("/eeg")
+                .with_origin(paths::EEG)
                 .into(),
             Spatial2DView::new("Visited states (Fig. 4)")
                 .with_origin("/visits")
@@ -95,7 +97,7 @@ pub fn record_grid_run(file: RrdFile, report: &GridRunReport) -> Result<PathBuf>
     for (k, ep) in report.episodes.iter().enumerate() {
         rec.set_duration_secs(SIM_TIME, t0);
         rec.log(
-            "log",
+            paths::LOG,
             &TextLog::new(format!(
                 "episode {}: start {} goal {}",
                 k + 1,
@@ -137,9 +139,9 @@ pub fn record_grid_run(file: RrdFile, report: &GridRunReport) -> Result<PathBuf>
                     .with_colors([Color::from_rgb(30, 30, 30)]),
             )
             .map_err(&err)?;
-            rec.log("decoder/p_error", &Scalars::single(step.p_error))
+            rec.log(paths::P_ERROR, &Scalars::single(step.p_error))
                 .map_err(&err)?;
-            rec.log("decoder/threshold", &Scalars::single(0.5))
+            rec.log(paths::THRESHOLD, &Scalars::single(0.5))
                 .map_err(&err)?;
             rec.log(
                 "belief/true_goal",
@@ -160,7 +162,7 @@ pub fn record_grid_run(file: RrdFile, report: &GridRunReport) -> Result<PathBuf>
                 "WARN"
             };
             rec.log(
-                "log",
+                paths::LOG,
                 &TextLog::new(format!(
                     "{} {} -> {}: user {truth}, decoded {decoded} (p = {:.2})",
                     step.action.name(),
@@ -173,7 +175,8 @@ pub fn record_grid_run(file: RrdFile, report: &GridRunReport) -> Result<PathBuf>
             .map_err(&err)?;
             for (i, v) in step.fcz.iter().enumerate() {
                 rec.set_duration_secs(SIM_TIME, t + i as f64 / fs);
-                rec.log("eeg/FCz", &Scalars::single(*v)).map_err(&err)?;
+                rec.log(eeg_channel("FCz"), &Scalars::single(*v))
+                    .map_err(&err)?;
             }
         }
         let end = t0 + ep.total_secs;
@@ -188,7 +191,7 @@ pub fn record_grid_run(file: RrdFile, report: &GridRunReport) -> Result<PathBuf>
             None => "did not converge".to_string(),
         };
         rec.log(
-            "log",
+            paths::LOG,
             &TextLog::new(format!(
                 "episode {}: {outcome} after {} actions ({:.1} s net, {:.1} s total)",
                 k + 1,
