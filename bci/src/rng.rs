@@ -22,8 +22,12 @@ pub fn derive_seed(seed: u64, label: &str, index: u64) -> u64 {
     z ^ (z >> 31)
 }
 
-fn fnv1a(label: &str) -> u64 {
-    label.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
+/// FNV-1a, 64 bits, of `bytes`: the hash of stream labels, and a digest that
+/// is stable across platforms and releases (cache file names, the golden
+/// digests of the determinism tests: hash a value's `Debug` text, in which
+/// floats print their exact shortest round-trip form).
+pub fn fnv1a(bytes: impl AsRef<[u8]>) -> u64 {
+    bytes.as_ref().iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
         (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
     })
 }

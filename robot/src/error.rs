@@ -1,5 +1,7 @@
 //! The crate's error type.
 
+use std::fmt::Display;
+
 use thiserror::Error;
 
 /// Everything that can go wrong in `errp_robot`.
@@ -31,19 +33,11 @@ pub type Result<T, E = RobotError> = std::result::Result<T, E>;
 
 /// An [`RobotError::InvalidParameter`] unless `ok` (and, for numbers, the
 /// value is finite: NaN and infinities are never accepted).
-pub(crate) fn check(
-    ok: bool,
-    name: &'static str,
-    value: impl std::fmt::Display,
-    expected: &str,
-) -> Result<()> {
-    if ok {
-        Ok(())
-    } else {
-        Err(RobotError::InvalidParameter {
+pub(crate) fn check(ok: bool, name: &'static str, v: impl Display, expected: &str) -> Result<()> {
+    ok.then_some(())
+        .ok_or_else(|| RobotError::InvalidParameter {
             name,
-            value: value.to_string(),
+            value: v.to_string(),
             expected: expected.to_string(),
         })
-    }
 }

@@ -36,6 +36,20 @@ pub fn eeg_channel(name: &str) -> String {
     format!("eeg/{name}")
 }
 
+/// The layout of a task recording: the scene above the event log on the
+/// left, `panels` stacked on the right.
+pub(crate) fn task_blueprint(
+    scene: rerun::blueprint::Spatial2DView,
+    panels: Vec<rerun::blueprint::ContainerLike>,
+) -> Blueprint {
+    use rerun::blueprint::{Horizontal, TextLogView, Vertical};
+    let events = TextLogView::new("Events").with_origin(format!("/{}", paths::LOG));
+    Blueprint::new(Horizontal::new([
+        Vertical::new([scene.into(), events.into()]).into(),
+        Vertical::new(panels).into(),
+    ]))
+}
+
 /// An `.rrd` file being recorded. Log to [`RrdFile::stream`]; call
 /// [`RrdFile::finish`] to flush it and move it into place.
 pub struct RrdFile {

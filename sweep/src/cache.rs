@@ -27,13 +27,6 @@ struct Entry {
     result: TargetingResult,
 }
 
-/// 64-bit FNV-1a of `text`.
-fn fnv1a(text: &str) -> u64 {
-    text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
-    })
-}
-
 impl TargetCache {
     /// A cache in `dir` (created when first written).
     pub fn new(dir: impl Into<PathBuf>) -> Self {
@@ -93,7 +86,10 @@ impl TargetingCache for TargetCache {
             return Ok((search()?, false));
         };
         let request = format!("{kind} v1 {request}");
-        let path = dir.join(format!("{kind}-{:016x}.json", fnv1a(&request)));
+        let path = dir.join(format!(
+            "{kind}-{:016x}.json",
+            errp_bci::rng::fnv1a(&request)
+        ));
         if let Ok(text) = std::fs::read_to_string(&path)
             && let Ok(entry) = serde_json::from_str::<Entry>(&text)
             && entry.request == request

@@ -106,7 +106,7 @@ fn run_with(
     }
 }
 
-fn names(targets: &[usize]) -> Vec<String> {
+pub(crate) fn names(targets: &[usize]) -> Vec<String> {
     let l = GoalLayout::cities();
     targets.iter().map(|&i| l.goal(i).name.clone()).collect()
 }

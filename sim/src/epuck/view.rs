@@ -8,9 +8,7 @@
 use std::path::Path;
 
 use errp_robot::GoalLayout;
-use rerun::blueprint::{
-    BarChartView, Blueprint, Horizontal, Spatial2DView, TextLogView, TimeSeriesView, Vertical,
-};
+use rerun::blueprint::{BarChartView, Blueprint, Spatial2DView, TimeSeriesView};
 use rerun::{
     Arrows2D, BarChart, Color, LineStrips2D, Points2D, RecordingStream, Scalars, SeriesLines,
     TextLog,
@@ -19,7 +17,9 @@ use rerun::{
 use crate::epuck::episode::{EpuckObserver, PhysicsFrame, WindowFrame};
 use crate::epuck::world::{ArenaSpec, Obstacle};
 use crate::error::{Result, SimError};
-use crate::record::{RrdFile, SIM_TIME, eeg_channel, log_decoder_series, paths, record_error};
+use crate::record::{
+    RrdFile, SIM_TIME, eeg_channel, log_decoder_series, paths, record_error, task_blueprint,
+};
 
 /// Pause between runs on the timeline (s).
 pub const RUN_GAP_SECS: f64 = 2.0;
@@ -27,17 +27,9 @@ pub const RUN_GAP_SECS: f64 = 2.0;
 const TRAJECTORY_EVERY: usize = 8;
 
 fn blueprint() -> Blueprint {
-    Blueprint::new(Horizontal::new([
-        Vertical::new([
-            Spatial2DView::new("Arena (cm): e-puck, trajectory, detected errors")
-                .with_origin("/arena")
-                .into(),
-            TextLogView::new("Events")
-                .with_origin(format!("/{}", paths::LOG))
-                .into(),
-        ])
-        .into(),
-        Vertical::new([
+    task_blueprint(
+        Spatial2DView::new("Arena (cm): e-puck, trajectory, detected errors").with_origin("/arena"),
+        vec![
             BarChartView::new("Belief over the 25 cities")
                 .with_origin("/belief/bars")
                 .into(),
@@ -50,9 +42,8 @@ fn blueprint() -> Blueprint {
             TimeSeriesView::new("EEG (uV, preprocessed)")
                 .with_origin(paths::EEG)
                 .into(),
-        ])
-        .into(),
-    ]))
+        ],
+    )
 }
 
 /// Opens the `.rrd` of an e-puck run, with its layout, before the run.

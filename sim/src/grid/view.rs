@@ -3,30 +3,22 @@
 use std::path::{Path, PathBuf};
 
 use errp_robot::{Cell, Grid};
-use rerun::blueprint::{
-    Blueprint, Horizontal, Spatial2DView, TextLogView, TimeSeriesView, Vertical,
-};
+use rerun::blueprint::{Blueprint, Spatial2DView, TimeSeriesView};
 use rerun::{Boxes2D, Color, Image, Points2D, Scalars, SeriesLines, TextLog};
 
 use crate::error::Result;
 use crate::grid::run::GridRunReport;
-use crate::record::{RrdFile, SIM_TIME, eeg_channel, log_decoder_series, paths, record_error};
+use crate::record::{
+    RrdFile, SIM_TIME, eeg_channel, log_decoder_series, paths, record_error, task_blueprint,
+};
 
 /// Pause between episodes on the timeline (s).
 const EPISODE_GAP_SECS: f64 = 2.0;
 
 fn blueprint() -> Blueprint {
-    Blueprint::new(Horizontal::new([
-        Vertical::new([
-            Spatial2DView::new("Grid: cursor, goal, posterior")
-                .with_origin("/grid")
-                .into(),
-            TextLogView::new("Events")
-                .with_origin(format!("/{}", paths::LOG))
-                .into(),
-        ])
-        .into(),
-        Vertical::new([
+    task_blueprint(
+        Spatial2DView::new("Grid: cursor, goal, posterior").with_origin("/grid"),
+        vec![
             TimeSeriesView::new("p(error) per action")
                 .with_origin(paths::DECODER)
                 .into(),
@@ -37,9 +29,8 @@ fn blueprint() -> Blueprint {
             Spatial2DView::new("Visited states (Fig. 4)")
                 .with_origin("/visits")
                 .into(),
-        ])
-        .into(),
-    ]))
+        ],
+    )
 }
 
 /// Opens the `.rrd` of a grid run, with its layout, before the run.

@@ -5,73 +5,39 @@
 //! digest only for a change meant to alter the numbers, and say so in the
 //! commit.
 
+use errp_bci::rng::fnv1a;
 use errp_robot::Cell;
 use errp_sim::epuck::{prepare_continuous_decoder, run_epuck_batch, run_epuck_once};
-use errp_sim::grid::{AssessmentDecoder, GridTaskParams, run_grid_episode};
+use errp_sim::grid::{AssessmentDecoder, GridEpisodeResult, GridTaskParams, run_grid_episode};
 
 use crate::{epuck, grid};
 
-/// FNV-1a over the `Debug` text of `value` (exact: floats print their
-/// shortest round-trip form).
+/// The digest of `value`'s exact `Debug` text (floats print their shortest
+/// round-trip form).
 fn digest(value: &impl std::fmt::Debug) -> u64 {
-    format!("{value:?}")
-        .bytes()
-        .fold(0xcbf2_9ce4_8422_2325, |h, b| {
-            (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
-        })
+    fnv1a(format!("{value:?}"))
 }
 
-#[track_caller]
-fn assert_digest(what: &str, got: u64, golden: u64) {
-    assert_eq!(
-        got, golden,
-        "{what}: digest {got:#018x}, golden {golden:#018x}"
-    );
-}
-
-/// A grid episode with the EEG decoder calibrated at 80 % (seed 3), every
+/// The episode from (0, 0) to (3, 4) with `decoder` and `seed`, every
 /// action recorded.
-#[test]
-fn a_grid_episode_is_the_golden_one() {
+fn episode(decoder: &AssessmentDecoder, seed: u64) -> GridEpisodeResult {
     let params = GridTaskParams::default();
     let t = grid::table(&params);
-    let decoder = grid::eeg_decoder(0.8, 3);
-    let r = run_grid_episode(
-        Cell::new(0, 0),
-        Cell::new(3, 4),
-        &t,
-        &params,
-        &decoder,
-        3,
-        true,
-    )
-    .unwrap();
-    assert_digest(
-        "grid episode, EEG at 80 %, seed 3",
-        digest(&r),
-        0xa224_67d1_8840_7c5d,
-    );
+    let (start, goal) = (Cell::new(0, 0), Cell::new(3, 4));
+    run_grid_episode(start, goal, &t, &params, decoder, seed, true).unwrap()
 }
 
 #[test]
 fn same_seed_same_episode() {
-    let params = GridTaskParams::default();
-    let t = grid::table(&params);
-    let decoder = AssessmentDecoder::Oracle { accuracy: 0.75 };
-    let run = |seed| {
-        run_grid_episode(
-            Cell::new(0, 0),
-            Cell::new(3, 4),
-            &t,
-            &params,
-            &decoder,
-            seed,
-            true,
-        )
-        .unwrap()
-    };
-    assert_eq!(run(5), run(5));
-    assert_ne!(run(5), run(6));
+    let oracle = AssessmentDecoder::Oracle { accuracy: 0.75 };
+    assert_eq!(episode(&oracle, 5), episode(&oracle, 5));
+    assert_ne!(episode(&oracle, 5), episode(&oracle, 6));
+    // With the EEG decoder calibrated at 80 % (seed 3): the golden episode.
+    let got = digest(&episode(&grid::eeg_decoder(0.8, 3), 3));
+    assert_eq!(
+        got, 0xa224_67d1_8840_7c5d,
+        "grid episode, EEG at 80 %: digest {got:#x}"
+    );
 }
 
 #[test]
@@ -111,5 +77,9 @@ fn the_same_seed_gives_the_same_run() {
     // The batch (parallel) gives the runs in order, identical to one by one.
     let batch = run_epuck_batch(&s, &decoder, 5).unwrap();
     assert_eq!(batch[3], a);
-    assert_digest("Lisbon to Tokyo, run 3", digest(&a), 0xd84c_c185_866c_8066);
+    let got = digest(&a);
+    assert_eq!(
+        got, 0xd84c_c185_866c_8066,
+        "Lisbon to Tokyo, run 3: digest {got:#x}"
+    );
 }
