@@ -114,16 +114,21 @@ fn measure(strategy: Strategy, accuracy: f64, n: u64) -> Summary {
 /// the belief is spread its draws send the cursor to goals that greedy,
 /// heading for the leader, would not visit. The bounds leave about 20 %
 /// margin (Thompson's excludes the per-action redraw).
+/// `n` episodes of each strategy (greedy, info gain, Thompson) at
+/// `accuracy`, printed.
+fn measure_all(accuracy: f64, n: u64) -> [Summary; 3] {
+    let all = Strategy::ALL.map(|s| measure(s, accuracy, n));
+    eprintln!(
+        "{n} episodes at accuracy {accuracy}:\n  greedy    {:?}\n  info_gain {:?}\n  \
+         thompson  {:?}",
+        all[0], all[1], all[2]
+    );
+    all
+}
+
 #[test]
 fn every_strategy_finds_the_goal_with_an_80_percent_decoder() {
-    let (n, accuracy) = (200, 0.8);
-    let greedy = measure(Strategy::Greedy, accuracy, n);
-    let info = measure(Strategy::InfoGain, accuracy, n);
-    let thompson = measure(Strategy::Thompson, accuracy, n);
-    eprintln!(
-        "{n} episodes at accuracy {accuracy}:\n  greedy    {greedy:?}\n  info_gain {info:?}\n  \
-         thompson  {thompson:?}"
-    );
+    let [greedy, info, thompson] = measure_all(0.8, 200);
     for s in [&greedy, &info, &thompson] {
         assert!(s.success_rate >= 0.85, "{s:?}");
     }
@@ -152,14 +157,7 @@ fn every_strategy_finds_the_goal_with_an_80_percent_decoder() {
 /// the per-action redraw).
 #[test]
 fn every_strategy_mostly_finds_the_goal_with_a_65_percent_decoder() {
-    let (n, accuracy) = (200, 0.65);
-    let greedy = measure(Strategy::Greedy, accuracy, n);
-    let info = measure(Strategy::InfoGain, accuracy, n);
-    let thompson = measure(Strategy::Thompson, accuracy, n);
-    eprintln!(
-        "{n} episodes at accuracy {accuracy}:\n  greedy    {greedy:?}\n  info_gain {info:?}\n  \
-         thompson  {thompson:?}"
-    );
+    let [greedy, info, thompson] = measure_all(0.65, 200);
     assert!(greedy.success_rate >= 0.8, "{greedy:?}");
     assert!(info.success_rate >= 0.75, "{info:?}");
     assert!(thompson.success_rate >= 0.7, "{thompson:?}");
