@@ -22,6 +22,7 @@ pub mod grid;
 mod output;
 mod paper;
 pub mod record;
+mod scenario;
 mod scenario_file;
 #[cfg(test)]
 mod snapshot;
@@ -30,10 +31,8 @@ mod stats;
 pub use error::{Result, SimError};
 pub use output::{PendingFile, write_atomic};
 pub use paper::{PAPER, PAPER_EPUCK, PAPER_POOLED};
-pub use scenario_file::{
-    AnyScenario, is_epuck, load_scenario, load_scenario_with, parse_scenario, parse_toml,
-    read_scenario, set_key,
-};
+pub use scenario::{AnyScenario, is_epuck, load_scenario, load_scenario_with, parse_scenario};
+pub use scenario_file::{parse_toml, read_scenario, set_key};
 pub use stats::{
     StreamingPearson, correlation_p_value, incomplete_beta, mean_sd, median, pearson,
     wilson_interval,

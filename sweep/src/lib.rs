@@ -16,8 +16,10 @@
 
 mod cache;
 mod figure;
+mod finish;
 mod manifest;
 mod merge;
+mod observer;
 mod plot;
 mod prepare;
 mod rows;
@@ -29,14 +31,16 @@ mod writer;
 
 pub use cache::TargetCache;
 pub use figure::sweep_plot;
+pub use finish::finish_dir;
 pub use manifest::{DecoderInfo, EPISODES, MANIFEST, Manifest};
 pub use merge::merge_sweeps;
+pub use observer::SweepObserver;
 pub use plot::{LevelPoint, PaperPoint, PlotError, Series, SweepPlot};
 pub use rows::{cost_column, episodes_header};
-pub use run::{SweepObserver, SweepOptions, SweepOutcome, run_sweep};
+pub use run::{SweepOptions, SweepOutcome, run_sweep};
 pub use spec::{
     Axis, Level, Shard, SweepSpec, SweepTask, aliases, parse_accuracies, parse_axis, parse_values,
     read_task, sweepable,
 };
-pub use summary::{LevelSummary, SweepReport, finish_dir, summarise_dir};
+pub use summary::{LevelSummary, SweepReport, summarise_dir};
 pub use table::summary_csv;

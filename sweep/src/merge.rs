@@ -8,9 +8,10 @@ use std::path::{Path, PathBuf};
 use errp_sim::PendingFile;
 use errp_sim::{Result, SimError};
 
+use crate::finish::finish_dir;
 use crate::manifest::{EPISODES, MANIFEST, Manifest};
 use crate::rows::episodes_header;
-use crate::summary::{SweepReport, finish_dir};
+use crate::summary::SweepReport;
 
 /// Merges the shard directories `dirs` (every shard of one sweep, in any
 /// order) into `out`: `episodes.csv` in sweep order, then the summary, plots

@@ -11,7 +11,7 @@ use errp_sim::{AnyScenario, Result};
 
 use crate::cache::TargetCache;
 use crate::manifest::DecoderInfo;
-use crate::run::SweepObserver;
+use crate::observer::SweepObserver;
 use crate::spec::Level;
 
 /// One level, ready to run episodes.

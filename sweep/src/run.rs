@@ -14,22 +14,12 @@ use errp_sim::grid::GridShared;
 use errp_sim::{AnyScenario, Result, SimError};
 
 use crate::cache::TargetCache;
-use crate::manifest::{DecoderInfo, EPISODES, MANIFEST, Manifest};
+use crate::manifest::{EPISODES, MANIFEST, Manifest};
+use crate::observer::SweepObserver;
 use crate::prepare::{Prepared, Runner, decoder_key, prepare_all};
 use crate::rows::episodes_header;
 use crate::spec::{Shard, SweepSpec, SweepTask};
 use crate::writer::{EpisodeJob, resume_rows};
-
-/// What a sweep reports as it goes. Every method defaults to nothing;
-/// `()` watches nothing.
-pub trait SweepObserver: Sync {
-    /// A decoder is calibrated (`done` of `total`).
-    fn decoder_ready(&self, _info: &DecoderInfo, _done: usize, _total: usize) {}
-    /// `done` of this run's `total` episodes are on disk.
-    fn episodes_done(&self, _done: usize, _total: usize) {}
-}
-
-impl SweepObserver for () {}
 
 /// How a sweep runs (none of it changes the results).
 #[derive(Debug, Clone)]

@@ -8,9 +8,9 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use errp_sim::{Result, SimError};
 
+use crate::observer::SweepObserver;
 use crate::prepare::Runner;
 use crate::rows::run_row;
-use crate::run::SweepObserver;
 use crate::spec::{Level, SweepSpec};
 
 /// The episodes of a slice, run on every thread of the current pool and

@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::calibration::CalibrationReport;
 use crate::error::{Result, SimError};
-use crate::grid::episode::GridTaskParams;
+use crate::grid::params::GridTaskParams;
 
 /// What turns the user's assessment into p(error).
 #[derive(Debug, Clone)]

@@ -3,6 +3,7 @@
 
 pub(crate) mod decoder;
 pub(crate) mod episode;
+pub(crate) mod params;
 pub(crate) mod report;
 pub(crate) mod run;
 pub(crate) mod scenario;
@@ -13,7 +14,8 @@ pub use decoder::{
     AssessmentDecoder, EegDecoder, EegSource, EpochBank, EpochBankParts, PErrorChoice,
     PErrorMapping,
 };
-pub use episode::{GridEpisodeResult, GridStep, GridTaskParams, run_grid_episode};
+pub use episode::{GridEpisodeResult, GridStep, run_grid_episode};
+pub use params::GridTaskParams;
 pub use report::{GridEpisodeHeader, GridEpisodeRow, Table1Report};
 pub use run::{
     GridRunReport, GridShared, PreparedGrid, decoder_from_calibration, pooled_accuracy,

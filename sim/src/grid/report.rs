@@ -223,7 +223,7 @@ accuracy = 0.8
             seed: 1,
             decoder: DecoderChoice::Oracle,
             eeg: EegMode::Bank,
-            params: crate::grid::episode::GridTaskParams::default(),
+            params: crate::grid::params::GridTaskParams::default(),
         };
         let cells = run_table1(&options, |_, _| {}).unwrap();
         assert_snapshot("table1_oracle", &Table1Report(&cells).to_string());

@@ -14,7 +14,7 @@ use serde::Deserialize;
 
 use crate::error::Result;
 use crate::grid::decoder::PErrorChoice;
-use crate::grid::episode::GridTaskParams;
+use crate::grid::params::GridTaskParams;
 use crate::scenario_file::{field_error, parse_toml, read_scenario, robot_error, scenario_name};
 
 /// Which decoder turns the user's assessments into p(error).

@@ -7,7 +7,8 @@ use rayon::prelude::*;
 
 use crate::error::Result;
 use crate::grid::decoder::PErrorChoice;
-use crate::grid::episode::{GridEpisodeResult, GridTaskParams, run_grid_episode};
+use crate::grid::episode::{GridEpisodeResult, run_grid_episode};
+use crate::grid::params::GridTaskParams;
 use crate::grid::run::prepare_decoder;
 use crate::grid::scenario::{DecoderChoice, EegMode, GridScenario, free_pairs};
 use crate::stats::mean_sd;

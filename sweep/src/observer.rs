@@ -1,0 +1,14 @@
+//! What a sweep reports as it goes: decoders calibrated, episodes done.
+
+use crate::manifest::DecoderInfo;
+
+/// What a sweep reports as it goes. Every method defaults to nothing;
+/// `()` watches nothing.
+pub trait SweepObserver: Sync {
+    /// A decoder is calibrated (`done` of `total`).
+    fn decoder_ready(&self, _info: &DecoderInfo, _done: usize, _total: usize) {}
+    /// `done` of this run's `total` episodes are on disk.
+    fn episodes_done(&self, _done: usize, _total: usize) {}
+}
+
+impl SweepObserver for () {}
