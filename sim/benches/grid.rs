@@ -4,6 +4,7 @@
 use std::sync::LazyLock;
 
 use divan::{Bencher, black_box};
+use errp_bci::SessionOptions;
 use errp_robot::{Grid, QTable};
 use errp_sim::calibration::{CalibrationRequest, run_calibration};
 use errp_sim::grid::{
@@ -16,7 +17,12 @@ fn main() {
 }
 
 static EEG: LazyLock<AssessmentDecoder> = LazyLock::new(|| {
-    let report = run_calibration(&CalibrationRequest::new(0.7438, 1), |_| {}, None).unwrap();
+    let report = run_calibration(
+        &CalibrationRequest::new(0.7438, 1),
+        |_| {},
+        SessionOptions::default(),
+    )
+    .unwrap();
     AssessmentDecoder::Eeg(Box::new(EegDecoder::from_report(
         &report,
         PErrorChoice::Platt,

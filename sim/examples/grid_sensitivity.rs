@@ -9,6 +9,7 @@
 //!
 //! `cargo run -p errp_sim --example grid_sensitivity` (a few minutes).
 
+use errp_bci::SessionOptions;
 use errp_robot::{Grid, QParams, QTable};
 use errp_sim::calibration::{CalibrationRequest, run_calibration};
 use errp_sim::grid::{
@@ -86,8 +87,12 @@ fn main() {
     println!("| accuracy | variant | goals reached | actions |");
     println!("|---|---|---|---|");
     for accuracy in [0.7438, 0.90] {
-        let report = run_calibration(&CalibrationRequest::new(accuracy, 3), |_| {}, None)
-            .expect("calibration");
+        let report = run_calibration(
+            &CalibrationRequest::new(accuracy, 3),
+            |_| {},
+            SessionOptions::default(),
+        )
+        .expect("calibration");
         let eeg =
             |choice| AssessmentDecoder::Eeg(Box::new(EegDecoder::from_report(&report, choice)));
         for v in &variants {

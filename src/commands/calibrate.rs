@@ -1,7 +1,7 @@
 //! `errp calibrate` and `errp subjects`.
 
 use anyhow::{Context, Result};
-use errp_bci::{EdfWriter, GoalSet, subject, subjects};
+use errp_bci::{EdfWriter, GoalSet, SessionOptions, subject, subjects};
 use errp_sim::PendingFile;
 use errp_sim::calibration::{
     CalibrationRequest, calibration_recording, record_calibration, run_calibration,
@@ -46,8 +46,7 @@ pub(crate) fn calibrate(args: &CalibrateArgs) -> Result<()> {
         None => None,
     };
 
-    let mut request = CalibrationRequest::new(accuracy, args.seed);
-    request.grand_average = args.save.is_some();
+    let request = CalibrationRequest::new(accuracy, args.seed);
     if !args.quiet {
         eprintln!(
             "Targeting a mean accuracy of {:.2} % ({who}), seed {}:",
@@ -72,16 +71,17 @@ pub(crate) fn calibrate(args: &CalibrateArgs) -> Result<()> {
         Some((_, w)) => w.write(block, events),
         None => Ok(()),
     };
-    let report = run_calibration(
-        &request,
-        progress,
-        if args.export.is_some() {
+    // Grand averages for the recording, the raw session for the export.
+    let options = SessionOptions {
+        grand_average: args.save.is_some(),
+        raw_sink: if args.export.is_some() {
             Some(&mut sink)
         } else {
             None
         },
-    )
-    .context("calibration failed")?;
+        ..SessionOptions::default()
+    };
+    let report = run_calibration(&request, progress, options).context("calibration failed")?;
 
     let a = &report.calibrated.accuracy;
     let m = &report.calibrated.model;

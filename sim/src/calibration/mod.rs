@@ -6,65 +6,81 @@ mod view;
 pub use view::{calibration_recording, record_calibration};
 
 use errp_bci::{
-    Calibrated, CalibrationSetup, GeneratorParams, LdaDecoder, LdaModel, RawSink, SessionOptions,
+    Calibrated, CalibrationParams, GeneratorParams, LdaDecoder, LdaModel, Protocol, SessionOptions,
     Setup, TargetingParams, TargetingResult, TargetingStep, calibrate, target_accuracy,
 };
 
 use crate::error::Result;
 
-/// What to calibrate.
+/// What to calibrate: a synthetic user recorded with protocol `P` (the
+/// discrete session or the button-locked one), targeted at a mean accuracy.
 #[derive(Debug, Clone)]
-pub struct CalibrationRequest {
+pub struct Request<P> {
     /// Requested mean accuracy, in (0.5, 1).
     pub accuracy: f64,
     /// Seed of the synthetic user and session.
     pub seed: u64,
     /// EEG model, protocol, preprocessing, montage.
-    pub setup: CalibrationSetup,
+    pub setup: Setup<P>,
     /// Search settings.
     pub search: TargetingParams,
-    /// Compute grand averages of every EEG channel (for recording).
-    pub grand_average: bool,
 }
 
-impl CalibrationRequest {
-    /// This request's key in a [`TargetingCache`].
-    pub fn targeting_key(&self) -> String {
-        request_key(&self.setup, &self.search, self.accuracy, self.seed)
-    }
-
+impl<P: Protocol> Request<P> {
     /// A request with the paper's protocol and the default EEG model.
     pub fn new(accuracy: f64, seed: u64) -> Self {
         Self {
             accuracy,
             seed,
-            setup: CalibrationSetup::default(),
+            setup: Setup::default(),
             search: TargetingParams::default(),
-            grand_average: false,
+        }
+    }
+
+    /// This request's key in a [`TargetingCache`].
+    pub fn targeting_key(&self) -> String {
+        request_key(&self.setup, &self.search, self.accuracy, self.seed)
+    }
+
+    /// The setup with the EEG model at the ErrP-to-noise ratio `ratio`.
+    pub fn setup_at(&self, ratio: f64) -> Setup<P> {
+        Setup {
+            generator: GeneratorParams {
+                errp_to_noise: ratio,
+                ..self.setup.generator.clone()
+            },
+            ..self.setup.clone()
         }
     }
 }
 
-/// The outcome of [`run_calibration`].
+/// The outcome of a calibration whose decoder is a model `M`.
 #[derive(Debug, Clone)]
-pub struct CalibrationReport {
+pub struct Report<M> {
     /// The search for the ErrP-to-noise ratio.
     pub targeting: TargetingResult,
     /// The EEG model at the ratio found.
     pub generator: GeneratorParams,
     /// The calibration session at that ratio, its cross-validated accuracy
     /// and the decoder trained on all of it.
-    pub calibrated: Calibrated<LdaModel>,
+    pub calibrated: Calibrated<M>,
 }
+
+/// The discrete calibration of the grid task and `errp calibrate`.
+pub type CalibrationRequest = Request<CalibrationParams>;
+
+/// Its outcome: the LDA decoder.
+pub type CalibrationReport = Report<LdaModel>;
 
 /// Targets the requested accuracy, then simulates the calibration session at
 /// the ratio found from scratch (raw EEG through the whole pipeline), scores
 /// it by k-fold cross-validation and trains the decoder on every trial.
-/// `progress` sees each targeting step; `raw_sink` sees the raw session.
+/// `progress` sees each targeting step; `options` asks for grand averages
+/// and a sink for the raw session (`errp calibrate --save`, `--export`).
 pub fn run_calibration(
     request: &CalibrationRequest,
     progress: impl FnMut(&TargetingStep),
-    raw_sink: Option<RawSink<'_>>,
+    options: SessionOptions<'_>,
 ) -> Result<CalibrationReport> {
     let decoder = LdaDecoder::default();
     let targeting = target_accuracy(
@@ -75,39 +91,22 @@ pub fn run_calibration(
         request.seed,
         progress,
     )?;
-    calibrate_at(request, targeting, raw_sink)
+    calibrate_at(request, targeting, options)
 }
 
 /// The second half of [`run_calibration`], for a ratio already found (by
-/// an earlier search with the same request, e.g. from a sweep's cache):
-/// simulates the session at `targeting.ratio`, scores it and trains on it.
+/// an earlier search with the same request): simulates the session at
+/// `targeting.ratio`, scores it and trains on it.
 pub fn calibrate_at(
     request: &CalibrationRequest,
     targeting: TargetingResult,
-    raw_sink: Option<RawSink<'_>>,
+    options: SessionOptions<'_>,
 ) -> Result<CalibrationReport> {
-    let decoder = LdaDecoder::default();
-    let generator = GeneratorParams {
-        errp_to_noise: targeting.ratio,
-        ..request.setup.generator.clone()
-    };
-    let setup = CalibrationSetup {
-        generator: generator.clone(),
-        ..request.setup.clone()
-    };
-    let calibrated = calibrate(
-        &decoder,
-        &setup,
-        request.seed,
-        SessionOptions {
-            grand_average: request.grand_average,
-            raw_sink,
-            ..SessionOptions::default()
-        },
-    )?;
+    let setup = request.setup_at(targeting.ratio);
+    let calibrated = calibrate(&LdaDecoder::default(), &setup, request.seed, options)?;
     Ok(CalibrationReport {
         targeting,
-        generator,
+        generator: setup.generator,
         calibrated,
     })
 }

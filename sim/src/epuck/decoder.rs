@@ -3,57 +3,22 @@
 //! that slides every 62.5 ms over streamed EEG.
 
 use errp_bci::{
-    Accuracy, Calibrated, ContinuousFeatures, ContinuousSetup, Detector, DetectorMode,
+    Accuracy, ContinuousCalibrationParams, ContinuousFeatures, Detector, DetectorMode,
     DetectorParams, EegGenerator, GeneratorParams, Montage, OnlineRecording, OnlineRecordingParams,
     OnlineStep, OnlineTarget, OnlineTargeting, OperatingPoint, Preprocessor, ResponseSpan,
-    SPAN_FRACTION, SlidingWindow, SvmDecoder, SvmModel, TargetingParams, TargetingResult,
-    TargetingStep, calibrate_continuous, operating_point, record_online, response_span,
-    rng::derive_seed, target_continuous_accuracy, target_online,
+    SPAN_FRACTION, SlidingWindow, SvmDecoder, SvmModel, TargetingResult, TargetingStep,
+    calibrate_continuous, operating_point, record_online, response_span, rng::derive_seed,
+    target_continuous_accuracy, target_online,
 };
 
+use crate::calibration::{Report, Request};
 use crate::error::Result;
 
-/// What to calibrate.
-#[derive(Debug, Clone)]
-pub struct ContinuousRequest {
-    /// Requested mean accuracy (cross-validated, per-class rates), in (0.5, 1).
-    pub accuracy: f64,
-    /// Seed of the synthetic user and session.
-    pub seed: u64,
-    /// EEG model, protocol, preprocessing, montage.
-    pub setup: ContinuousSetup,
-    /// Search settings.
-    pub search: TargetingParams,
-}
+/// The button-locked calibration of the e-puck task.
+pub type ContinuousRequest = Request<ContinuousCalibrationParams>;
 
-impl ContinuousRequest {
-    /// This request's key in a [`TargetingCache`](crate::calibration::TargetingCache).
-    pub fn targeting_key(&self) -> String {
-        crate::calibration::request_key(&self.setup, &self.search, self.accuracy, self.seed)
-    }
-
-    /// A request with the paper's protocol and the default EEG model.
-    pub fn new(accuracy: f64, seed: u64) -> Self {
-        Self {
-            accuracy,
-            seed,
-            setup: ContinuousSetup::default(),
-            search: TargetingParams::default(),
-        }
-    }
-}
-
-/// The outcome of [`run_continuous_calibration`].
-#[derive(Debug, Clone)]
-pub struct ContinuousReport {
-    /// The search for the ErrP-to-noise ratio.
-    pub targeting: TargetingResult,
-    /// The EEG model at the ratio found.
-    pub generator: GeneratorParams,
-    /// The session at that ratio, its cross-validated accuracy and the SVM
-    /// trained on all of it.
-    pub calibrated: Calibrated<SvmModel>,
-}
+/// Its outcome: the SVM decoder.
+pub type ContinuousReport = Report<SvmModel>;
 
 /// Targets the requested accuracy with the SVM decoder, then re-runs the
 /// calibration session at the ratio found, scores it and trains on it.
@@ -80,19 +45,11 @@ pub fn calibrate_continuous_at(
     request: &ContinuousRequest,
     targeting: TargetingResult,
 ) -> Result<ContinuousReport> {
-    let svm = SvmDecoder::default();
-    let generator = GeneratorParams {
-        errp_to_noise: targeting.ratio,
-        ..request.setup.generator.clone()
-    };
-    let setup = ContinuousSetup {
-        generator: generator.clone(),
-        ..request.setup.clone()
-    };
-    let calibrated = calibrate_continuous(&svm, &setup, request.seed)?;
+    let setup = request.setup_at(targeting.ratio);
+    let calibrated = calibrate_continuous(&SvmDecoder::default(), &setup, request.seed)?;
     Ok(ContinuousReport {
         targeting,
-        generator,
+        generator: setup.generator,
         calibrated,
     })
 }

@@ -5,8 +5,8 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 use errp_bci::{
-    Accuracy, GeneratorParams, LdaDecoder, SessionParts, TargetingStep, calibrate_session,
-    rng::derive_seed, target_accuracy_on,
+    Accuracy, LdaDecoder, SessionParts, TargetingStep, calibrate_session, rng::derive_seed,
+    target_accuracy_on,
 };
 use errp_robot::{Grid, QTable};
 
@@ -177,10 +177,7 @@ pub fn prepare_grid_decoder(
         request.seed,
     )?;
     let report = CalibrationReport {
-        generator: GeneratorParams {
-            errp_to_noise: targeting.ratio,
-            ..request.setup.generator.clone()
-        },
+        generator: request.setup_at(targeting.ratio).generator,
         targeting,
         calibrated,
     };

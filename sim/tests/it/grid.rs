@@ -2,6 +2,7 @@
 //! determinism checks with fixed seeds.
 
 use errp_bci::Accuracy;
+use errp_bci::SessionOptions;
 use errp_robot::{Grid, QTable};
 use errp_sim::calibration::{CalibrationRequest, run_calibration};
 use errp_sim::grid::{
@@ -9,7 +10,12 @@ use errp_sim::grid::{
 };
 
 pub(crate) fn eeg_decoder(accuracy: f64, seed: u64) -> AssessmentDecoder {
-    let report = run_calibration(&CalibrationRequest::new(accuracy, seed), |_| {}, None).unwrap();
+    let report = run_calibration(
+        &CalibrationRequest::new(accuracy, seed),
+        |_| {},
+        SessionOptions::default(),
+    )
+    .unwrap();
     AssessmentDecoder::Eeg(Box::new(EegDecoder::from_report(
         &report,
         PErrorChoice::Platt,
@@ -67,7 +73,12 @@ fn online_accuracy_matches_the_calibrated_accuracy() {
 
 #[test]
 fn banked_epochs_give_the_streamed_accuracy_and_reach_the_goals() {
-    let report = run_calibration(&CalibrationRequest::new(0.90, 7), |_| {}, None).unwrap();
+    let report = run_calibration(
+        &CalibrationRequest::new(0.90, 7),
+        |_| {},
+        SessionOptions::default(),
+    )
+    .unwrap();
     let eeg = EegDecoder::from_report(&report, PErrorChoice::Platt);
     let bank = errp_sim::grid::EpochBank::build(eeg, &GridTaskParams::default(), 400, 7).unwrap();
     assert_eq!(bank.len(), 400);
@@ -112,7 +123,12 @@ fn a_decoder_without_errps_converges_to_the_right_goal_only_by_chance() {
 #[test]
 fn an_epoch_bank_from_parts_equals_the_bank_streamed_at_its_ratio() {
     // Sweeps stream a bank's noise and ERP parts once and mix them per level.
-    let report = run_calibration(&CalibrationRequest::new(0.75, 2), |_| {}, None).unwrap();
+    let report = run_calibration(
+        &CalibrationRequest::new(0.75, 2),
+        |_| {},
+        SessionOptions::default(),
+    )
+    .unwrap();
     let eeg = EegDecoder::from_report(&report, PErrorChoice::Platt);
     let params = GridTaskParams::default();
     let direct = errp_sim::grid::EpochBank::build(eeg.clone(), &params, 12, 2).unwrap();
