@@ -4,30 +4,16 @@
 use std::sync::LazyLock;
 
 use divan::{Bencher, black_box};
-use errp_bci::SessionOptions;
 use errp_robot::{Grid, QTable};
-use errp_sim::calibration::{CalibrationRequest, run_calibration};
 use errp_sim::grid::{
-    AssessmentDecoder, EegDecoder, EpochBank, FIXED_PAIRS, GridTaskParams, PErrorChoice,
-    run_grid_episode,
+    AssessmentDecoder, EpochBank, FIXED_PAIRS, GridTaskParams, eeg_decoder, run_grid_episode,
 };
 
 fn main() {
     divan::main();
 }
 
-static EEG: LazyLock<AssessmentDecoder> = LazyLock::new(|| {
-    let report = run_calibration(
-        &CalibrationRequest::new(0.7438, 1),
-        |_| {},
-        SessionOptions::default(),
-    )
-    .unwrap();
-    AssessmentDecoder::Eeg(Box::new(EegDecoder::from_report(
-        &report,
-        PErrorChoice::Platt,
-    )))
-});
+static EEG: LazyLock<AssessmentDecoder> = LazyLock::new(|| eeg_decoder(0.7438, 1).unwrap());
 
 fn episodes(bencher: Bencher, decoder: &AssessmentDecoder) {
     let params = GridTaskParams::default();

@@ -5,14 +5,18 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 use errp_bci::{
-    Accuracy, LdaDecoder, SessionParts, TargetingStep, calibrate_session, rng::derive_seed,
-    target_accuracy_on,
+    Accuracy, LdaDecoder, SessionOptions, SessionParts, TargetingStep, calibrate_session,
+    rng::derive_seed, target_accuracy_on,
 };
 use errp_robot::{Grid, QTable};
 
-use crate::calibration::{CalibrationReport, CalibrationRequest, NoCache, TargetingCache};
+use crate::calibration::{
+    CalibrationReport, CalibrationRequest, NoCache, TargetingCache, run_calibration,
+};
 use crate::error::{Result, SimError};
-use crate::grid::decoder::{AssessmentDecoder, EegDecoder, EegSource, EpochBank, EpochBankParts};
+use crate::grid::decoder::{
+    AssessmentDecoder, EegDecoder, EegSource, EpochBank, EpochBankParts, PErrorChoice,
+};
 use crate::grid::episode::{GridEpisodeResult, run_grid_episode};
 use crate::grid::scenario::{DecoderChoice, EegMode, GridScenario};
 
@@ -197,6 +201,17 @@ pub fn prepare_grid_decoder(
         calibration: Some(report),
         cached,
     })
+}
+
+/// The streamed EEG decoder of a synthetic user calibrated at `accuracy`
+/// (seed `seed`; the discrete session simulated from raw EEG, as `errp
+/// calibrate` does), with Platt-scaled p(error): for benches, examples and
+/// tests that need one decoder without a scenario.
+pub fn eeg_decoder(accuracy: f64, seed: u64) -> Result<AssessmentDecoder> {
+    let request = CalibrationRequest::new(accuracy, seed);
+    let report = run_calibration(&request, |_| {}, SessionOptions::default())?;
+    let eeg = EegDecoder::from_report(&report, PErrorChoice::Platt);
+    Ok(AssessmentDecoder::Eeg(Box::new(eeg)))
 }
 
 /// The scenario's decoder from its calibration (none for the oracle): the

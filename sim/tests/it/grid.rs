@@ -10,16 +10,7 @@ use errp_sim::grid::{
 };
 
 pub(crate) fn eeg_decoder(accuracy: f64, seed: u64) -> AssessmentDecoder {
-    let report = run_calibration(
-        &CalibrationRequest::new(accuracy, seed),
-        |_| {},
-        SessionOptions::default(),
-    )
-    .unwrap();
-    AssessmentDecoder::Eeg(Box::new(EegDecoder::from_report(
-        &report,
-        PErrorChoice::Platt,
-    )))
+    errp_sim::grid::eeg_decoder(accuracy, seed).unwrap()
 }
 
 pub(crate) fn table(params: &GridTaskParams) -> QTable {
