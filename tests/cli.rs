@@ -21,6 +21,14 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
+/// Runs `errp args`, which must refuse with exit code 2; its stderr.
+#[track_caller]
+fn refused(args: &[&str]) -> String {
+    let o = errp(args);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    stderr(&o)
+}
+
 fn files_in(dir: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)
         .unwrap()
@@ -83,9 +91,7 @@ fn accuracy_out_of_range_is_exit_2_naming_the_flag() {
 
 #[test]
 fn unknown_subject_is_exit_2_listing_the_known_ones() {
-    let o = errp(&["calibrate", "--subject", "S9"]);
-    assert_eq!(o.status.code(), Some(2));
-    let e = stderr(&o);
+    let e = refused(&["calibrate", "--subject", "S9"]);
     assert!(e.contains("S9") && e.contains("S1, S2, S3, S4"), "{e}");
 }
 
@@ -162,14 +168,12 @@ fn a_broken_scenario_is_exit_2_naming_file_field_and_fix() {
     )
     .unwrap();
     let rrd = dir.join("run.rrd");
-    let o = errp(&[
+    let e = refused(&[
         "run",
         path.to_str().unwrap(),
         "--save",
         rrd.to_str().unwrap(),
     ]);
-    assert_eq!(o.status.code(), Some(2));
-    let e = stderr(&o);
     assert!(
         e.contains("bad.toml") && e.contains("episode[0].goal") && e.contains("[7, 1]"),
         "{e}"

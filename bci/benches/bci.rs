@@ -25,15 +25,11 @@ struct Trained {
 
 static TRAINED: LazyLock<Trained> = LazyLock::new(|| {
     let setup = CalibrationSetup {
-        generator: GeneratorParams {
-            errp_to_noise: 0.8,
-            ..GeneratorParams::default()
-        },
         calibration: CalibrationParams {
             n_actions: 120,
             ..CalibrationParams::default()
         },
-        ..CalibrationSetup::default()
+        ..CalibrationSetup::with_ratio(0.8)
     };
     let c = calibrate(&LdaDecoder::default(), &setup, 1, SessionOptions::default()).unwrap();
     Trained {
@@ -110,13 +106,7 @@ struct TrainedContinuous {
 }
 
 static TRAINED_CONTINUOUS: LazyLock<TrainedContinuous> = LazyLock::new(|| {
-    let setup = ContinuousSetup {
-        generator: GeneratorParams {
-            errp_to_noise: 1.0,
-            ..GeneratorParams::default()
-        },
-        ..ContinuousSetup::default()
-    };
+    let setup = ContinuousSetup::with_ratio(1.0);
     let c = calibrate_continuous(&SvmDecoder::default(), &setup, 1).unwrap();
     let mut g = EegGenerator::new(setup.generator.clone(), &setup.montage, 4).unwrap();
     let mut pre = c.session.preprocessor.clone();

@@ -205,6 +205,17 @@ impl<P: Protocol> Default for Setup<P> {
 }
 
 impl<P: Protocol> Setup<P> {
+    /// The default setup with the EEG model at ErrP-to-noise `ratio`.
+    pub fn with_ratio(ratio: f64) -> Self {
+        Self {
+            generator: GeneratorParams {
+                errp_to_noise: ratio,
+                ..GeneratorParams::default()
+            },
+            ..Self::default()
+        }
+    }
+
     /// Checks every part.
     pub fn validate(&self) -> Result<()> {
         self.generator.validate()?;

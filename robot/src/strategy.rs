@@ -247,6 +247,19 @@ mod tests {
     }
 
     /// Eq. (4) with a soft-max probability q_i of the action for goal i.
+    /// The gain when each goal's likelihood is the Bayesian P(o | i) of a
+    /// decoder right with probability `alpha` about an action that is wrong
+    /// for goal i with probability `e[i]`.
+    fn bayesian_gain(b: &[f64], alpha: f64, e: &[f64]) -> f64 {
+        let pe = |i: usize| alpha * e[i] + (1.0 - alpha) * (1.0 - e[i]);
+        expected_information_gain(
+            b,
+            alpha,
+            |i| e[i],
+            |i, err| if err { pe(i) } else { 1.0 - pe(i) },
+        )
+    }
+
     fn eq4(q: f64, p: f64) -> f64 {
         (1.0 - p) * q + p * (1.0 - q)
     }
@@ -262,14 +275,7 @@ mod tests {
             let e: Vec<f64> = (0..n).map(|_| rng.random::<f64>()).collect();
             let alpha = rng.random_range(0.5..=1.0);
             let pe = |i: usize| alpha * e[i] + (1.0 - alpha) * (1.0 - e[i]);
-            let g = expected_information_gain(
-                &b,
-                alpha,
-                |i| e[i],
-                |i, err| {
-                    if err { pe(i) } else { 1.0 - pe(i) }
-                },
-            );
+            let g = bayesian_gain(&b, alpha, &e);
             let mut mi = 0.0;
             for err in [true, false] {
                 let joint: Vec<f64> = (0..n)
@@ -304,15 +310,7 @@ mod tests {
         );
         assert!(g < 0.0, "{g}");
         // The Bayesian posterior of the same outcomes gains.
-        let pe = |i: usize| alpha * e[i] + (1.0 - alpha) * (1.0 - e[i]);
-        let g = expected_information_gain(
-            &b,
-            alpha,
-            |i| e[i],
-            |i, err| {
-                if err { pe(i) } else { 1.0 - pe(i) }
-            },
-        );
+        let g = bayesian_gain(&b, alpha, &e);
         assert!(g.abs() < 1e-12, "nothing to learn: {g}");
     }
 

@@ -16,30 +16,43 @@ fn main() {
     divan::main();
 }
 
-fn grid_spec(episodes: usize) -> SweepSpec {
+/// A sweep of the shipped scenario `file` (its text is `toml`).
+fn spec(task: SweepTask, file: &str, toml: &str, accuracies: &str, episodes: usize) -> SweepSpec {
     SweepSpec {
-        task: SweepTask::Grid,
-        scenario_path: "scenarios/grid_fixed_goals.toml".into(),
-        scenario_toml: include_str!("../../scenarios/grid_fixed_goals.toml").into(),
-        accuracies: parse_accuracies("0.55:0.95:0.04").unwrap(),
-        axes: vec![],
-        fixed: vec![("eeg".into(), toml::Value::String("bank".into()))],
-        episodes,
-        seed: 1,
-    }
-}
-
-fn epuck_spec(episodes: usize) -> SweepSpec {
-    SweepSpec {
-        task: SweepTask::Epuck,
-        scenario_path: "scenarios/mexico_to_pisa.toml".into(),
-        scenario_toml: include_str!("../../scenarios/mexico_to_pisa.toml").into(),
-        accuracies: parse_accuracies("0.75").unwrap(),
+        task,
+        scenario_path: format!("scenarios/{file}").into(),
+        scenario_toml: toml.into(),
+        accuracies: parse_accuracies(accuracies).unwrap(),
         axes: vec![],
         fixed: vec![],
         episodes,
         seed: 1,
     }
+}
+
+fn grid_spec(episodes: usize) -> SweepSpec {
+    let toml = include_str!("../../scenarios/grid_fixed_goals.toml");
+    SweepSpec {
+        fixed: vec![("eeg".into(), toml::Value::String("bank".into()))],
+        ..spec(
+            SweepTask::Grid,
+            "grid_fixed_goals.toml",
+            toml,
+            "0.55:0.95:0.04",
+            episodes,
+        )
+    }
+}
+
+fn epuck_spec(episodes: usize) -> SweepSpec {
+    let toml = include_str!("../../scenarios/mexico_to_pisa.toml");
+    spec(
+        SweepTask::Epuck,
+        "mexico_to_pisa.toml",
+        toml,
+        "0.75",
+        episodes,
+    )
 }
 
 fn scratch(name: &str) -> PathBuf {
@@ -78,18 +91,27 @@ fn grid_11x200_cold(bencher: Bencher, threads: usize) {
 /// The same with the targeting cached (a rerun, a resume or another shard).
 #[divan::bench(args = [1, 2], sample_count = 2, sample_size = 1)]
 fn grid_11x200_cached(bencher: Bencher, threads: usize) {
-    let spec = grid_spec(200);
-    let cache = TargetCache::new(scratch("grid-cache"));
-    sweep(&grid_spec(1), 2, &cache, "grid-warm-up");
-    bencher.bench_local(|| sweep(&spec, threads, &cache, "grid-cached"));
+    cached(bencher, threads, grid_spec, 200, "grid");
 }
 
 /// 40 e-puck episodes (Mexico to Pisa at 75 %), calibration cached: divide
 /// by 40 for the time per episode.
 #[divan::bench(args = [1, 2], sample_count = 2, sample_size = 1)]
 fn epuck_40_episodes(bencher: Bencher, threads: usize) {
-    let spec = epuck_spec(40);
-    let cache = TargetCache::new(scratch("epuck-cache"));
-    sweep(&epuck_spec(1), 2, &cache, "epuck-warm-up");
-    bencher.bench_local(|| sweep(&spec, threads, &cache, "epuck"));
+    cached(bencher, threads, epuck_spec, 40, "epuck");
+}
+
+/// Benches a sweep of `episodes` episodes per level made by `spec`, its
+/// targeting cached by a one-episode warm-up.
+fn cached(
+    bencher: Bencher,
+    threads: usize,
+    spec: fn(usize) -> SweepSpec,
+    episodes: usize,
+    name: &str,
+) {
+    let cache = TargetCache::new(scratch(&format!("{name}-cache")));
+    sweep(&spec(1), 2, &cache, &format!("{name}-warm-up"));
+    let spec = spec(episodes);
+    bencher.bench_local(|| sweep(&spec, threads, &cache, name));
 }

@@ -4,18 +4,12 @@
 //! calibration is deterministic. Seeded; tolerances stated.
 
 use errp_bci::{
-    ContinuousSetup, ErrorModel, GeneratorParams, SessionOptions, SvmDecoder, TargetingParams,
-    calibrate_continuous, simulate_continuous_session, target_continuous_accuracy,
+    ContinuousSetup, ErrorModel, SessionOptions, SvmDecoder, TargetingParams, calibrate_continuous,
+    simulate_continuous_session, target_continuous_accuracy,
 };
 
 pub(crate) fn setup_at(ratio: f64) -> ContinuousSetup {
-    ContinuousSetup {
-        generator: GeneratorParams {
-            errp_to_noise: ratio,
-            ..GeneratorParams::default()
-        },
-        ..ContinuousSetup::default()
-    }
+    ContinuousSetup::with_ratio(ratio)
 }
 
 pub(crate) fn rows(x: &errp_bci::Features) -> impl Iterator<Item = Vec<f64>> + '_ {

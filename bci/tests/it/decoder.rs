@@ -12,23 +12,22 @@ use errp_bci::{
 use rand::seq::SliceRandom;
 
 fn setup_at(ratio: f64) -> CalibrationSetup {
+    CalibrationSetup::with_ratio(ratio)
+}
+
+/// The default setup with `n_actions` actions at ErrP-to-noise `ratio`.
+pub(crate) fn sized(n_actions: usize, ratio: f64) -> CalibrationSetup {
     CalibrationSetup {
-        generator: GeneratorParams {
-            errp_to_noise: ratio,
-            ..GeneratorParams::default()
+        calibration: CalibrationParams {
+            n_actions,
+            ..CalibrationParams::default()
         },
-        ..CalibrationSetup::default()
+        ..setup_at(ratio)
     }
 }
 
 pub(crate) fn small_session(seed: u64) -> (Features, Vec<bool>) {
-    let setup = CalibrationSetup {
-        calibration: CalibrationParams {
-            n_actions: 150,
-            ..CalibrationParams::default()
-        },
-        ..setup_at(1.0)
-    };
+    let setup = sized(150, 1.0);
     let s = simulate_session(&setup, seed, SessionOptions::default()).unwrap();
     (s.features, s.labels)
 }
@@ -83,13 +82,7 @@ fn every_classifier_meets_the_contract() {
 #[test]
 fn features_are_linear_in_the_errp_to_noise_ratio() {
     // Targeting relies on: features(r) = features(noise) + r * features(ERP at 1).
-    let setup = CalibrationSetup {
-        calibration: CalibrationParams {
-            n_actions: 30,
-            ..CalibrationParams::default()
-        },
-        ..setup_at(1.0)
-    };
+    let setup = sized(30, 1.0);
     let part = |c: Components, ratio: f64| {
         let s = CalibrationSetup {
             generator: GeneratorParams {
@@ -133,13 +126,7 @@ fn features_are_linear_in_the_errp_to_noise_ratio() {
 #[test]
 fn session_parts_give_the_session_and_the_calibration_at_any_ratio() {
     // Sweeps simulate a session once and calibrate every level from it.
-    let setup = CalibrationSetup {
-        calibration: CalibrationParams {
-            n_actions: 120,
-            ..CalibrationParams::default()
-        },
-        ..setup_at(0.6)
-    };
+    let setup = sized(120, 0.6);
     let parts = SessionParts::simulate(&setup, 8).unwrap();
     let direct = simulate_session(&setup, 8, SessionOptions::default()).unwrap();
     let from_parts = parts.session_at(0.6);
@@ -211,13 +198,7 @@ fn targeting_lands_at_90_percent() {
 
 #[test]
 fn unreachable_accuracy_is_a_clear_error() {
-    let setup = CalibrationSetup {
-        calibration: CalibrationParams {
-            n_actions: 60,
-            ..CalibrationParams::default()
-        },
-        ..CalibrationSetup::default()
-    };
+    let setup = sized(60, GeneratorParams::default().errp_to_noise);
     let search = TargetingParams {
         max_ratio: 0.3,
         ..TargetingParams::default()

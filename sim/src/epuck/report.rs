@@ -110,21 +110,19 @@ impl fmt::Display for EpuckSummaryReport<'_> {
             writeln!(f, "  {label:<20} {value:.1}{}", note(paper))?;
         }
         writeln!(f, "  median false         {:.1}", s.median_false)?;
+        let [turning, driving, on_goal] = s.phase_shares.map(|x| 100.0 * x);
         writeln!(
             f,
-            "  detections           {:.3} per second of run; {:.0} % turning, {:.0} % driving, \
-             {:.0} % on a goal   [paper: 0.18 and 0.21, mostly during turns]",
-            s.detections_per_sec,
-            100.0 * s.phase_shares[0],
-            100.0 * s.phase_shares[1],
-            100.0 * s.phase_shares[2]
+            "  detections           {:.3} per second of run; {turning:.0} % turning, \
+             {driving:.0} % driving, {on_goal:.0} % on a goal   [paper: 0.18 and 0.21, mostly \
+             during turns]",
+            s.detections_per_sec
         )?;
+        let [turn, drive, stop] = s.judged_shares.map(|x| 100.0 * x);
         writeln!(
             f,
-            "  true detections      of ErrPs judging a turn {:.0} %, a drive {:.0} %, a stop {:.0} %",
-            100.0 * s.judged_shares[0],
-            100.0 * s.judged_shares[1],
-            100.0 * s.judged_shares[2]
+            "  true detections      of ErrPs judging a turn {turn:.0} %, a drive {drive:.0} %, a \
+             stop {stop:.0} %"
         )?;
         writeln!(
             f,

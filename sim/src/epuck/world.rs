@@ -495,13 +495,7 @@ mod tests {
         let epuck = EpuckParams::default();
         let r = epuck.body_diameter_m / 2.0;
         // Straight into the right wall for 30 s.
-        let mut w = World::new(
-            &ArenaSpec::paper(),
-            &epuck,
-            start(1.8, 1.0, 0.0),
-            1.0 / 64.0,
-        )
-        .unwrap();
+        let mut w = free_world(1.8, 1.0, 0.0);
         for _ in 0..64 * 30 {
             w.step(twist(0.129, 0.0));
         }
@@ -525,22 +519,10 @@ mod tests {
     #[test]
     fn proximity_sensors_see_a_wall_ahead_and_nothing_in_the_open() {
         let epuck = EpuckParams::default();
-        let w = World::new(
-            &ArenaSpec::paper(),
-            &epuck,
-            start(1.0, 1.0, 0.0),
-            1.0 / 64.0,
-        )
-        .unwrap();
+        let w = free_world(1.0, 1.0, 0.0);
         assert!(w.proximity_distances().iter().all(Option::is_none));
         let r = epuck.body_diameter_m / 2.0;
-        let w = World::new(
-            &ArenaSpec::paper(),
-            &epuck,
-            start(2.0 - r - 0.01, 1.0, 0.0),
-            1.0 / 64.0,
-        )
-        .unwrap();
+        let w = free_world(2.0 - r - 0.01, 1.0, 0.0);
         let d = w.proximity_distances();
         // ps0 and ps7 look 17 degrees off the front: 1 cm / cos 17.
         let expect = 0.01 / 17f64.to_radians().cos();

@@ -2,15 +2,21 @@
 //! determinism checks with fixed seeds.
 
 use errp_bci::Accuracy;
-use errp_bci::SessionOptions;
 use errp_robot::{Grid, QTable};
-use errp_sim::calibration::{CalibrationRequest, run_calibration};
 use errp_sim::grid::{
-    AssessmentDecoder, EegDecoder, FIXED_PAIRS, GridTaskParams, PErrorChoice, run_grid_episode,
+    AssessmentDecoder, EegDecoder, FIXED_PAIRS, GridTaskParams, run_grid_episode,
 };
 
 pub(crate) fn eeg_decoder(accuracy: f64, seed: u64) -> AssessmentDecoder {
     errp_sim::grid::eeg_decoder(accuracy, seed).unwrap()
+}
+
+/// The streamed EEG decoder of [`eeg_decoder`] itself.
+fn streamed(accuracy: f64, seed: u64) -> EegDecoder {
+    match eeg_decoder(accuracy, seed) {
+        AssessmentDecoder::Eeg(d) => *d,
+        _ => unreachable!("eeg_decoder streams"),
+    }
 }
 
 pub(crate) fn table(params: &GridTaskParams) -> QTable {
@@ -64,13 +70,7 @@ fn online_accuracy_matches_the_calibrated_accuracy() {
 
 #[test]
 fn banked_epochs_give_the_streamed_accuracy_and_reach_the_goals() {
-    let report = run_calibration(
-        &CalibrationRequest::new(0.90, 7),
-        |_| {},
-        SessionOptions::default(),
-    )
-    .unwrap();
-    let eeg = EegDecoder::from_report(&report, PErrorChoice::Platt);
+    let eeg = streamed(0.90, 7);
     let bank = errp_sim::grid::EpochBank::build(eeg, &GridTaskParams::default(), 400, 7).unwrap();
     assert_eq!(bank.len(), 400);
     let decoder = AssessmentDecoder::EegBank(Box::new(bank));
@@ -114,13 +114,7 @@ fn a_decoder_without_errps_converges_to_the_right_goal_only_by_chance() {
 #[test]
 fn an_epoch_bank_from_parts_equals_the_bank_streamed_at_its_ratio() {
     // Sweeps stream a bank's noise and ERP parts once and mix them per level.
-    let report = run_calibration(
-        &CalibrationRequest::new(0.75, 2),
-        |_| {},
-        SessionOptions::default(),
-    )
-    .unwrap();
-    let eeg = EegDecoder::from_report(&report, PErrorChoice::Platt);
+    let eeg = streamed(0.75, 2);
     let params = GridTaskParams::default();
     let direct = errp_sim::grid::EpochBank::build(eeg.clone(), &params, 12, 2).unwrap();
     let parts = errp_sim::grid::EpochBankParts::build(eeg.source(), &params, 12, 2).unwrap();
