@@ -66,17 +66,15 @@ pub fn prepare_epuck_decoder(
     let request = ContinuousRequest::new(scenario.accuracy, scenario.seed);
     match scenario.online_target {
         None => {
+            let (accuracy, seed, svm) = (request.accuracy, request.seed, SvmDecoder::default());
+            let (setup, search) = (&request.setup, &request.search);
+            let mut find = || {
+                let found =
+                    target_continuous_accuracy(accuracy, &svm, setup, search, seed, &mut progress);
+                Ok(found?)
+            };
             let (targeting, cached) =
-                cache.get_or_search("epuck-svm", &request.targeting_key(), &mut || {
-                    Ok(target_continuous_accuracy(
-                        request.accuracy,
-                        &SvmDecoder::default(),
-                        &request.setup,
-                        &request.search,
-                        request.seed,
-                        &mut progress,
-                    )?)
-                })?;
+                cache.get_or_search("epuck-svm", &request.targeting_key(), &mut find)?;
             let report = calibrate_continuous_at(&request, targeting)?;
             let decoder = finish_continuous_decoder(scenario, &report)?;
             Ok(PreparedEpuck {
