@@ -43,7 +43,18 @@ pub(crate) fn decoder_key(level: &Level) -> String {
                 s.params.interval_max_secs
             )
         ),
-        AnyScenario::Epuck(s) => format!("{:?}", (s.accuracy, s.seed)),
+        // The held-out operating point, and with an online target the
+        // calibration itself, depend on the detector and T_e too.
+        AnyScenario::Epuck(s) => format!(
+            "{:?}",
+            (
+                s.accuracy,
+                s.seed,
+                s.online_target,
+                s.params.detector,
+                s.params.control.t_e
+            )
+        ),
     }
 }
 
@@ -150,4 +161,35 @@ pub(crate) fn prepare_all(
                 .expect("every decoder was prepared")
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spec::{SweepSpec, SweepTask, parse_accuracies, parse_axis};
+
+    fn epuck_levels(param: &str) -> Vec<Level> {
+        SweepSpec {
+            task: SweepTask::Epuck,
+            scenario_path: "mexico_to_pisa.toml".into(),
+            scenario_toml: include_str!("../../scenarios/mexico_to_pisa.toml").into(),
+            accuracies: parse_accuracies("0.9").unwrap(),
+            axes: vec![parse_axis(SweepTask::Epuck, param).unwrap()],
+            fixed: vec![],
+            episodes: 1,
+            seed: 1,
+        }
+        .levels()
+        .unwrap()
+    }
+
+    #[test]
+    fn levels_share_a_decoder_only_when_it_would_be_the_same() {
+        // T_e sets the held-out operating point the decoder carries.
+        let t_e = epuck_levels("t_e=0.7,0.8");
+        assert_ne!(decoder_key(&t_e[0]), decoder_key(&t_e[1]));
+        // The user's field of view does not touch the decoder.
+        let fov = epuck_levels("fov_deg=60,90");
+        assert_eq!(decoder_key(&fov[0]), decoder_key(&fov[1]));
+    }
 }
