@@ -207,12 +207,17 @@ impl<P: Protocol> Default for Setup<P> {
 impl<P: Protocol> Setup<P> {
     /// The default setup with the EEG model at ErrP-to-noise `ratio`.
     pub fn with_ratio(ratio: f64) -> Self {
+        Self::default().at_ratio(ratio)
+    }
+
+    /// This setup with the EEG model at ErrP-to-noise `ratio`.
+    pub fn at_ratio(&self, ratio: f64) -> Self {
         Self {
             generator: GeneratorParams {
                 errp_to_noise: ratio,
-                ..GeneratorParams::default()
+                ..self.generator.clone()
             },
-            ..Self::default()
+            ..self.clone()
         }
     }
 

@@ -10,7 +10,7 @@ use crate::calibration::{
 use crate::classify::{Classifier, Features};
 use crate::continuous_calibration::{ContinuousSetup, simulate_continuous_session};
 use crate::error::{BciError, Result, check};
-use crate::generator::{Components, GeneratorParams};
+use crate::generator::Components;
 use crate::svm::SvmDecoder;
 
 /// How closely and how hard to search.
@@ -150,15 +150,8 @@ impl SessionParts {
         seed: u64,
         erp: bool,
     ) -> Result<CalibrationSession> {
-        let unit = CalibrationSetup {
-            generator: GeneratorParams {
-                errp_to_noise: 1.0,
-                ..setup.generator.clone()
-            },
-            ..setup.clone()
-        };
         simulate_session(
-            &unit,
+            &setup.at_ratio(1.0),
             seed,
             SessionOptions {
                 components: Components {
@@ -228,13 +221,7 @@ pub fn target_continuous_accuracy(
         requested,
         search,
         |ratio| {
-            let at = ContinuousSetup {
-                generator: GeneratorParams {
-                    errp_to_noise: ratio,
-                    ..setup.generator.clone()
-                },
-                ..setup.clone()
-            };
+            let at = setup.at_ratio(ratio);
             let s = simulate_continuous_session(&at, seed, SessionOptions::default())?;
             cross_validate(
                 classifier,

@@ -22,18 +22,18 @@ pub mod paths {
     /// The decoder's output and threshold, under one time-series view.
     pub const DECODER: &str = "/decoder";
     /// p(error) of each decision.
-    pub const P_ERROR: &str = "decoder/p_error";
+    pub const P_ERROR: &str = "/decoder/p_error";
     /// The decision threshold (0.5, or T_e).
-    pub const THRESHOLD: &str = "decoder/threshold";
-    /// A few preprocessed EEG channels, each at `eeg/NAME`.
+    pub const THRESHOLD: &str = "/decoder/threshold";
+    /// A few preprocessed EEG channels, each at `/eeg/NAME`.
     pub const EEG: &str = "/eeg";
     /// The text log of events.
-    pub const LOG: &str = "log";
+    pub const LOG: &str = "/log";
 }
 
 /// The entity path of preprocessed EEG channel `name` (e.g. "FCz").
 pub fn eeg_channel(name: &str) -> String {
-    format!("eeg/{name}")
+    format!("/eeg/{name}")
 }
 
 /// The layout of a task recording: the scene above the event log on the
@@ -43,7 +43,7 @@ pub(crate) fn task_blueprint(
     panels: Vec<rerun::blueprint::ContainerLike>,
 ) -> Blueprint {
     use rerun::blueprint::{Horizontal, TextLogView, Vertical};
-    let events = TextLogView::new("Events").with_origin(format!("/{}", paths::LOG));
+    let events = TextLogView::new("Events").with_origin(paths::LOG);
     Blueprint::new(Horizontal::new([
         Vertical::new([scene.into(), events.into()]).into(),
         Vertical::new(panels).into(),

@@ -39,18 +39,13 @@ impl<P: Protocol> Request<P> {
 
     /// This request's key in a [`TargetingCache`].
     pub fn targeting_key(&self) -> String {
-        request_key(&self.setup, &self.search, self.accuracy, self.seed)
-    }
-
-    /// The setup with the EEG model at the ErrP-to-noise ratio `ratio`.
-    pub fn setup_at(&self, ratio: f64) -> Setup<P> {
-        Setup {
-            generator: GeneratorParams {
-                errp_to_noise: ratio,
-                ..self.setup.generator.clone()
-            },
-            ..self.setup.clone()
-        }
+        let Self {
+            accuracy,
+            seed,
+            setup,
+            search,
+        } = self;
+        format!("{setup:?} {search:?} accuracy={accuracy:?} seed={seed}")
     }
 }
 
@@ -102,7 +97,7 @@ pub fn calibrate_at(
     targeting: TargetingResult,
     options: SessionOptions<'_>,
 ) -> Result<CalibrationReport> {
-    let setup = request.setup_at(targeting.ratio);
+    let setup = request.setup.at_ratio(targeting.ratio);
     let calibrated = calibrate(&LdaDecoder::default(), &setup, request.seed, options)?;
     Ok(CalibrationReport {
         targeting,
@@ -142,16 +137,4 @@ impl TargetingCache for NoCache {
     ) -> Result<(TargetingResult, bool)> {
         Ok((search()?, false))
     }
-}
-
-/// The text that names a targeting request in a [`TargetingCache`]: its
-/// setup, search settings, accuracy and seed, everything the search
-/// depends on.
-pub fn request_key<P: std::fmt::Debug>(
-    setup: &Setup<P>,
-    search: &TargetingParams,
-    accuracy: f64,
-    seed: u64,
-) -> String {
-    format!("{setup:?} {search:?} accuracy={accuracy:?} seed={seed}")
 }

@@ -26,16 +26,23 @@ pub fn run_continuous_calibration(
     request: &ContinuousRequest,
     progress: impl FnMut(&TargetingStep),
 ) -> Result<ContinuousReport> {
-    let svm = SvmDecoder::default();
-    let targeting = target_continuous_accuracy(
+    calibrate_continuous_at(request, target_continuous(request, progress)?)
+}
+
+/// The first half of [`run_continuous_calibration`]: the ErrP-to-noise
+/// ratio at which the SVM reaches the requested accuracy.
+pub fn target_continuous(
+    request: &ContinuousRequest,
+    progress: impl FnMut(&TargetingStep),
+) -> Result<TargetingResult> {
+    Ok(target_continuous_accuracy(
         request.accuracy,
-        &svm,
+        &SvmDecoder::default(),
         &request.setup,
         &request.search,
         request.seed,
         progress,
-    )?;
-    calibrate_continuous_at(request, targeting)
+    )?)
 }
 
 /// The second half of [`run_continuous_calibration`], for a ratio already
@@ -45,7 +52,7 @@ pub fn calibrate_continuous_at(
     request: &ContinuousRequest,
     targeting: TargetingResult,
 ) -> Result<ContinuousReport> {
-    let setup = request.setup_at(targeting.ratio);
+    let setup = request.setup.at_ratio(targeting.ratio);
     let calibrated = calibrate_continuous(&SvmDecoder::default(), &setup, request.seed)?;
     Ok(ContinuousReport {
         targeting,

@@ -15,7 +15,7 @@ pub(crate) mod world;
 
 pub use decoder::{
     ContinuousDecoder, ContinuousReport, ContinuousRequest, OnlineReport, calibrate_continuous_at,
-    run_continuous_calibration, run_online_calibration,
+    run_continuous_calibration, run_online_calibration, target_continuous,
 };
 pub use episode::{
     EpuckEpisode, EpuckEpisodeResult, EpuckObserver, EpuckTaskParams, PHYSICS_DT_SECS,

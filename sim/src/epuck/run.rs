@@ -2,15 +2,13 @@
 //! scenario's accuracy, then every run of the episode, each from its own
 //! derived seed (in parallel when no recording watches).
 
-use errp_bci::{
-    Accuracy, OnlineStep, SvmDecoder, TargetingStep, rng::derive_seed, target_continuous_accuracy,
-};
+use errp_bci::{Accuracy, OnlineStep, TargetingStep, rng::derive_seed};
 use rayon::prelude::*;
 
 use crate::calibration::{NoCache, TargetingCache};
 use crate::epuck::decoder::{
     ContinuousDecoder, ContinuousReport, ContinuousRequest, calibrate_continuous_at,
-    run_online_calibration,
+    run_online_calibration, target_continuous,
 };
 use crate::epuck::episode::{EpuckEpisodeResult, EpuckObserver, run_epuck_episode};
 use crate::epuck::scenario::EpuckScenario;
@@ -66,13 +64,7 @@ pub fn prepare_epuck_decoder(
     let request = ContinuousRequest::new(scenario.accuracy, scenario.seed);
     match scenario.online_target {
         None => {
-            let (accuracy, seed, svm) = (request.accuracy, request.seed, SvmDecoder::default());
-            let (setup, search) = (&request.setup, &request.search);
-            let mut find = || {
-                let found =
-                    target_continuous_accuracy(accuracy, &svm, setup, search, seed, &mut progress);
-                Ok(found?)
-            };
+            let mut find = || target_continuous(&request, &mut progress);
             let (targeting, cached) =
                 cache.get_or_search("epuck-svm", &request.targeting_key(), &mut find)?;
             let report = calibrate_continuous_at(&request, targeting)?;

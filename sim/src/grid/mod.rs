@@ -18,8 +18,8 @@ pub use episode::{GridEpisodeResult, GridStep, run_grid_episode};
 pub use params::GridTaskParams;
 pub use report::{GridEpisodeHeader, GridEpisodeRow, Table1Report};
 pub use run::{
-    GridRunReport, GridShared, PreparedGrid, decoder_from_calibration, eeg_decoder,
-    pooled_accuracy, prepare_decoder, prepare_grid_decoder, run_grid_scenario,
+    GridRunReport, GridShared, PreparedGrid, eeg_decoder, pooled_accuracy, prepare_decoder,
+    prepare_grid_decoder, run_grid_scenario,
 };
 pub use scenario::{DecoderChoice, EegMode, GridScenario, free_pairs};
 pub use table1::{FIXED_PAIRS, Table1Cell, Table1Options, accuracy_time_correlation, run_table1};

@@ -5,17 +5,17 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 use errp_bci::{
-    Accuracy, LdaDecoder, SessionOptions, SessionParts, TargetingStep, calibrate_session,
-    rng::derive_seed, target_accuracy_on,
+    Accuracy, CalibrationSetup, LdaDecoder, SessionOptions, SessionParts, TargetingStep,
+    calibrate_session, rng::derive_seed, target_accuracy_on,
 };
 use errp_robot::{Grid, QTable};
 
 use crate::calibration::{
     CalibrationReport, CalibrationRequest, NoCache, TargetingCache, run_calibration,
 };
-use crate::error::{Result, SimError};
+use crate::error::Result;
 use crate::grid::decoder::{
-    AssessmentDecoder, EegDecoder, EegSource, EpochBank, EpochBankParts, PErrorChoice,
+    AssessmentDecoder, EegDecoder, EegSource, EpochBankParts, PErrorChoice,
 };
 use crate::grid::episode::{GridEpisodeResult, run_grid_episode};
 use crate::grid::scenario::{DecoderChoice, EegMode, GridScenario};
@@ -89,20 +89,23 @@ fn bank_key(s: &GridScenario) -> String {
     )
 }
 
-/// The calibration session of `seed`, streamed as its noise and ERP parts
-/// in parallel.
-fn simulate_session(accuracy: f64, seed: u64) -> Result<SessionParts> {
-    let setup = CalibrationRequest::new(accuracy, seed).setup;
+/// The calibration session of `setup` and `seed`, streamed as its noise and
+/// ERP parts in parallel.
+fn simulate_parts(setup: &CalibrationSetup, seed: u64) -> Result<SessionParts> {
     let (noise, erp) = rayon::join(
-        || SessionParts::simulate_part(&setup, seed, false),
-        || SessionParts::simulate_part(&setup, seed, true),
+        || SessionParts::simulate_part(setup, seed, false),
+        || SessionParts::simulate_part(setup, seed, true),
     );
     Ok(SessionParts::from_parts(noise?, erp?)?)
 }
 
-/// The epoch bank parts of `s`, streamed through `session`'s preprocessing.
-fn build_bank(s: &GridScenario, session: &SessionParts) -> Result<EpochBankParts> {
-    let setup = CalibrationRequest::new(s.accuracy, s.seed).setup;
+/// The epoch bank parts of `s`, streamed through `session`'s preprocessing
+/// with the user of `setup`.
+fn build_bank(
+    s: &GridScenario,
+    setup: &CalibrationSetup,
+    session: &SessionParts,
+) -> Result<EpochBankParts> {
     let source = EegSource {
         generator: &setup.generator,
         montage: &setup.montage,
@@ -113,19 +116,22 @@ fn build_bank(s: &GridScenario, session: &SessionParts) -> Result<EpochBankParts
 
 impl GridShared {
     /// Simulates once what `scenarios` share: one calibration session per
-    /// seed, one epoch bank per bank key (EEG decoders only).
+    /// seed, one epoch bank per bank key (EEG decoders only), with the
+    /// paper's protocol and the default EEG model, as every grid scenario
+    /// is calibrated.
     pub fn build<'a>(scenarios: impl IntoIterator<Item = &'a GridScenario>) -> Result<Self> {
+        let setup = CalibrationSetup::default();
         let mut shared = Self::default();
         for s in scenarios {
             if s.decoder != DecoderChoice::Eeg {
                 continue;
             }
             if let std::collections::hash_map::Entry::Vacant(slot) = shared.sessions.entry(s.seed) {
-                slot.insert(Arc::new(simulate_session(s.accuracy, s.seed)?));
+                slot.insert(Arc::new(simulate_parts(&setup, s.seed)?));
             }
             let key = bank_key(s);
             if s.eeg == EegMode::Bank && !shared.banks.contains_key(&key) {
-                let bank = build_bank(s, &shared.sessions[&s.seed])?;
+                let bank = build_bank(s, &setup, &shared.sessions[&s.seed])?;
                 shared.banks.insert(key, Arc::new(bank));
             }
         }
@@ -147,7 +153,9 @@ pub fn prepare_grid_decoder(
 ) -> Result<PreparedGrid> {
     if scenario.decoder == DecoderChoice::Oracle {
         return Ok(PreparedGrid {
-            decoder: decoder_from_calibration(scenario, None)?,
+            decoder: AssessmentDecoder::Oracle {
+                accuracy: scenario.accuracy,
+            },
             calibration: None,
             cached: false,
         });
@@ -157,7 +165,7 @@ pub fn prepare_grid_decoder(
     let parts = match shared.sessions.get(&scenario.seed) {
         Some(parts) => parts.as_ref(),
         None => {
-            simulated = simulate_session(scenario.accuracy, scenario.seed)?;
+            simulated = simulate_parts(&request.setup, scenario.seed)?;
             &simulated
         }
     };
@@ -181,7 +189,7 @@ pub fn prepare_grid_decoder(
         request.seed,
     )?;
     let report = CalibrationReport {
-        generator: request.setup_at(targeting.ratio).generator,
+        generator: request.setup.at_ratio(targeting.ratio).generator,
         targeting,
         calibrated,
     };
@@ -191,7 +199,7 @@ pub fn prepare_grid_decoder(
         EegMode::Bank => {
             let bank = match shared.banks.get(&bank_key(scenario)) {
                 Some(bank) => bank.bank(eeg),
-                None => build_bank(scenario, parts)?.bank(eeg),
+                None => build_bank(scenario, &request.setup, parts)?.bank(eeg),
             };
             AssessmentDecoder::EegBank(Box::new(bank))
         }
@@ -212,37 +220,6 @@ pub fn eeg_decoder(accuracy: f64, seed: u64) -> Result<AssessmentDecoder> {
     let report = run_calibration(&request, |_| {}, SessionOptions::default())?;
     let eeg = EegDecoder::from_report(&report, PErrorChoice::Platt);
     Ok(AssessmentDecoder::Eeg(Box::new(eeg)))
-}
-
-/// The scenario's decoder from its calibration (none for the oracle): the
-/// online EEG decoder, streamed or with its epoch bank built.
-pub fn decoder_from_calibration(
-    scenario: &GridScenario,
-    report: Option<&CalibrationReport>,
-) -> Result<AssessmentDecoder> {
-    let report = match (scenario.decoder, report) {
-        (DecoderChoice::Oracle, _) => {
-            return Ok(AssessmentDecoder::Oracle {
-                accuracy: scenario.accuracy,
-            });
-        }
-        (DecoderChoice::Eeg, Some(report)) => report,
-        (DecoderChoice::Eeg, None) => {
-            return Err(SimError::Scenario(
-                "the EEG decoder needs a calibration".into(),
-            ));
-        }
-    };
-    let eeg = EegDecoder::from_report(report, scenario.p_error);
-    Ok(match scenario.eeg {
-        EegMode::Stream => AssessmentDecoder::Eeg(Box::new(eeg)),
-        EegMode::Bank => AssessmentDecoder::EegBank(Box::new(EpochBank::build(
-            eeg,
-            &scenario.params,
-            scenario.bank_per_class,
-            scenario.seed,
-        )?)),
-    })
 }
 
 /// Runs every episode of `scenario` with `decoder`. Episode k uses the seed
