@@ -10,6 +10,7 @@
 //! - [`calibration`]: the button-locked calibration session of the grid task
 //!   and `errp calibrate`;
 //! - [`record`]: `.rrd` files and the timelines they share;
+//! - [`task`]: what a Monte Carlo driver (the sweep) needs of a task;
 //! - at the top: scenario files of either task, the paper's numbers,
 //!   statistics, atomic output files and the error type.
 
@@ -27,6 +28,7 @@ mod scenario_file;
 #[cfg(test)]
 mod snapshot;
 mod stats;
+pub mod task;
 
 pub use error::{Result, SimError};
 pub use output::{PendingFile, write_atomic};

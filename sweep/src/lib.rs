@@ -30,13 +30,14 @@ mod table;
 mod writer;
 
 pub use cache::TargetCache;
+pub use errp_sim::task::DecoderInfo;
 pub use figure::sweep_plot;
 pub use finish::finish_dir;
-pub use manifest::{DecoderInfo, EPISODES, MANIFEST, Manifest};
+pub use manifest::{EPISODES, MANIFEST, Manifest};
 pub use merge::merge_sweeps;
 pub use observer::SweepObserver;
 pub use plot::{LevelPoint, PaperPoint, PlotError, Series, SweepPlot};
-pub use rows::{cost_column, episodes_header};
+pub use rows::episodes_header;
 pub use run::{SweepOptions, SweepOutcome, run_sweep};
 pub use spec::{
     Axis, Level, Shard, SweepSpec, SweepTask, aliases, parse_accuracies, parse_axis, parse_values,

@@ -4,37 +4,10 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
+use errp_sim::task::DecoderInfo;
 use errp_sim::{Result, SimError, write_atomic};
 
 use crate::spec::{Shard, SweepSpec};
-
-/// The calibrated decoder behind one or more levels, as `sweep.json` lists it.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct DecoderInfo {
-    /// Requested accuracy.
-    pub accuracy: f64,
-    /// `lda` (grid EEG), `svm` (e-puck) or `oracle`.
-    pub kind: String,
-    /// Seed of its calibration session.
-    pub calibration_seed: u64,
-    /// ErrP-to-noise ratio found by targeting.
-    pub errp_to_noise: Option<f64>,
-    /// Cross-validated correct-class rate of the calibration session.
-    pub cv_correct: Option<f64>,
-    /// Cross-validated error-class rate.
-    pub cv_error: Option<f64>,
-    /// Their mean: the accuracy reached.
-    pub cv_mean: Option<f64>,
-    /// E-puck: the detector's hit rate per ErrP on the held-out recording.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub online_hit_rate: Option<f64>,
-    /// E-puck: its false alarms per minute of error-free time there.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub online_false_alarms_per_min: Option<f64>,
-    /// True if the targeting came from the cache (not written to disk).
-    #[serde(skip)]
-    pub cached: bool,
-}
 
 /// The contents of `sweep.json`: enough to rerun the sweep exactly.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -1,6 +1,6 @@
 //! What a sweep reports as it goes: decoders calibrated, episodes done.
 
-use crate::manifest::DecoderInfo;
+use errp_sim::task::DecoderInfo;
 
 /// What a sweep reports as it goes. Every method defaults to nothing;
 /// `()` watches nothing.

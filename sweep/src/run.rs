@@ -8,17 +8,17 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
-use errp_robot::{Grid, QTable};
-
-use errp_sim::grid::GridShared;
-use errp_sim::{AnyScenario, Result, SimError};
+use errp_sim::epuck::EpuckTask;
+use errp_sim::grid::GridTask;
+use errp_sim::task::Task;
+use errp_sim::{Result, SimError};
 
 use crate::cache::TargetCache;
 use crate::manifest::{EPISODES, MANIFEST, Manifest};
 use crate::observer::SweepObserver;
-use crate::prepare::{Prepared, Runner, decoder_key, prepare_all};
+use crate::prepare::prepare_all;
 use crate::rows::episodes_header;
-use crate::spec::{Shard, SweepSpec, SweepTask};
+use crate::spec::{Level, Shard, SweepSpec, SweepTask};
 use crate::writer::{EpisodeJob, resume_rows};
 
 /// How a sweep runs (none of it changes the results).
@@ -98,60 +98,68 @@ pub fn run_sweep(
         fresh.write(out)?;
     }
 
-    // Decoders: one per distinct calibration, in parallel.
-    let mut keys: Vec<String> = Vec::new();
-    let mut first_level: Vec<usize> = Vec::new();
+    match spec.task {
+        SweepTask::Grid => run_levels::<GridTask>(spec, opts, &levels, fresh, cancel, observer),
+        SweepTask::Epuck => run_levels::<EpuckTask>(spec, opts, &levels, fresh, cancel, observer),
+    }
+}
+
+/// Prepares the levels' decoders (one per distinct calibration, in
+/// parallel), lists them in the manifest, then runs the slice's episodes.
+fn run_levels<T: Task>(
+    spec: &SweepSpec,
+    opts: &SweepOptions,
+    levels: &[Level],
+    fresh: Manifest,
+    cancel: &AtomicBool,
+    observer: &dyn SweepObserver,
+) -> Result<SweepOutcome> {
+    let out = &opts.out;
+    let episodes_path = out.join(EPISODES);
+    let scenarios: Vec<&T::Scenario> = levels
+        .iter()
+        .map(|level| {
+            T::scenario(&level.scenario).ok_or_else(|| {
+                SimError::Sweep(format!(
+                    "the sweep is of the {} task, but {} is not a scenario of it",
+                    T::INFO.name,
+                    spec.scenario_path.display()
+                ))
+            })
+        })
+        .collect::<Result<_>>()?;
+    let mut first: Vec<usize> = Vec::new();
     let mut key_of = Vec::with_capacity(levels.len());
     let mut index: HashMap<String, usize> = HashMap::new();
-    for level in &levels {
-        let key = decoder_key(level);
-        let i = *index.entry(key.clone()).or_insert_with(|| {
-            keys.push(key);
-            first_level.push(level.index);
-            keys.len() - 1
+    for (i, s) in scenarios.iter().enumerate() {
+        let d = *index.entry(T::decoder_key(s)).or_insert_with(|| {
+            first.push(i);
+            first.len() - 1
         });
-        key_of.push(i);
+        key_of.push(d);
     }
-    let shared = GridShared::build(levels.iter().filter_map(|l| match &l.scenario {
-        AnyScenario::Grid(s) => Some(s.as_ref()),
-        AnyScenario::Epuck(_) => None,
-    }))?;
-    let prepared = prepare_all(&levels, &first_level, &opts.cache, &shared, observer)?;
+    let distinct: Vec<&T::Scenario> = first.iter().map(|&i| scenarios[i]).collect();
+    let shared = T::shared(&scenarios)?;
+    let prepared = prepare_all::<T>(
+        &distinct,
+        |d| (levels[first[d]].accuracy - 0.75).abs(),
+        &opts.cache,
+        &shared,
+        observer,
+    )?;
+    let (decoders, infos): (Vec<_>, Vec<_>) = prepared
+        .into_iter()
+        .map(|(decoder, info)| (Arc::new(decoder), info))
+        .unzip();
     let manifest = Manifest {
-        decoders: prepared.iter().map(|(_, i)| i.clone()).collect(),
+        decoders: infos,
         ..fresh
     };
     manifest.write(out)?;
-
-    let mut tables: HashMap<String, Arc<QTable>> = HashMap::new();
-    let runners: Vec<Runner> = levels
+    let runners: Vec<T::Runner> = scenarios
         .iter()
         .zip(&key_of)
-        .map(|(level, &d)| {
-            Ok(match (&level.scenario, &prepared[d].0) {
-                (AnyScenario::Grid(s), Prepared::Grid(decoder)) => {
-                    let q = &s.params.control.q;
-                    let table = match tables.get(&format!("{q:?}")) {
-                        Some(t) => t.clone(),
-                        None => {
-                            let t = Arc::new(QTable::compute(Grid::paper(), q)?);
-                            tables.insert(format!("{q:?}"), t.clone());
-                            t
-                        }
-                    };
-                    Runner::Grid {
-                        scenario: s.clone(),
-                        decoder: decoder.clone(),
-                        table,
-                    }
-                }
-                (AnyScenario::Epuck(s), Prepared::Epuck(decoder)) => Runner::Epuck {
-                    scenario: s.clone(),
-                    decoder: decoder.clone(),
-                },
-                _ => unreachable!("a level's decoder is of its task"),
-            })
-        })
+        .map(|(s, &d)| T::runner(s, decoders[d].clone()))
         .collect::<Result<_>>()?;
 
     // Episodes of this slice, in sweep order.
@@ -187,14 +195,11 @@ pub fn run_sweep(
     let sync_every = if opts.chunk > 0 {
         opts.chunk
     } else {
-        match spec.task {
-            SweepTask::Grid => 256,
-            SweepTask::Epuck => 16,
-        }
+        T::INFO.rows_per_sync
     };
-    let job = EpisodeJob {
+    let job = EpisodeJob::<T> {
         spec,
-        levels: &levels,
+        levels,
         runners: &runners,
         items: &items,
         cancel,

@@ -11,6 +11,10 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 use toml::{Table, Value};
 
+use errp_sim::epuck::EpuckTask;
+use errp_sim::grid::GridTask;
+pub use errp_sim::task::format_number;
+use errp_sim::task::{Task, TaskInfo};
 use errp_sim::{AnyScenario, is_epuck, parse_scenario};
 use errp_sim::{Result, SimError};
 use errp_sim::{parse_toml, read_scenario, set_key};
@@ -25,12 +29,19 @@ pub enum SweepTask {
     Epuck,
 }
 
+impl SweepTask {
+    /// The task's columns, labels and sweepable parameters.
+    pub fn info(self) -> &'static TaskInfo {
+        match self {
+            SweepTask::Grid => &GridTask::INFO,
+            SweepTask::Epuck => &EpuckTask::INFO,
+        }
+    }
+}
+
 impl fmt::Display for SweepTask {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            SweepTask::Grid => "grid",
-            SweepTask::Epuck => "epuck",
-        })
+        f.write_str(self.info().name)
     }
 }
 
@@ -137,11 +148,6 @@ pub fn value_text(v: &Value) -> String {
     }
 }
 
-/// A float in its shortest exact form (`0.3`, `1`, `0.7438`).
-pub fn format_number(x: f64) -> String {
-    format!("{x}")
-}
-
 /// Rounds away the binary noise of `a + k * step` (`0.30000000000000004`).
 fn tidy(x: f64) -> f64 {
     let r = (x * 1e12).round() / 1e12;
@@ -245,54 +251,10 @@ pub fn parse_accuracies(text: &str) -> Result<Vec<f64>> {
     Ok(out)
 }
 
-/// The short names of the grid task's sweepable parameters, and where they
-/// live in the scenario file. Any other parameter is named by its dotted
-/// path.
-const GRID_PARAMS: &[(&str, &str)] = &[
-    ("tau", "control.tau"),
-    ("epsilon", "control.epsilon"),
-    ("p_c", "control.p_c"),
-    ("discount", "control.discount"),
-    ("goal_reward", "control.goal_reward"),
-    ("wrong_goal_reward", "control.wrong_goal_reward"),
-    ("strategy", "control.strategy"),
-    ("interval_min_secs", "timing.interval_min_secs"),
-    ("interval_max_secs", "timing.interval_max_secs"),
-    ("epoch_secs", "timing.epoch_secs"),
-    ("max_actions", "timing.max_actions"),
-    ("decoder", "decoder"),
-    ("p_error", "p_error"),
-    ("eeg", "eeg"),
-    ("bank_per_class", "bank_per_class"),
-];
-
-/// The same for the e-puck task.
-const EPUCK_PARAMS: &[(&str, &str)] = &[
-    ("t_e", "control.t_e"),
-    ("k_turn", "control.k_turn"),
-    ("k_p", "control.k_p"),
-    ("k_n", "control.k_n"),
-    ("sigma_deg", "control.sigma_deg"),
-    ("p_c", "control.p_c"),
-    ("stop_secs", "control.stop_secs"),
-    ("drive_speed_fraction", "control.drive_speed_fraction"),
-    ("turn_speed_fraction", "control.turn_speed_fraction"),
-    ("strategy", "control.strategy"),
-    ("fov_deg", "user.fov_deg"),
-    ("reaction_latency_ms", "user.reaction_latency_ms"),
-    ("reelicit_secs", "user.reelicit_secs"),
-    ("max_secs", "max_secs"),
-    ("rate_hz", "tracker.rate_hz"),
-    ("position_noise_cm", "tracker.position_noise_cm"),
-    ("heading_noise_deg", "tracker.heading_noise_deg"),
-];
-
-/// The sweepable parameters of `task`: (short name, dotted key).
+/// The sweepable parameters of `task`: (short name, dotted key). Any other
+/// parameter is named by its dotted path.
 pub fn sweepable(task: SweepTask) -> &'static [(&'static str, &'static str)] {
-    match task {
-        SweepTask::Grid => GRID_PARAMS,
-        SweepTask::Epuck => EPUCK_PARAMS,
-    }
+    task.info().sweepable
 }
 
 /// The dotted key of short name `name` for `task`.

@@ -13,7 +13,6 @@ use errp_sim::{StreamingPearson, pearson};
 use errp_sim::{mean_sd, median};
 
 use crate::manifest::EPISODES;
-use crate::rows::cost_column;
 use crate::spec::{SweepSpec, SweepTask};
 
 /// The statistics of one level.
@@ -88,15 +87,12 @@ fn columns(header: &str, task: SweepTask, path: &Path) -> Result<Columns> {
     Ok(Columns {
         level: find("level")?,
         success: find("success")?,
-        committed: find(match task {
-            SweepTask::Grid => "committed_x",
-            SweepTask::Epuck => "committed",
-        })?,
-        cost: find(cost_column(task))?,
+        committed: find(task.info().committed_column)?,
+        cost: find(task.info().cost_column)?,
         online: find("online_accuracy")?,
-        detector: match task {
-            SweepTask::Grid => None,
-            SweepTask::Epuck => Some((find("hit_rate")?, find("false_alarms_per_min")?)),
+        detector: match task.info().detector_columns {
+            None => None,
+            Some((hits, false_alarms)) => Some((find(hits)?, find(false_alarms)?)),
         },
     })
 }

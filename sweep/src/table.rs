@@ -4,8 +4,7 @@ use std::fmt;
 
 use errp_sim::wilson_interval;
 
-use crate::rows::cost_column;
-use crate::spec::{SweepSpec, SweepTask, format_number, value_text};
+use crate::spec::{SweepSpec, format_number, value_text};
 use crate::summary::SweepReport;
 
 /// A statistic in the summary: 6 decimals, empty when undefined.
@@ -21,7 +20,8 @@ fn stat(x: f64) -> String {
 
 /// The text of `summary.csv`.
 pub fn summary_csv(spec: &SweepSpec, report: &SweepReport) -> String {
-    let cost = cost_column(spec.task);
+    let info = spec.task.info();
+    let cost = info.cost_column;
     let mut cols = vec!["level".to_string(), "accuracy".into()];
     cols.extend(spec.axes.iter().map(|a| a.name.clone()));
     cols.extend(
@@ -39,9 +39,9 @@ pub fn summary_csv(spec: &SweepSpec, report: &SweepReport) -> String {
     cols.push("online_accuracy".into());
     cols.push(format!("r_online_{cost}"));
     cols.push(format!("p_online_{cost}"));
-    let epuck = spec.task == SweepTask::Epuck;
-    if epuck {
-        cols.extend(["hit_rate", "false_alarms_per_min"].map(String::from));
+    let detector = info.detector_columns.is_some();
+    if let Some((hits, false_alarms)) = info.detector_columns {
+        cols.extend([hits, false_alarms].map(String::from));
     }
     let mut out = cols.join(",");
     out.push('\n');
@@ -65,7 +65,7 @@ pub fn summary_csv(spec: &SweepSpec, report: &SweepReport) -> String {
             stat(l.r_p.0),
             stat(l.r_p.1),
         ]);
-        if epuck {
+        if detector {
             f.extend([stat(l.detector.0), stat(l.detector.1)]);
         }
         out.push_str(&f.join(","));
@@ -76,10 +76,7 @@ pub fn summary_csv(spec: &SweepSpec, report: &SweepReport) -> String {
 
 impl fmt::Display for SweepReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let cost = match self.task {
-            SweepTask::Grid => "actions",
-            SweepTask::Epuck => "time (s)",
-        };
+        let cost = self.task.info().cost_label;
         let width = self
             .levels
             .iter()
@@ -91,7 +88,7 @@ impl fmt::Display for SweepReport {
         if with_series {
             write!(f, "{:<width$}  ", "series")?;
         }
-        let epuck = self.task == SweepTask::Epuck;
+        let detector = self.task.info().detector_columns.is_some();
         write!(
             f,
             "{:>8} {:>6} {:>8} {:>15} {:>17} {:>7} {:>7} {:>6} {:>7}",
@@ -105,7 +102,7 @@ impl fmt::Display for SweepReport {
             "r",
             "p"
         )?;
-        if epuck {
+        if detector {
             write!(f, " {:>6} {:>8}", "hits", "FA/min")?;
         }
         writeln!(f)?;
@@ -134,7 +131,7 @@ impl fmt::Display for SweepReport {
                 num(l.r_p.0, 2),
                 num(l.r_p.1, 3),
             )?;
-            if epuck {
+            if detector {
                 write!(
                     f,
                     " {:>6} {:>8}",

@@ -6,10 +6,10 @@ use std::path::Path;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
+use errp_sim::task::Task;
 use errp_sim::{Result, SimError};
 
 use crate::observer::SweepObserver;
-use crate::prepare::Runner;
 use crate::rows::run_row;
 use crate::spec::{Level, SweepSpec};
 
@@ -18,10 +18,10 @@ use crate::spec::{Level, SweepSpec};
 /// the next episode as soon as it is free (no barrier between chunks), and
 /// rows that finish early wait in memory until the rows before them are
 /// written, at most `window` of them.
-pub(crate) struct EpisodeJob<'a> {
+pub(crate) struct EpisodeJob<'a, T: Task> {
     pub(crate) spec: &'a SweepSpec,
     pub(crate) levels: &'a [Level],
-    pub(crate) runners: &'a [Runner],
+    pub(crate) runners: &'a [T::Runner],
     pub(crate) items: &'a [usize],
     pub(crate) cancel: &'a AtomicBool,
     pub(crate) observer: &'a dyn SweepObserver,
@@ -42,7 +42,7 @@ pub(crate) struct Writer {
     error: Option<SimError>,
 }
 
-impl EpisodeJob<'_> {
+impl<T: Task> EpisodeJob<'_, T> {
     /// Runs the episodes after the first `done` and returns how many rows of
     /// the slice are on disk (all of them unless cancelled).
     pub(crate) fn run(&self, file: File, done: usize, path: &Path) -> Result<usize> {
@@ -81,7 +81,7 @@ impl EpisodeJob<'_> {
                             }
                         }
                         let (l, k) = split(self.spec, self.items[i]);
-                        let row = run_row(self.spec, &self.levels[l], &self.runners[l], k);
+                        let row = run_row::<T>(self.spec, &self.levels[l], &self.runners[l], k);
                         let mut guard = state.lock().expect("a worker panicked");
                         let st = &mut *guard;
                         let row = match row {

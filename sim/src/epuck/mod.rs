@@ -8,6 +8,7 @@ pub(crate) mod report;
 pub(crate) mod run;
 pub(crate) mod scenario;
 pub(crate) mod schema;
+pub(crate) mod task;
 pub(crate) mod tracker;
 pub(crate) mod user;
 pub(crate) mod view;
@@ -29,6 +30,7 @@ pub use run::{
     run_epuck_batch, run_epuck_once, summarise,
 };
 pub use scenario::EpuckScenario;
+pub use task::{EpuckRunner, EpuckTask};
 pub use tracker::{CameraTracker, TrackerParams};
 pub use user::{Elicited, Judgement, SeenMotion, SyntheticUser, UserParams};
 pub use view::{EpuckRecorder, RUN_GAP_SECS, epuck_recording};

@@ -28,6 +28,10 @@ mod panels;
 mod series;
 
 use glyph_text::*;
+
+/// A point from the paper to overlay on the cost panel (Table 1 subjects, or
+/// the paper's e-puck runs).
+pub use errp_sim::task::PaperPoint;
 use legend::*;
 use panels::*;
 use series::*;
@@ -109,21 +113,6 @@ pub struct Series {
     pub label: String,
     /// The levels, in any order (they are drawn sorted by accuracy).
     pub points: Vec<LevelPoint>,
-}
-
-/// A point from the paper to overlay on the cost panel (Table 1 subjects, or
-/// the paper's e-puck runs).
-#[derive(Debug, Clone, PartialEq)]
-pub struct PaperPoint {
-    /// What the point is (e.g. "S1, goal set A"); not drawn, all paper points
-    /// share the one legend entry [`SweepPlot::paper_label`].
-    pub label: String,
-    /// The decoder accuracy the paper reports.
-    pub accuracy: f64,
-    /// The cost the paper reports, in the unit of [`SweepPlot::cost_label`].
-    pub value: f64,
-    /// Its standard deviation, drawn as an error bar when given.
-    pub sd: Option<f64>,
 }
 
 /// Everything one sweep figure shows.

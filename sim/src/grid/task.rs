@@ -1,0 +1,238 @@
+//! The grid task as a [`Task`]: what a sweep runs at one level.
+
+use std::sync::Arc;
+
+use errp_bci::GoalSet;
+use errp_robot::{Cell, Grid, QTable};
+
+use crate::calibration::TargetingCache;
+use crate::error::Result;
+use crate::grid::decoder::AssessmentDecoder;
+use crate::grid::episode::run_grid_episode;
+use crate::grid::run::{GridShared, prepare_grid_decoder};
+use crate::grid::scenario::{DecoderChoice, GridScenario};
+use crate::paper::PAPER;
+use crate::scenario::AnyScenario;
+use crate::task::{
+    DecoderInfo, EpisodeRow, FigureText, PaperPoint, Task, TaskInfo, format_number, overall,
+};
+
+/// The discrete 5x5 grid (sec. 4): the cost is actions to convergence.
+#[derive(Debug, Clone, Copy)]
+pub struct GridTask;
+
+/// A grid level: its scenario, decoder and Q-table.
+#[derive(Debug)]
+pub struct GridRunner {
+    scenario: GridScenario,
+    decoder: Arc<AssessmentDecoder>,
+    table: QTable,
+}
+
+impl Task for GridTask {
+    const INFO: TaskInfo = TaskInfo {
+        name: "grid",
+        columns: &[
+            "start_x",
+            "start_y",
+            "goal_x",
+            "goal_y",
+            "committed_x",
+            "committed_y",
+            "actions",
+            "net_secs",
+            "total_secs",
+            "errors",
+            "detected",
+            "false_alarms",
+            "missed",
+        ],
+        cost_column: "actions",
+        cost_label: "actions",
+        committed_column: "committed_x",
+        detector_columns: None,
+        rows_per_sync: 256,
+        sweepable: &[
+            ("tau", "control.tau"),
+            ("epsilon", "control.epsilon"),
+            ("p_c", "control.p_c"),
+            ("discount", "control.discount"),
+            ("goal_reward", "control.goal_reward"),
+            ("wrong_goal_reward", "control.wrong_goal_reward"),
+            ("strategy", "control.strategy"),
+            ("interval_min_secs", "timing.interval_min_secs"),
+            ("interval_max_secs", "timing.interval_max_secs"),
+            ("epoch_secs", "timing.epoch_secs"),
+            ("max_actions", "timing.max_actions"),
+            ("decoder", "decoder"),
+            ("p_error", "p_error"),
+            ("eeg", "eeg"),
+            ("bank_per_class", "bank_per_class"),
+        ],
+    };
+    type Scenario = GridScenario;
+    type Shared = GridShared;
+    type Decoder = AssessmentDecoder;
+    type Runner = GridRunner;
+
+    fn scenario(any: &AnyScenario) -> Option<&GridScenario> {
+        match any {
+            AnyScenario::Grid(s) => Some(s),
+            AnyScenario::Epuck(_) => None,
+        }
+    }
+
+    fn decoder_key(s: &GridScenario) -> String {
+        format!(
+            "{:?}",
+            (
+                s.accuracy,
+                s.seed,
+                s.decoder,
+                s.p_error,
+                s.eeg,
+                s.bank_per_class,
+                s.params.interval_min_secs,
+                s.params.interval_max_secs
+            )
+        )
+    }
+
+    fn shared(scenarios: &[&GridScenario]) -> Result<GridShared> {
+        GridShared::build(scenarios.iter().copied())
+    }
+
+    fn prepare(
+        s: &GridScenario,
+        shared: &GridShared,
+        cache: &dyn TargetingCache,
+    ) -> Result<(AssessmentDecoder, DecoderInfo)> {
+        let prepared = prepare_grid_decoder(s, shared, cache, |_| {})?;
+        let calibration = prepared.calibration.as_ref();
+        let accuracy = calibration.map(|c| c.calibrated.accuracy);
+        let info = DecoderInfo {
+            accuracy: s.accuracy,
+            kind: if calibration.is_some() {
+                "lda"
+            } else {
+                "oracle"
+            }
+            .into(),
+            calibration_seed: s.seed,
+            errp_to_noise: calibration.map(|c| c.targeting.ratio),
+            cv_correct: accuracy.map(|a| a.correct),
+            cv_error: accuracy.map(|a| a.error),
+            cv_mean: accuracy.map(|a| a.mean()),
+            online_hit_rate: None,
+            online_false_alarms_per_min: None,
+            cached: prepared.cached,
+        };
+        Ok((prepared.decoder, info))
+    }
+
+    fn runner(s: &GridScenario, decoder: Arc<AssessmentDecoder>) -> Result<GridRunner> {
+        Ok(GridRunner {
+            scenario: s.clone(),
+            decoder,
+            table: QTable::compute(Grid::paper(), &s.params.control.q)?,
+        })
+    }
+
+    fn run_episode(runner: &GridRunner, k: usize, seed: u64) -> Result<EpisodeRow> {
+        let s = &runner.scenario;
+        let (start, goal) = s.episodes[k % s.episodes.len()];
+        let r = run_grid_episode(
+            start,
+            goal,
+            &runner.table,
+            &s.params,
+            &runner.decoder,
+            seed,
+            false,
+        )?;
+        let cell = |c: Option<Cell>| match c {
+            Some(c) => [c.x.to_string(), c.y.to_string()],
+            None => [String::new(), String::new()],
+        };
+        let (detected, hits_correct, _) = overall(&r.online);
+        let mut fields = Vec::with_capacity(Self::INFO.columns.len());
+        fields.extend(cell(Some(start)));
+        fields.extend(cell(Some(goal)));
+        fields.extend(cell(r.committed));
+        fields.extend([
+            r.actions.to_string(),
+            format_number(r.net_secs),
+            format_number(r.total_secs),
+            r.online.n_error.to_string(),
+            detected.to_string(),
+            (r.online.n_correct - hits_correct).to_string(),
+            (r.online.n_error - detected).to_string(),
+        ]);
+        Ok(EpisodeRow {
+            success: r.reached(),
+            fields,
+            online: r.online,
+        })
+    }
+
+    fn figure(s: &GridScenario) -> FigureText {
+        FigureText {
+            task: "Grid task".into(),
+            decoder: match s.decoder {
+                DecoderChoice::Oracle => "oracle decoder".into(),
+                DecoderChoice::Eeg => format!("EEG decoder ({:?})", s.eeg).to_lowercase(),
+            },
+            cost_label: "actions to convergence (successful episodes)".into(),
+            paper: PAPER
+                .iter()
+                .map(|(name, set, row)| PaperPoint {
+                    label: format!(
+                        "{name} {}",
+                        if *set == GoalSet::Fixed {
+                            "fixed"
+                        } else {
+                            "free"
+                        }
+                    ),
+                    accuracy: row[6] / 100.0,
+                    value: row[0],
+                    sd: Some(row[1]),
+                })
+                .collect(),
+            paper_label: "paper, Table 1 (S1-S4, fixed and free goals)".into(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::calibration::NoCache;
+
+    #[test]
+    fn an_episode_row_fills_the_task_columns() {
+        let text = include_str!("../../../scenarios/grid_fixed_goals.toml")
+            .replace("decoder = \"eeg\"", "decoder = \"oracle\"");
+        let scenario = GridScenario::parse(&text, "grid_fixed_goals.toml".as_ref()).unwrap();
+        assert_eq!(scenario.decoder, DecoderChoice::Oracle);
+        let shared = GridTask::shared(&[&scenario]).unwrap();
+        let (decoder, info) = GridTask::prepare(&scenario, &shared, &NoCache).unwrap();
+        assert_eq!(info.kind, "oracle");
+        let runner = GridTask::runner(&scenario, Arc::new(decoder)).unwrap();
+        let row = GridTask::run_episode(&runner, 0, 7).unwrap();
+        assert_eq!(row.fields.len(), GridTask::INFO.columns.len());
+        let (start, goal) = scenario.episodes[0];
+        assert_eq!(
+            row.fields[..4],
+            [start.x, start.y, goal.x, goal.y].map(|v| v.to_string())
+        );
+        // The oracle at the scenario's accuracy still decides every action.
+        assert!(row.online.n_error + row.online.n_correct > 0);
+        let cost = GridTask::INFO
+            .columns
+            .iter()
+            .position(|c| *c == GridTask::INFO.cost_column)
+            .unwrap();
+        assert!(row.fields[cost].parse::<usize>().unwrap() > 0);
+    }
+}

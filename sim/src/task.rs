@@ -1,0 +1,185 @@
+//! What a Monte Carlo driver needs of a task: its scenario and decoder
+//! types, the one way to prepare a decoder, one episode as a CSV row, and
+//! the columns and labels that describe its results.
+//!
+//! [`GridTask`](crate::grid::GridTask) and
+//! [`EpuckTask`](crate::epuck::EpuckTask) implement it; `errp sweep` is
+//! written once over it, so a sweep prepares decoders on the path `errp run`
+//! takes and a new task needs no change to the sweep.
+
+use std::sync::Arc;
+
+use serde::{Deserialize, Serialize};
+
+use errp_bci::Accuracy;
+
+use crate::calibration::TargetingCache;
+use crate::error::Result;
+use crate::scenario::AnyScenario;
+
+/// The fixed facts of a task: its name, the columns of its episode rows and
+/// what its summaries call things.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TaskInfo {
+    /// As in scenario files and `--task` (`grid`, `epuck`).
+    pub name: &'static str,
+    /// The task's own columns of an episode row, between `success` and the
+    /// online accuracy columns, in the order of [`EpisodeRow::fields`].
+    pub columns: &'static [&'static str],
+    /// The column of the cost a sweep summarises (over successful episodes).
+    pub cost_column: &'static str,
+    /// The cost as a table heading, with its unit.
+    pub cost_label: &'static str,
+    /// A column that is empty when the episode committed to no goal.
+    pub committed_column: &'static str,
+    /// The columns of the online detector's hit rate and false alarms per
+    /// minute, if the task has a detector.
+    pub detector_columns: Option<(&'static str, &'static str)>,
+    /// Episode rows written between two syncs to disk when the caller does
+    /// not choose (about a second of work on two cores).
+    pub rows_per_sync: usize,
+    /// Short names of sweepable scenario parameters and their dotted keys in
+    /// the scenario file; the alias list and its help text derive from it.
+    pub sweepable: &'static [(&'static str, &'static str)],
+}
+
+/// The calibrated decoder behind one or more levels of a sweep, as
+/// `sweep.json` lists it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DecoderInfo {
+    /// Requested accuracy.
+    pub accuracy: f64,
+    /// `lda` (grid EEG), `svm` (e-puck) or `oracle`.
+    pub kind: String,
+    /// Seed of its calibration session.
+    pub calibration_seed: u64,
+    /// ErrP-to-noise ratio found by targeting.
+    pub errp_to_noise: Option<f64>,
+    /// Cross-validated correct-class rate of the calibration session.
+    pub cv_correct: Option<f64>,
+    /// Cross-validated error-class rate.
+    pub cv_error: Option<f64>,
+    /// Their mean: the accuracy reached.
+    pub cv_mean: Option<f64>,
+    /// E-puck: the detector's hit rate per ErrP on the held-out recording.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub online_hit_rate: Option<f64>,
+    /// E-puck: its false alarms per minute of error-free time there.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub online_false_alarms_per_min: Option<f64>,
+    /// True if the targeting came from the cache (not written to disk).
+    #[serde(skip)]
+    pub cached: bool,
+}
+
+/// One episode's outcome, as a sweep writes it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EpisodeRow {
+    /// Converged on the user's goal.
+    pub success: bool,
+    /// The values of [`TaskInfo::columns`], formatted.
+    pub fields: Vec<String>,
+    /// The decoder's accuracy over the episode's decisions.
+    pub online: Accuracy,
+}
+
+/// A result the paper reports, drawn beside a sweep's curves.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PaperPoint {
+    /// What the point is (e.g. "S1 fixed"); not drawn, all paper points
+    /// share one legend entry.
+    pub label: String,
+    /// The decoder accuracy the paper reports.
+    pub accuracy: f64,
+    /// The cost the paper reports, in the unit of the figure's cost axis.
+    pub value: f64,
+    /// Its standard deviation, drawn as an error bar when given.
+    pub sd: Option<f64>,
+}
+
+/// The words and paper points of a sweep figure of one scenario.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FigureText {
+    /// The task, as the title starts (`Grid task`).
+    pub task: String,
+    /// The decoder, for the title.
+    pub decoder: String,
+    /// The cost axis.
+    pub cost_label: String,
+    /// What the paper reports for this scenario.
+    pub paper: Vec<PaperPoint>,
+    /// The legend entry of those points.
+    pub paper_label: String,
+}
+
+/// A task a Monte Carlo driver can run: levels of one scenario file, each
+/// with its decoder prepared once and many seeded episodes.
+pub trait Task: 'static {
+    /// Its fixed facts.
+    const INFO: TaskInfo;
+    /// A validated scenario of the task.
+    type Scenario: Send + Sync;
+    /// What the decoders of several scenarios share (simulated once).
+    type Shared: Sync;
+    /// A prepared decoder, shared by the levels with equal
+    /// [`decoder_key`](Self::decoder_key)s.
+    type Decoder: Send + Sync;
+    /// One level, ready to run episodes.
+    type Runner: Send + Sync;
+
+    /// The task's scenario, if `any` is one.
+    fn scenario(any: &AnyScenario) -> Option<&Self::Scenario>;
+
+    /// What the scenario's decoder depends on: scenarios with equal keys
+    /// share one decoder.
+    fn decoder_key(scenario: &Self::Scenario) -> String;
+
+    /// What the decoders of `scenarios` can share.
+    fn shared(scenarios: &[&Self::Scenario]) -> Result<Self::Shared>;
+
+    /// Prepares the scenario's decoder on the path `errp run` takes, with
+    /// `cache` for the accuracy targeting.
+    fn prepare(
+        scenario: &Self::Scenario,
+        shared: &Self::Shared,
+        cache: &dyn TargetingCache,
+    ) -> Result<(Self::Decoder, DecoderInfo)>;
+
+    /// A level of `scenario` with its prepared decoder.
+    fn runner(scenario: &Self::Scenario, decoder: Arc<Self::Decoder>) -> Result<Self::Runner>;
+
+    /// Runs episode `k` of a level from `seed`.
+    fn run_episode(runner: &Self::Runner, k: usize, seed: u64) -> Result<EpisodeRow>;
+
+    /// The words and paper points of a figure of `scenario`'s sweep.
+    fn figure(scenario: &Self::Scenario) -> FigureText;
+}
+
+/// A rate as a CSV field: empty when undefined.
+pub fn rate_field(x: f64) -> String {
+    if x.is_finite() {
+        format_number(x)
+    } else {
+        String::new()
+    }
+}
+
+/// A float in its shortest exact form (`0.3`, `1`, `0.7438`), as CSV files
+/// and labels write it.
+pub fn format_number(x: f64) -> String {
+    format!("{x}")
+}
+
+/// Correct decisions of an accuracy's two classes: (hits on errors, hits on
+/// correct actions, their fraction of all decisions; NaN with none).
+pub fn overall(a: &Accuracy) -> (usize, usize, f64) {
+    let hits_error = (a.error * a.n_error as f64).round() as usize;
+    let hits_correct = (a.correct * a.n_correct as f64).round() as usize;
+    let n = a.n_error + a.n_correct;
+    let acc = if n == 0 {
+        f64::NAN
+    } else {
+        (hits_error + hits_correct) as f64 / n as f64
+    };
+    (hits_error, hits_correct, acc)
+}
