@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
 use clap::ValueEnum;
-use errp_bci::TargetingStep;
+use errp_bci::{MeanAccuracy, TargetingStep};
 use errp_sim::grid::EegMode;
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -22,7 +22,7 @@ pub(crate) struct CalibrateArgs {
     /// strictly between 0.5 and 1. Default: 0.7438, the paper's mean over
     /// subjects with the fixed goals.
     #[arg(long, value_parser = parse_accuracy, conflicts_with = "subject", allow_negative_numbers = true)]
-    pub(crate) accuracy: Option<f64>,
+    pub(crate) accuracy: Option<MeanAccuracy>,
     /// Take the accuracy of a subject of Table 1 (S1..S4) instead.
     #[arg(long)]
     pub(crate) subject: Option<String>,
@@ -83,7 +83,7 @@ pub(crate) struct RunArgs {
     /// Override the decoder's accuracy (mean of the per-class rates, in
     /// (0.5, 1)).
     #[arg(long, value_parser = parse_accuracy, allow_negative_numbers = true)]
-    pub(crate) accuracy: Option<f64>,
+    pub(crate) accuracy: Option<MeanAccuracy>,
     /// Override the number of runs (e-puck scenarios); each run has its own
     /// seed derived from the scenario's.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=100_000))]
@@ -123,20 +123,19 @@ pub(crate) struct Table1Args {
     pub(crate) quiet: bool,
 }
 
-pub(crate) fn parse_accuracy(s: &str) -> Result<f64, String> {
+pub(crate) fn parse_accuracy(s: &str) -> Result<MeanAccuracy, String> {
     let v: f64 = s.trim().parse().map_err(|_| {
         format!(
             "{s:?} is not a number: give a mean accuracy strictly between 0.5 and 1 as a \
                  fraction, e.g. 0.7438"
         )
     })?;
-    errp_bci::check_requested_accuracy(v).map_err(|_| {
+    MeanAccuracy::new(v).map_err(|_| {
         format!(
             "{s} is out of range: give a mean accuracy strictly between 0.5 (chance) and 1 \
              as a fraction, e.g. 0.7438 for 74.38 %"
         )
-    })?;
-    Ok(v)
+    })
 }
 
 pub(crate) fn check_extension(path: &Path, ext: &str, flag: &str) -> Result<()> {

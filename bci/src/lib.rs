@@ -80,7 +80,7 @@ pub use psd::ThetaPsd;
 pub use subjects::{GoalSet, Subject, subject, subjects};
 pub use svm::{SvmDecoder, SvmModel};
 pub use targeting::{
-    SessionParts, TargetingParams, TargetingResult, TargetingStep, check_requested_accuracy,
+    MeanAccuracy, SessionParts, TargetingParams, TargetingResult, TargetingStep,
     inverse_normal_cdf, search_ratio, target_accuracy, target_accuracy_on,
     target_continuous_accuracy,
 };

@@ -57,15 +57,52 @@ pub struct TargetingResult {
     pub steps: Vec<TargetingStep>,
 }
 
-/// Checks a requested accuracy: the mean of two per-class rates, strictly
-/// between chance (0.5) and perfect (1).
-pub fn check_requested_accuracy(requested: f64) -> Result<()> {
-    check(
-        requested.is_finite() && requested > 0.5 && requested < 1.0,
-        "accuracy",
-        requested,
-        "a mean accuracy strictly between 0.5 (chance) and 1, e.g. 0.7438",
-    )
+/// A requested mean accuracy (the mean of the correct- and error-class
+/// rates), checked once where it enters: strictly between chance (0.5) and
+/// perfect (1), the range a real decoder can be targeted at. Every function
+/// that targets an accuracy takes one, so none checks it again.
+#[derive(Debug, Clone, Copy, PartialEq, PartialOrd, Serialize, Deserialize)]
+#[serde(try_from = "f64", into = "f64")]
+pub struct MeanAccuracy(f64);
+
+impl MeanAccuracy {
+    /// `value` if it is in (0.5, 1); otherwise an
+    /// [`InvalidParameter`](BciError::InvalidParameter) naming `accuracy`
+    /// and the range.
+    pub fn new(value: f64) -> Result<Self> {
+        check(
+            value.is_finite() && value > 0.5 && value < 1.0,
+            "accuracy",
+            value,
+            "a mean accuracy strictly between 0.5 (chance) and 1, e.g. 0.7438",
+        )?;
+        Ok(Self(value))
+    }
+
+    /// The accuracy.
+    pub const fn get(self) -> f64 {
+        self.0
+    }
+}
+
+impl TryFrom<f64> for MeanAccuracy {
+    type Error = BciError;
+
+    fn try_from(value: f64) -> Result<Self> {
+        Self::new(value)
+    }
+}
+
+impl From<MeanAccuracy> for f64 {
+    fn from(a: MeanAccuracy) -> f64 {
+        a.0
+    }
+}
+
+impl std::fmt::Display for MeanAccuracy {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.0)
+    }
 }
 
 /// Searches the ErrP-to-noise ratio of `params` so that `classifier`,
@@ -79,14 +116,13 @@ pub fn check_requested_accuracy(requested: f64) -> Result<()> {
 /// The search brackets the target, then interpolates on the probit scale
 /// (accuracy ~ Phi(c r) for an ideal observer), bisecting when that stalls.
 pub fn target_accuracy<C: Classifier>(
-    requested: f64,
+    requested: MeanAccuracy,
     classifier: &C,
     setup: &CalibrationSetup,
     search: &TargetingParams,
     seed: u64,
     progress: impl FnMut(&TargetingStep),
 ) -> Result<TargetingResult> {
-    check_requested_accuracy(requested)?;
     let parts = SessionParts::simulate(setup, seed)?;
     target_accuracy_on(&parts, requested, classifier, setup, search, seed, progress)
 }
@@ -95,14 +131,13 @@ pub fn target_accuracy<C: Classifier>(
 /// shared by every level of a sweep).
 pub fn target_accuracy_on<C: Classifier>(
     parts: &SessionParts,
-    requested: f64,
+    requested: MeanAccuracy,
     classifier: &C,
     setup: &CalibrationSetup,
     search: &TargetingParams,
     seed: u64,
     progress: impl FnMut(&TargetingStep),
 ) -> Result<TargetingResult> {
-    check_requested_accuracy(requested)?;
     let labels = &parts.noise.labels;
     let cv_seed = cv_seed(seed);
     search_ratio(
@@ -207,14 +242,13 @@ impl SessionParts {
 /// schedule and button presses) and cross-validates on it, with the folds of
 /// [`calibrate_continuous`](crate::calibrate_continuous).
 pub fn target_continuous_accuracy(
-    requested: f64,
+    requested: MeanAccuracy,
     classifier: &SvmDecoder,
     setup: &ContinuousSetup,
     search: &TargetingParams,
     seed: u64,
     progress: impl FnMut(&TargetingStep),
 ) -> Result<TargetingResult> {
-    check_requested_accuracy(requested)?;
     setup.validate()?;
     let cv_seed = cv_seed(seed);
     search_ratio(
@@ -242,12 +276,12 @@ pub fn target_continuous_accuracy(
 /// observer), bisecting when that stalls, until within `search.tolerance` or
 /// `search.max_evaluations`. Returns the closest evaluation.
 pub fn search_ratio(
-    requested: f64,
+    requested: MeanAccuracy,
     search: &TargetingParams,
     mut evaluate: impl FnMut(f64) -> Result<Accuracy>,
     mut progress: impl FnMut(&TargetingStep),
 ) -> Result<TargetingResult> {
-    check_requested_accuracy(requested)?;
+    let requested = requested.get();
     let mut steps: Vec<TargetingStep> = Vec::new();
     let mut evaluate = |ratio: f64, steps: &mut Vec<TargetingStep>| -> Result<f64> {
         let accuracy = evaluate(ratio)?;
@@ -377,9 +411,14 @@ mod tests {
     #[test]
     fn requested_accuracy_must_be_above_chance_and_below_one() {
         for bad in [0.5, 1.0, 1.7, -0.2, f64::NAN] {
-            let err = check_requested_accuracy(bad).unwrap_err().to_string();
+            let err = MeanAccuracy::new(bad).unwrap_err().to_string();
             assert!(err.contains("accuracy"), "{err}");
         }
-        assert!(check_requested_accuracy(0.7438).is_ok());
+        assert_eq!(MeanAccuracy::new(0.7438).unwrap().get(), 0.7438);
+        // Deserialized values are checked too.
+        let parse =
+            |text: &str| toml::from_str::<std::collections::BTreeMap<String, MeanAccuracy>>(text);
+        assert_eq!(parse("a = 0.7438").unwrap()["a"].get(), 0.7438);
+        assert!(parse("a = 0.4").is_err());
     }
 }

@@ -16,7 +16,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let accuracy: f64 = args.next().map_or(Ok(0.95), |a| a.parse())?;
     let seed: u64 = args.next().map_or(Ok(1), |a| a.parse())?;
-    let report = run_continuous_calibration(&ContinuousRequest::new(accuracy, seed), |_| {})?;
+    let report = run_continuous_calibration(
+        &ContinuousRequest::new(errp_bci::MeanAccuracy::new(accuracy)?, seed),
+        |_| {},
+    )?;
     let d = ContinuousDecoder::from_report(&report);
     let params = OnlineRecordingParams {
         duration_secs: 1800.0,

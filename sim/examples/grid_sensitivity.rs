@@ -88,7 +88,10 @@ fn main() {
     println!("|---|---|---|---|");
     for accuracy in [0.7438, 0.90] {
         let report = run_calibration(
-            &CalibrationRequest::new(accuracy, 3),
+            &CalibrationRequest::new(
+                errp_bci::MeanAccuracy::new(accuracy).expect("an accuracy in (0.5, 1)"),
+                3,
+            ),
             |_| {},
             SessionOptions::default(),
         )

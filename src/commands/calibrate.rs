@@ -1,7 +1,7 @@
 //! `errp calibrate` and `errp subjects`.
 
 use anyhow::{Context, Result};
-use errp_bci::{EdfWriter, GoalSet, SessionOptions, subject, subjects};
+use errp_bci::{EdfWriter, GoalSet, MeanAccuracy, SessionOptions, subject, subjects};
 use errp_sim::PendingFile;
 use errp_sim::calibration::{
     CalibrationRequest, calibration_recording, record_calibration, run_calibration,
@@ -17,13 +17,16 @@ pub(crate) fn calibrate(args: &CalibrateArgs) -> Result<()> {
                 Goals::Fixed => GoalSet::Fixed,
                 Goals::Free => GoalSet::Free,
             };
-            let a = s.accuracy(goals);
+            let a = MeanAccuracy::new(s.accuracy(goals))?;
             (
                 a,
                 format!("subject {} ({:?} goals)", s.name, goals).to_lowercase(),
             )
         }
-        None => (args.accuracy.unwrap_or(0.7438), "requested".to_string()),
+        None => (
+            args.accuracy.unwrap_or(MeanAccuracy::new(0.7438)?),
+            "requested".to_string(),
+        ),
     };
     if let Some(p) = &args.save {
         check_extension(p, "rrd", "--save")?;
@@ -50,7 +53,7 @@ pub(crate) fn calibrate(args: &CalibrateArgs) -> Result<()> {
     if !args.quiet {
         eprintln!(
             "Targeting a mean accuracy of {:.2} % ({who}), seed {}:",
-            100.0 * accuracy,
+            100.0 * accuracy.get(),
             args.seed
         );
     }
@@ -97,8 +100,8 @@ pub(crate) fn calibrate(args: &CalibrateArgs) -> Result<()> {
     println!(
         "  mean           {:6.2} %   ({who} {:.2} %, off by {:+.2} points)",
         100.0 * a.mean(),
-        100.0 * accuracy,
-        100.0 * (a.mean() - accuracy)
+        100.0 * accuracy.get(),
+        100.0 * (a.mean() - accuracy.get())
     );
     println!(
         "  ErrP-to-noise ratio {:.4}; decoder: {} PCA components, Ledoit-Wolf shrinkage {:.3}",

@@ -21,7 +21,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<()> {
     // they are checked and carried through exactly as the file's own.
     let mut overrides: Vec<(&str, toml::Value)> = Vec::new();
     if let Some(a) = args.accuracy {
-        overrides.push(("user.accuracy", toml::Value::Float(a)));
+        overrides.push(("user.accuracy", toml::Value::Float(a.get())));
     }
     // The file as written is checked first, so that its own errors quote
     // its own lines; the overrides are then set in a copy of its TOML.
@@ -129,7 +129,7 @@ pub(crate) fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<(
     let rrd = open_recording(args, epuck_recording)?;
     let quiet = args.quiet;
     let decoder_text = match scenario.online_target {
-        None => format!("decoder accuracy {:.2} %", 100.0 * scenario.accuracy),
+        None => format!("decoder accuracy {:.2} %", 100.0 * scenario.accuracy.get()),
         Some(t) => format!(
             "decoder calibrated online for {:.1} % hits{}",
             100.0 * t.hit_rate,

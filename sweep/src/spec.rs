@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 use toml::{Table, Value};
 
+use errp_bci::MeanAccuracy;
 use errp_sim::epuck::EpuckTask;
 use errp_sim::grid::GridTask;
 pub use errp_sim::task::format_number;
@@ -240,7 +241,8 @@ pub fn parse_accuracies(text: &str) -> Result<Vec<f64>> {
                 )));
             }
         };
-        if !(a > 0.5 && a <= 1.0) {
+        // 1 is for the oracle; a grid EEG or e-puck scenario refuses it.
+        if !(a == 1.0 || MeanAccuracy::new(a).is_ok()) {
             return Err(SimError::Sweep(format!(
                 "--accuracy {text:?} is invalid: {a} is not a mean accuracy in (0.5, 1) \
                  (e.g. 0.55:0.95:0.05)"

@@ -4,8 +4,8 @@
 //! calibration is deterministic. Seeded; tolerances stated.
 
 use errp_bci::{
-    ContinuousSetup, ErrorModel, SessionOptions, SvmDecoder, TargetingParams, calibrate_continuous,
-    simulate_continuous_session, target_continuous_accuracy,
+    ContinuousSetup, ErrorModel, MeanAccuracy, SessionOptions, SvmDecoder, TargetingParams,
+    calibrate_continuous, simulate_continuous_session, target_continuous_accuracy,
 };
 
 pub(crate) fn setup_at(ratio: f64) -> ContinuousSetup {
@@ -19,7 +19,7 @@ pub(crate) fn rows(x: &errp_bci::Features) -> impl Iterator<Item = Vec<f64>> + '
 fn lands_within_2_points(requested: f64, seed: u64) {
     let decoder = SvmDecoder::default();
     let found = target_continuous_accuracy(
-        requested,
+        MeanAccuracy::new(requested).unwrap(),
         &decoder,
         &ContinuousSetup::default(),
         &TargetingParams::default(),
@@ -84,7 +84,7 @@ fn trained_decoder_rates_fresh_error_windows_higher() {
 fn report_targeting() {
     for (requested, seed) in [(0.80, 1), (0.7438, 1)] {
         let found = target_continuous_accuracy(
-            requested,
+            MeanAccuracy::new(requested).unwrap(),
             &SvmDecoder::default(),
             &ContinuousSetup::default(),
             &TargetingParams::default(),

@@ -5,7 +5,7 @@
 
 use errp_bci::{
     CalibrationParams, CalibrationSetup, Classifier, Components, ErrorModel, Features,
-    GeneratorParams, LdaDecoder, SessionOptions, SessionParts, Shrinkage, SvmDecoder,
+    GeneratorParams, LdaDecoder, MeanAccuracy, SessionOptions, SessionParts, Shrinkage, SvmDecoder,
     TargetingParams, calibrate, calibrate_session, cross_validate, rng::stream, simulate_session,
     target_accuracy,
 };
@@ -147,7 +147,7 @@ fn lands_within_1_5_points(requested: f64, seed: u64) {
     let decoder = LdaDecoder::default();
     let setup = CalibrationSetup::default();
     let found = target_accuracy(
-        requested,
+        MeanAccuracy::new(requested).unwrap(),
         &decoder,
         &setup,
         &TargetingParams::default(),
@@ -203,9 +203,16 @@ fn unreachable_accuracy_is_a_clear_error() {
         max_ratio: 0.3,
         ..TargetingParams::default()
     };
-    let err = target_accuracy(0.99, &LdaDecoder::default(), &setup, &search, 1, |_| {})
-        .unwrap_err()
-        .to_string();
+    let err = target_accuracy(
+        MeanAccuracy::new(0.99).unwrap(),
+        &LdaDecoder::default(),
+        &setup,
+        &search,
+        1,
+        |_| {},
+    )
+    .unwrap_err()
+    .to_string();
     assert!(err.contains("accuracy") && err.contains("largest"), "{err}");
 }
 

@@ -6,8 +6,9 @@ mod view;
 pub use view::{calibration_recording, record_calibration};
 
 use errp_bci::{
-    Calibrated, CalibrationParams, GeneratorParams, LdaDecoder, LdaModel, Protocol, SessionOptions,
-    Setup, TargetingParams, TargetingResult, TargetingStep, calibrate, target_accuracy,
+    Calibrated, CalibrationParams, GeneratorParams, LdaDecoder, LdaModel, MeanAccuracy, Protocol,
+    SessionOptions, Setup, TargetingParams, TargetingResult, TargetingStep, calibrate,
+    target_accuracy,
 };
 
 use crate::error::Result;
@@ -16,8 +17,8 @@ use crate::error::Result;
 /// discrete session or the button-locked one), targeted at a mean accuracy.
 #[derive(Debug, Clone)]
 pub struct Request<P> {
-    /// Requested mean accuracy, in (0.5, 1).
-    pub accuracy: f64,
+    /// Requested mean accuracy.
+    pub accuracy: MeanAccuracy,
     /// Seed of the synthetic user and session.
     pub seed: u64,
     /// EEG model, protocol, preprocessing, montage.
@@ -28,7 +29,7 @@ pub struct Request<P> {
 
 impl<P: Protocol> Request<P> {
     /// A request with the paper's protocol and the default EEG model.
-    pub fn new(accuracy: f64, seed: u64) -> Self {
+    pub fn new(accuracy: MeanAccuracy, seed: u64) -> Self {
         Self {
             accuracy,
             seed,
@@ -45,7 +46,10 @@ impl<P: Protocol> Request<P> {
             setup,
             search,
         } = self;
-        format!("{setup:?} {search:?} accuracy={accuracy:?} seed={seed}")
+        format!(
+            "{setup:?} {search:?} accuracy={:?} seed={seed}",
+            accuracy.get()
+        )
     }
 }
 

@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use errp_bci::{DetectorMode, DetectorParams, OnlineTarget, check_requested_accuracy};
+use errp_bci::{DetectorMode, DetectorParams, MeanAccuracy, OnlineTarget};
 use errp_robot::{GoalLayout, Pose};
 
 use crate::epuck::episode::{EpuckEpisode, EpuckTaskParams};
@@ -38,9 +38,9 @@ pub struct EpuckScenario {
     pub description: String,
     /// Base seed (calibration and runs).
     pub seed: u64,
-    /// The continuous decoder's cross-validated mean accuracy, in (0.5, 1)
-    /// (with an online target: its hit rate, as the device assumes it).
-    pub accuracy: f64,
+    /// The continuous decoder's cross-validated mean accuracy (with an
+    /// online target: its hit rate, as the device assumes it).
+    pub accuracy: MeanAccuracy,
     /// Calibrate for this online operating point instead of the accuracy.
     pub online_target: Option<OnlineTarget>,
     /// Runs of the episode, each from its own derived seed.
@@ -133,11 +133,13 @@ impl EpuckScenario {
         }
 
         let u = &file.user;
-        let online_target = match (u.accuracy, u.hit_rate, u.false_alarms_per_min) {
+        // The accuracy the device assumes (info gain): the cross-validated
+        // accuracy, or the targeted hit rate.
+        let (online_target, accuracy) = match (u.accuracy, u.hit_rate, u.false_alarms_per_min) {
             (Some(a), None, None) => {
-                check_requested_accuracy(a)
+                let a = MeanAccuracy::new(a)
                     .map_err(|e| bad("user.accuracy", a.to_string(), &e.to_string()))?;
-                None
+                (None, a)
             }
             (None, Some(h), fa) => {
                 let target = OnlineTarget {
@@ -155,7 +157,10 @@ impl EpuckScenario {
                          calibrated to meet that false-alarm rate",
                     ));
                 }
-                Some(target)
+                // A hit rate is below 1, so this is a mean accuracy.
+                let assumed = MeanAccuracy::new(h.max(0.51))
+                    .map_err(|e| bad("user.hit_rate", h.to_string(), &e.to_string()))?;
+                (Some(target), assumed)
             }
             (None, None, Some(f)) => {
                 return Err(bad(
@@ -180,12 +185,6 @@ impl EpuckScenario {
                     "either accuracy or hit_rate [and false_alarms_per_min], not both",
                 ));
             }
-        };
-        // The accuracy the device assumes (info gain): the cross-validated
-        // accuracy, or the targeted hit rate.
-        let accuracy = match online_target {
-            None => u.accuracy.unwrap_or(0.0),
-            Some(t) => t.hit_rate.max(0.51),
         };
         if let Some(v) = file.user.fov_deg {
             params.user.fov_rad = v.to_radians();
@@ -267,7 +266,7 @@ impl EpuckScenario {
             p.validate().map_err(|e| table_error(path, "detector", e))?;
         }
         // The device knows its decoder's accuracy from the calibration.
-        params.control.assumed_accuracy = accuracy;
+        params.control.assumed_accuracy = accuracy.get();
         params
             .control
             .validate()

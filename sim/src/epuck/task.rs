@@ -108,7 +108,7 @@ impl Task for EpuckTask {
         let a = prepared.report.calibrated.accuracy;
         let point = prepared.decoder.online.as_ref().map(|o| o.point);
         let info = DecoderInfo {
-            accuracy: s.accuracy,
+            accuracy: s.accuracy.get(),
             kind: "svm".into(),
             calibration_seed: s.seed,
             errp_to_noise: Some(prepared.report.targeting.ratio),
@@ -175,7 +175,7 @@ impl Task for EpuckTask {
                     label: name.to_string(),
                     // The paper gives no accuracy for its continuous
                     // decoder: drawn at the scenario's.
-                    accuracy: s.accuracy,
+                    accuracy: s.accuracy.get(),
                     value: *secs,
                     sd: None,
                 })
@@ -183,7 +183,7 @@ impl Task for EpuckTask {
             paper_label: format!(
                 "paper, {} (one run; drawn at the scenario's {})",
                 s.name,
-                format_number(s.accuracy)
+                format_number(s.accuracy.get())
             ),
         }
     }

@@ -5,8 +5,8 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 use errp_bci::{
-    Accuracy, CalibrationSetup, LdaDecoder, SessionOptions, SessionParts, TargetingStep,
-    calibrate_session, rng::derive_seed, target_accuracy_on,
+    Accuracy, CalibrationSetup, LdaDecoder, MeanAccuracy, SessionOptions, SessionParts,
+    TargetingStep, calibrate_session, rng::derive_seed, target_accuracy_on,
 };
 use errp_robot::{Grid, QTable};
 
@@ -160,7 +160,7 @@ pub fn prepare_grid_decoder(
             cached: false,
         });
     }
-    let request = CalibrationRequest::new(scenario.accuracy, scenario.seed);
+    let request = CalibrationRequest::new(MeanAccuracy::new(scenario.accuracy)?, scenario.seed);
     let simulated;
     let parts = match shared.sessions.get(&scenario.seed) {
         Some(parts) => parts.as_ref(),
@@ -216,7 +216,7 @@ pub fn prepare_grid_decoder(
 /// calibrate` does), with Platt-scaled p(error): for benches, examples and
 /// tests that need one decoder without a scenario.
 pub fn eeg_decoder(accuracy: f64, seed: u64) -> Result<AssessmentDecoder> {
-    let request = CalibrationRequest::new(accuracy, seed);
+    let request = CalibrationRequest::new(MeanAccuracy::new(accuracy)?, seed);
     let report = run_calibration(&request, |_| {}, SessionOptions::default())?;
     let eeg = EegDecoder::from_report(&report, PErrorChoice::Platt);
     Ok(AssessmentDecoder::Eeg(Box::new(eeg)))

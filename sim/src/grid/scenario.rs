@@ -7,7 +7,7 @@
 
 use std::path::{Path, PathBuf};
 
-use errp_bci::{GoalSet, subject};
+use errp_bci::{GoalSet, MeanAccuracy, subject};
 use errp_robot::{Cell, Grid, GridControlParams, QParams, Strategy};
 use rand::Rng;
 use serde::Deserialize;
@@ -219,11 +219,14 @@ impl GridScenario {
                 ));
             }
         };
-        let upper_ok = match file.decoder {
-            DecoderChoice::Oracle => accuracy <= 1.0,
-            DecoderChoice::Eeg => accuracy < 1.0,
+        // A real decoder is targeted at a mean accuracy; the oracle may also
+        // be perfect.
+        let targetable = MeanAccuracy::new(accuracy).is_ok();
+        let ok = match file.decoder {
+            DecoderChoice::Oracle => targetable || accuracy == 1.0,
+            DecoderChoice::Eeg => targetable,
         };
-        if !(accuracy.is_finite() && accuracy > 0.5 && upper_ok) {
+        if !ok {
             return Err(bad(
                 "user.accuracy",
                 accuracy.to_string(),

@@ -1,7 +1,7 @@
 //! The continuous e-puck task end to end: rapier2d arena, synthetic user,
 //! streamed EEG, sliding-window SVM and shared control, with fixed seeds.
 
-use errp_bci::{AssessmentKind, DetectorParams, EegGenerator, SlidingWindow};
+use errp_bci::{AssessmentKind, DetectorParams, EegGenerator, MeanAccuracy, SlidingWindow};
 use errp_robot::{EpuckParams, Pose, Twist};
 use errp_sim::epuck::{
     ArenaSpec, EpuckObserver, EpuckScenario, PhysicsFrame, World, finish_continuous_decoder,
@@ -39,7 +39,7 @@ impl EpuckObserver for Bounds {
 #[test]
 fn at_95_percent_the_robot_reaches_pisa_in_all_of_10_runs_and_never_slides_sideways() {
     let mut s = scenario("mexico_to_pisa.toml");
-    s.accuracy = 0.95;
+    s.accuracy = MeanAccuracy::new(0.95).unwrap();
     s.seed = 11;
     let (decoder, report) = prepare_continuous_decoder(&s, |_| {}).unwrap();
     assert!(
@@ -69,7 +69,7 @@ fn at_chance_the_belief_does_not_find_the_goal() {
     // A decoder calibrated at 55 % fires almost at random: the run should
     // rarely end on Pisa within two minutes.
     let mut s = scenario("mexico_to_pisa.toml");
-    s.accuracy = 0.55;
+    s.accuracy = MeanAccuracy::new(0.55).unwrap();
     s.params.max_secs = 120.0;
     let (decoder, _) = prepare_continuous_decoder(&s, |_| {}).unwrap();
     let results = run_epuck_batch(&s, &decoder, 6).unwrap();

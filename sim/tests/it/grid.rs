@@ -162,7 +162,7 @@ fn an_accuracy_override_reaches_the_info_gain_planner() {
     );
     match errp_sim::load_scenario_with(&path, &over).unwrap() {
         errp_sim::AnyScenario::Epuck(s) => {
-            assert_eq!(s.accuracy, 0.9);
+            assert_eq!(s.accuracy.get(), 0.9);
             assert_eq!(s.params.control.assumed_accuracy, 0.9);
             assert!(s.online_target.is_none());
         }
