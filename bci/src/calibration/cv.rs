@@ -1,0 +1,135 @@
+//! Scoring and training on a session: stratified folds, cross-validation, and
+//! the calibrated decoder.
+
+use rand::seq::SliceRandom;
+
+use super::session::{CalibrationSession, SessionOptions, simulate_session};
+use super::{Accuracy, CalibrationSetup};
+use crate::classify::{Classifier, ErrorModel, Features};
+use crate::error::Result;
+use crate::platt::PlattScaling;
+use crate::rng::{derive_seed, stream};
+
+/// The seed of the cross-validation folds of a session simulated from `seed`
+/// (shared by [`calibrate`] and accuracy targeting, so both score alike).
+pub fn cv_seed(seed: u64) -> u64 {
+    derive_seed(seed, "calibration/cv", 0)
+}
+
+/// A calibrated decoder: the session, its cross-validated accuracy and the
+/// model trained on all of it.
+#[derive(Debug, Clone)]
+pub struct Calibrated<M> {
+    /// The simulated session.
+    pub session: CalibrationSession,
+    /// k-fold cross-validated accuracy.
+    pub accuracy: Accuracy,
+    /// The decoder trained on every trial, for online use.
+    pub model: M,
+    /// Platt scaling of the decision values, fitted on the out-of-fold
+    /// decisions with the session's 20 % error prior removed: a calibrated
+    /// p(error) for online use.
+    pub platt: PlattScaling,
+}
+
+/// Runs a calibration session as the paper did: simulate it, score the
+/// decoder by k-fold cross-validation, train it on every trial.
+pub fn calibrate<C: Classifier>(
+    classifier: &C,
+    setup: &CalibrationSetup,
+    seed: u64,
+    options: SessionOptions<'_>,
+) -> Result<Calibrated<C::Model>> {
+    let session = simulate_session(setup, seed, options)?;
+    calibrate_session(classifier, session, setup.calibration.folds, seed)
+}
+
+/// The second half of [`calibrate`], on a session already simulated (e.g.
+/// by [`SessionParts::session_at`](crate::SessionParts::session_at)): scores
+/// the decoder by `folds`-fold cross-validation and trains it on every trial,
+/// with the folds and the fit seeded from the session's `seed`.
+pub fn calibrate_session<C: Classifier>(
+    classifier: &C,
+    session: CalibrationSession,
+    folds: usize,
+    seed: u64,
+) -> Result<Calibrated<C::Model>> {
+    let decisions = out_of_fold_decisions(
+        classifier,
+        &session.features,
+        &session.labels,
+        folds,
+        cv_seed(seed),
+    )?;
+    let predicted: Vec<bool> = decisions.iter().map(|&d| d >= 0.0).collect();
+    let accuracy = Accuracy::score(&session.labels, &predicted);
+    let platt = PlattScaling::fit(&decisions, &session.labels)?
+        .balanced(accuracy.n_error, accuracy.n_correct);
+    let model = classifier.fit(
+        &session.features,
+        &session.labels,
+        derive_seed(seed, "calibration/fit", 0),
+    )?;
+    Ok(Calibrated {
+        session,
+        accuracy,
+        model,
+        platt,
+    })
+}
+
+/// Stratified k-fold cross-validation: every trial is scored by a model
+/// trained without it. Folds are drawn from `seed`.
+pub fn cross_validate<C: Classifier>(
+    classifier: &C,
+    x: &Features,
+    labels: &[bool],
+    folds: usize,
+    seed: u64,
+) -> Result<Accuracy> {
+    let decisions = out_of_fold_decisions(classifier, x, labels, folds, seed)?;
+    let predicted: Vec<bool> = decisions.iter().map(|&d| d >= 0.0).collect();
+    Ok(Accuracy::score(labels, &predicted))
+}
+
+/// The decision value of every trial from the model of the fold that left
+/// it out (stratified k-fold, folds drawn from `seed`).
+pub fn out_of_fold_decisions<C: Classifier>(
+    classifier: &C,
+    x: &Features,
+    labels: &[bool],
+    folds: usize,
+    seed: u64,
+) -> Result<Vec<f64>> {
+    let fold_of = stratified_folds(labels, folds, seed);
+    let mut decisions = vec![0.0; labels.len()];
+    for k in 0..folds {
+        let train: Vec<usize> = (0..labels.len()).filter(|&i| fold_of[i] != k).collect();
+        let test: Vec<usize> = (0..labels.len()).filter(|&i| fold_of[i] == k).collect();
+        if test.is_empty() {
+            continue;
+        }
+        let xt = x.select_rows(train.iter());
+        let yt: Vec<bool> = train.iter().map(|&i| labels[i]).collect();
+        let model = classifier.fit(&xt, &yt, derive_seed(seed, "cv/fit", k as u64))?;
+        for &i in &test {
+            let row: Vec<f64> = x.row(i).iter().copied().collect();
+            decisions[i] = model.decision(&row);
+        }
+    }
+    Ok(decisions)
+}
+
+/// Fold index of every trial: each class shuffled and dealt round-robin.
+pub fn stratified_folds(labels: &[bool], folds: usize, seed: u64) -> Vec<usize> {
+    let mut rng = stream(seed, "cv/folds");
+    let mut fold_of = vec![0; labels.len()];
+    for class in [false, true] {
+        let mut idx: Vec<usize> = (0..labels.len()).filter(|&i| labels[i] == class).collect();
+        idx.shuffle(&mut rng);
+        for (k, i) in idx.into_iter().enumerate() {
+            fold_of[i] = k % folds;
+        }
+    }
+    fold_of
+}

@@ -1,0 +1,280 @@
+//! Online, asynchronous ErrP detection (sec. 2.2.2 of the paper, and how
+//! asynchronous-ErrP studies score it): the 800 ms window sliding every
+//! 62.5 ms over streamed EEG, the detector that turns its p(error) stream
+//! into error events, and the detector's operating point measured on a
+//! held-out continuous recording.
+//!
+//! Without a cue, a decoder that looks every 62.5 ms has about 16 chances a
+//! second to fire on background EEG, and one ErrP is visible in several
+//! consecutive windows. Asynchronous-ErrP studies therefore do not count
+//! windows: they aggregate consecutive windows into events and score events
+//! per ErrP (a hit when an event follows the ErrP within the decoder's
+//! response span) and per unit of error-free time (false alarms per minute).
+//! [`Detector`] does this; [`DetectorMode::Literal`] keeps the paper's
+//! literal reading (each window against T_e on its own).
+
+use crate::classify::ErrorModel;
+use crate::continuous::ContinuousFeatures;
+use crate::erp::AssessmentKind;
+use crate::error::Result;
+use crate::generator::{Assessment, EegBlock, EegGenerator};
+use crate::montage::Montage;
+use crate::preprocess::Preprocessor;
+use crate::svm::SvmModel;
+
+mod detector;
+mod recording;
+mod targeting;
+
+pub use detector::*;
+pub use recording::*;
+pub use targeting::*;
+
+/// The decoder's window step: 62.5 ms (sec. 2.2.2).
+pub const WINDOW_STEP_SECS: f64 = 0.0625;
+/// Seconds of EEG streamed before a recording so the causal filters settle;
+/// recording time 0 is generator time `WARM_UP_SECS`.
+pub const WARM_UP_SECS: f64 = 2.0;
+
+/// Streamed EEG and the 800 ms window sliding over its preprocessed
+/// channels, one hop of 62.5 ms at a time.
+#[derive(Debug)]
+pub struct SlidingWindow {
+    generator: EegGenerator,
+    preprocessor: Preprocessor,
+    features: ContinuousFeatures,
+    window: EegBlock,
+    scratch: Vec<f64>,
+    raw: EegBlock,
+    /// Rows of FCz and Cz among the preprocessed channels.
+    fcz_cz: [usize; 2],
+}
+
+impl SlidingWindow {
+    /// Starts a stream from `generator` (fresh, at its time 0) through a
+    /// reset copy of `preprocessor`, and lets the filters settle for
+    /// [`WARM_UP_SECS`]: recording time 0 is generator time `WARM_UP_SECS`.
+    pub fn start(
+        mut generator: EegGenerator,
+        preprocessor: &Preprocessor,
+        features: &ContinuousFeatures,
+        montage: &Montage,
+    ) -> Result<Self> {
+        let fs = generator.params().sfreq_hz;
+        let mut preprocessor = preprocessor.clone();
+        preprocessor.reset();
+        let warm = preprocessor.process(&generator.generate((WARM_UP_SECS * fs) as usize));
+        let span = features.span();
+        let mut window = EegBlock::zeros(warm.n_channels, span);
+        for ch in 0..warm.n_channels {
+            let src = warm.channel(ch);
+            window
+                .channel_mut(ch)
+                .copy_from_slice(&src[src.len() - span..]);
+        }
+        let row = |name: &str| -> Result<usize> {
+            let i = montage.index(name)?;
+            Ok(preprocessor
+                .outputs()
+                .iter()
+                .position(|&o| o == i)
+                .unwrap_or(0))
+        };
+        let fcz_cz = [row("FCz")?, row("Cz")?];
+        let hop = (WINDOW_STEP_SECS * fs).round() as usize;
+        Ok(Self {
+            generator,
+            preprocessor,
+            features: features.clone(),
+            window,
+            scratch: Vec::with_capacity(features.n_features(warm.n_channels)),
+            raw: EegBlock::zeros(montage.len(), hop),
+            fcz_cz,
+        })
+    }
+
+    /// Schedules the potential of an assessment at recording time
+    /// `onset_secs` (its time zero).
+    pub fn schedule(&mut self, onset_secs: f64, kind: AssessmentKind) {
+        self.generator.schedule(Assessment {
+            onset_secs: WARM_UP_SECS + onset_secs,
+            kind,
+        });
+    }
+
+    /// Streams one more hop through the preprocessing, slides the window,
+    /// and returns the new preprocessed samples `(n_channels, hop)`.
+    pub fn advance(&mut self) -> EegBlock {
+        self.generator.generate_into(&mut self.raw);
+        let fresh = self.preprocessor.process(&self.raw);
+        let hop = fresh.n_samples;
+        for ch in 0..fresh.n_channels {
+            let w = self.window.channel_mut(ch);
+            w.copy_within(hop.., 0);
+            let n = w.len();
+            w[n - hop..].copy_from_slice(fresh.channel(ch));
+        }
+        fresh
+    }
+
+    /// p(error) of the current window.
+    pub fn p_error(&mut self, model: &SvmModel) -> f64 {
+        self.scratch.clear();
+        self.features
+            .extract_into(&self.window, 0, &mut self.scratch);
+        model.p_error(&self.scratch)
+    }
+
+    /// Rows of FCz and Cz in the blocks [`advance`](Self::advance) returns.
+    pub fn fcz_cz(&self) -> [usize; 2] {
+        self.fcz_cz
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::Rng;
+
+    use super::*;
+    use crate::rng::stream;
+
+    #[test]
+    fn the_literal_detector_fires_on_every_window_at_t_e() {
+        let mut d = Detector::new(DetectorParams::literal(), 0.8).unwrap();
+        let out: Vec<bool> = [0.5, 0.8, 0.9, 0.79, 0.85]
+            .iter()
+            .enumerate()
+            .map(|(k, &p)| d.push(p, k as f64 * WINDOW_STEP_SECS).detected)
+            .collect();
+        assert_eq!(out, [false, true, true, false, true]);
+    }
+
+    #[test]
+    fn the_smoothed_detector_averages_and_then_waits() {
+        let params = DetectorParams {
+            mode: DetectorMode::Smoothed,
+            smooth_windows: 3,
+            refractory_secs: 0.5,
+        };
+        let mut d = Detector::new(params, 0.8).unwrap();
+        // One window at 1.0 among lows never reaches a mean of 0.8.
+        let mut fired = Vec::new();
+        let ps = [
+            0.6, 1.0, 0.6, 0.9, 0.9, 0.9, 0.9, 0.9, 0.9, 0.9, 0.9, 0.9, 0.9,
+        ];
+        for (k, &p) in ps.iter().enumerate() {
+            if d.push(p, k as f64 * WINDOW_STEP_SECS).detected {
+                fired.push(k);
+            }
+        }
+        // Mean of (1.0, 0.6, 0.9) = 0.83 at k = 3 (at k = 2 the mean is
+        // 0.73); the next no earlier than 0.5 s = 8 steps later.
+        assert_eq!(fired, [3, 11]);
+        assert!((params.delay_secs() - 0.125).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bad_detector_settings_are_named() {
+        let e = DetectorParams {
+            smooth_windows: 0,
+            ..DetectorParams::default()
+        }
+        .validate()
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("smooth_windows") && e.contains("1 to 16"), "{e}");
+        let e = Detector::new(DetectorParams::default(), 1.5)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("t_e"), "{e}");
+        let e = OnlineRecordingParams {
+            duration_secs: 1e9,
+            ..OnlineRecordingParams::default()
+        }
+        .validate()
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("duration_secs"), "{e}");
+    }
+
+    #[test]
+    fn scoring_attributes_by_span_and_counts_false_alarms_per_minute() {
+        // 60 s, ErrPs at 10 and 30 s; p = 1 at 10.75 s (a hit, 0.75 s late),
+        // at 20 s (false) and at 31.5 s (outside [0.5, 1.0]: false).
+        let n = (60.0 / WINDOW_STEP_SECS) as usize;
+        let mut p = vec![0.0; n];
+        let at = |t: f64| (t / WINDOW_STEP_SECS).round() as usize - 1;
+        p[at(10.75)] = 1.0;
+        p[at(20.0)] = 1.0;
+        p[at(31.5)] = 1.0;
+        let rec = OnlineRecording {
+            p_error: p,
+            errps: vec![10.0, 30.0],
+        };
+        let span = ResponseSpan {
+            from_secs: 0.5,
+            to_secs: 1.0,
+        };
+        let op = operating_point(
+            &rec,
+            Detector::new(DetectorParams::literal(), 0.8).unwrap(),
+            span,
+        );
+        assert_eq!(op.n_errps, 2);
+        assert!((op.hit_rate - 0.5).abs() < 1e-12);
+        assert!((op.median_latency_secs - 0.75).abs() < 1e-9);
+        // Clean time: 60 s minus two spans of 9 windows each.
+        let clean_min = (n - 18) as f64 * WINDOW_STEP_SECS / 60.0;
+        assert!((op.clean_minutes - clean_min).abs() < 1e-9);
+        assert!((op.false_alarms_per_min - 2.0 / clean_min).abs() < 1e-9);
+    }
+
+    #[test]
+    fn the_threshold_search_meets_a_false_alarm_rate() {
+        // Background p(error) uniform in [0, 1) per window (seeded): the
+        // literal detector's false alarms fall as T_e rises.
+        let mut rng = stream(3, "test");
+        let n = (600.0 / WINDOW_STEP_SECS) as usize;
+        let p: Vec<f64> = (0..n).map(|_| rng.random::<f64>()).collect();
+        let rec = OnlineRecording {
+            p_error: p,
+            errps: vec![100.0],
+        };
+        let (t_e, op) = threshold_for_false_alarms(&rec, DetectorParams::literal(), 30.0).unwrap();
+        assert!((op.false_alarms_per_min - 30.0).abs() < 3.0, "{t_e} {op:?}");
+        // 16 windows a second: 30 a minute is a per-window rate of 1/32.
+        assert!((t_e - (1.0 - 1.0 / 32.0)).abs() < 0.01, "{t_e}");
+        let bad = OnlineTarget {
+            hit_rate: 1.5,
+            false_alarms_per_min: None,
+        }
+        .validate()
+        .unwrap_err()
+        .to_string();
+        assert!(bad.contains("hit_rate") && bad.contains("(0, 1)"), "{bad}");
+    }
+
+    #[test]
+    fn the_response_span_is_where_windows_respond() {
+        // Windows respond (p = 0.9) from 0.6 to 1.0 s after each ErrP, with
+        // a few background false positives.
+        let n = (300.0 / WINDOW_STEP_SECS) as usize;
+        let errps: Vec<f64> = (0..50).map(|k| 3.0 + 5.0 * k as f64).collect();
+        let mut p = vec![0.1; n];
+        for &o in &errps {
+            for k in 0..n {
+                let lag = OnlineRecording::window_end_secs(k) - o;
+                if (0.6 - 1e-9..=1.0 + 1e-9).contains(&lag) {
+                    p[k] = 0.9;
+                }
+            }
+        }
+        for k in (7..n).step_by(97) {
+            p[k] = 0.95;
+        }
+        let rec = OnlineRecording { p_error: p, errps };
+        let s = response_span(&rec, 0.8, 0.25);
+        assert!((s.from_secs - 0.625).abs() < 0.07, "{s:?}");
+        assert!((s.to_secs - 1.0).abs() < 0.07, "{s:?}");
+    }
+}
