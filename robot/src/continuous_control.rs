@@ -364,7 +364,10 @@ impl ContinuousController {
 
     fn stop(&self, time_secs: f64, reason: StopReason) -> Phase {
         let secs = match reason {
-            StopReason::OnGoal(_) => self.params.stop_secs.max(self.params.goal_hold_secs),
+            StopReason::OnGoal(_) => {
+                let hold = self.params.goal_hold_secs.unwrap_or(0.0);
+                self.params.stop_secs.max(hold)
+            }
             StopReason::ErrorDetected => self.params.stop_secs,
         };
         Phase::Stopped {
@@ -403,7 +406,8 @@ impl ContinuousController {
                         return WheelSpeeds::ZERO;
                     }
                     if let StopReason::OnGoal(j) = reason {
-                        self.left_goal = Some((j, time_secs + self.params.veto_window_secs));
+                        let window = self.params.veto_window_secs.unwrap_or(0.0);
+                        self.left_goal = Some((j, time_secs + window));
                     }
                 }
                 Phase::Turning => {
@@ -619,8 +623,8 @@ mod tests {
         let l = GoalLayout::cities();
         let start = on(&l, "Mexico", 0.0);
         let held = ContinuousControlParams {
-            goal_hold_secs: 1.8,
-            veto_window_secs: 1.2,
+            goal_hold_secs: Some(1.8),
+            veto_window_secs: Some(1.2),
             ..params()
         };
         let mut c = ContinuousController::new(held, l, start).unwrap();

@@ -11,7 +11,11 @@ use crate::pose::wrap_angle;
 use crate::strategy::Strategy;
 
 /// Parameters of the continuous strategy (sec. 5.2) and of the motion
-/// (sec. 5.1).
+/// (sec. 5.1), as a scenario file's `[control]` table holds them
+/// (deserialized straight into this type; missing fields take the defaults,
+/// unknown ones are refused). The controller's tuning below the paper's
+/// level (alignment, heading gain, goal radius, the robot's constants) and
+/// the assumed accuracy are not read from a file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ContinuousControlParams {
@@ -38,12 +42,15 @@ pub struct ContinuousControlParams {
     pub stop_secs: f64,
     /// Least length of a stop on a goal, s: the time the user's verdict on
     /// the arrival needs to reach the decoder (0: `stop_secs`, the paper's
-    /// literal stop). In [0, 10].
-    pub goal_hold_secs: f64,
+    /// literal stop). In [0, 10]. `None`: left to whoever runs the
+    /// controller (the testbed derives it from the detector's response
+    /// span); the controller itself reads it as 0.
+    pub goal_hold_secs: Option<f64>,
     /// After the robot leaves a goal, a detected error within this time is
     /// the user's late verdict on the stop (a veto of that goal), not on the
     /// new motion, s (0: none, the paper read literally). In [0, 10].
-    pub veto_window_secs: f64,
+    /// `None`: as for `goal_hold_secs`.
+    pub veto_window_secs: Option<f64>,
     /// Forward speed while driving, as a fraction of the top speed. In (0, 1].
     pub drive_speed_fraction: f64,
     /// Wheel speed while turning in place (one wheel forwards, one
@@ -51,14 +58,18 @@ pub struct ContinuousControlParams {
     pub turn_speed_fraction: f64,
     /// A turn ends when the bearing to the target is below this, deg. In
     /// (0, 90).
+    #[serde(skip)]
     pub align_tolerance_deg: f64,
     /// Proportional heading correction while driving, rad/s per rad of
     /// bearing. >= 0.
+    #[serde(skip)]
     pub heading_gain: f64,
     /// The robot has reached (is "on") a goal within this distance, m. > 0,
     /// and less than half the distance between the two closest goals.
+    #[serde(skip)]
     pub goal_radius_m: f64,
     /// The robot's constants (top speed, axle length).
+    #[serde(skip)]
     pub epuck: EpuckParams,
     /// How the next goal to head for is chosen after a stop (the paper:
     /// greedy, the most probable goal). Greedy or info gain:
@@ -68,7 +79,9 @@ pub struct ContinuousControlParams {
     /// The decoder accuracy the device assumes when it predicts the
     /// decoder's outcomes for [`Strategy::InfoGain`]: the probability of a
     /// detection (p(error) >= T_e) when the user judges the motion wrong, and
-    /// of none when the user judges it right. In (0.5, 1].
+    /// of none when the user judges it right. In (0.5, 1]. The device knows
+    /// it from the calibration.
+    #[serde(skip)]
     pub assumed_accuracy: f64,
 }
 
@@ -82,8 +95,8 @@ impl Default for ContinuousControlParams {
             sigma_deg: 20.0,
             p_c: 0.4,
             stop_secs: 1.0,
-            goal_hold_secs: 0.0,
-            veto_window_secs: 0.0,
+            goal_hold_secs: None,
+            veto_window_secs: None,
             drive_speed_fraction: 0.5,
             turn_speed_fraction: 0.25,
             align_tolerance_deg: 3.0,
@@ -126,18 +139,14 @@ impl ContinuousControlParams {
             self.stop_secs,
             "in (0, 10] s (the paper: 1)",
         )?;
-        check(
-            (0.0..=10.0).contains(&self.goal_hold_secs),
-            "goal_hold_secs",
-            self.goal_hold_secs,
-            "in [0, 10] s",
-        )?;
-        check(
-            (0.0..=10.0).contains(&self.veto_window_secs),
-            "veto_window_secs",
-            self.veto_window_secs,
-            "in [0, 10] s",
-        )?;
+        for (name, v) in [
+            ("goal_hold_secs", self.goal_hold_secs),
+            ("veto_window_secs", self.veto_window_secs),
+        ] {
+            if let Some(v) = v {
+                check((0.0..=10.0).contains(&v), name, v, "a time in [0, 10] s")?;
+            }
+        }
         check(
             half_open01(self.drive_speed_fraction),
             "drive_speed_fraction",

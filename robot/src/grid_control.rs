@@ -10,7 +10,9 @@ use crate::grid::{Cell, Grid, GridAction};
 use crate::qvalues::{QParams, QTable};
 use crate::strategy::{Strategy, gain_from_logs};
 
-/// Parameters of the grid strategy.
+/// Parameters of the grid strategy, as a scenario file's `[control]` table
+/// holds them (deserialized straight into this type; missing fields take
+/// the defaults, unknown ones are refused).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct GridControlParams {
@@ -22,12 +24,19 @@ pub struct GridControlParams {
     /// Convergence: the run ends when one goal's probability reaches this;
     /// the paper: 0.9.
     pub p_c: f64,
-    /// Reward model of the Q-values.
-    pub q: QParams,
+    /// Discount factor gamma of the Q-values' reward model ([`QParams`]), in
+    /// [0, 1).
+    pub discount: f64,
+    /// Reward of goal-reached on the goal ([`QParams`]).
+    pub goal_reward: f64,
+    /// Reward of goal-reached anywhere else ([`QParams`]).
+    pub wrong_goal_reward: f64,
     /// How the non-random actions are chosen (the paper: greedy).
     pub strategy: Strategy,
     /// The decoder accuracy the device assumes when it predicts the
-    /// decoder's outcomes for [`Strategy::InfoGain`]. In (0.5, 1].
+    /// decoder's outcomes for [`Strategy::InfoGain`]. In (0.5, 1]. Not read
+    /// from a file: the device knows it from the calibration.
+    #[serde(skip)]
     pub assumed_accuracy: f64,
 }
 
@@ -37,7 +46,9 @@ impl Default for GridControlParams {
             tau: 0.3,
             epsilon: 0.1,
             p_c: 0.9,
-            q: QParams::default(),
+            discount: QParams::default().discount,
+            goal_reward: QParams::default().goal_reward,
+            wrong_goal_reward: QParams::default().wrong_goal_reward,
             strategy: Strategy::Greedy,
             assumed_accuracy: 0.75,
         }
@@ -45,6 +56,15 @@ impl Default for GridControlParams {
 }
 
 impl GridControlParams {
+    /// The reward model of the Q-values.
+    pub fn q(&self) -> QParams {
+        QParams {
+            goal_reward: self.goal_reward,
+            wrong_goal_reward: self.wrong_goal_reward,
+            discount: self.discount,
+        }
+    }
+
     /// Checks every field; messages name the field and the accepted range.
     pub fn validate(&self) -> Result<()> {
         check(
@@ -72,7 +92,7 @@ impl GridControlParams {
             a,
             "a mean accuracy in (0.5, 1]",
         )?;
-        self.q.validate()
+        self.q().validate()
     }
 }
 
@@ -120,7 +140,7 @@ impl GridController {
     /// A controller with a uniform belief over every cell of `grid`.
     pub fn new(grid: Grid, params: GridControlParams) -> Result<Self> {
         params.validate()?;
-        let table = QTable::compute(grid, &params.q)?;
+        let table = QTable::compute(grid, &params.q())?;
         Ok(Self::with_table(table, params))
     }
 

@@ -10,7 +10,7 @@
 //! `cargo run -p errp_sim --example grid_sensitivity` (a few minutes).
 
 use errp_bci::SessionOptions;
-use errp_robot::{Grid, QParams, QTable};
+use errp_robot::{Grid, QTable};
 use errp_sim::calibration::{CalibrationRequest, run_calibration};
 use errp_sim::grid::{
     AssessmentDecoder, EegDecoder, FIXED_PAIRS, GridTaskParams, PErrorChoice, run_grid_episode,
@@ -106,12 +106,9 @@ fn main() {
             };
             let mut params = GridTaskParams::default();
             params.control.epsilon = v.epsilon;
-            params.control.q = QParams {
-                discount: v.discount,
-                goal_reward: v.reward,
-                ..QParams::default()
-            };
-            let table = QTable::compute(Grid::paper(), &params.control.q).expect("Q-values");
+            params.control.discount = v.discount;
+            params.control.goal_reward = v.reward;
+            let table = QTable::compute(Grid::paper(), &params.control.q()).expect("Q-values");
             let mut reached = 0;
             let mut actions = Vec::new();
             for k in 0..100 {

@@ -86,7 +86,7 @@ fn measure(strategy: Strategy, accuracy: f64, n: u64) -> Summary {
         strategy,
         ..GridControlParams::default()
     };
-    let table = QTable::compute(grid, &params.q).unwrap();
+    let table = QTable::compute(grid, &params.q()).unwrap();
     let mut pairs = stream(2013, 0);
     let (mut right, mut actions, mut not_greedy) = (0, 0, 0);
     for k in 0..n {

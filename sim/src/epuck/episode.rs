@@ -36,15 +36,6 @@ pub struct EpuckTaskParams {
     pub avoidance: AvoidanceParams,
     /// How window outputs become detected errors.
     pub detector: DetectorParams,
-    /// Least length of a stop on a goal (s); `None`: long enough for the
-    /// user's verdict on the arrival to reach the detector (the user's
-    /// motion window + reaction latency + the end of the detector's measured
-    /// response span).
-    pub goal_hold_secs: Option<f64>,
-    /// After the robot leaves a goal, detections within this time veto the
-    /// goal instead of stopping the robot (s); `None`: the end of the
-    /// detector's measured response span.
-    pub veto_window_secs: Option<f64>,
     /// The episode gives up after this long (s).
     pub max_secs: f64,
 }
@@ -53,8 +44,9 @@ impl EpuckTaskParams {
     /// The stop on a goal that lets the user's verdict reach a detector that
     /// responds over `span` after an ErrP's time zero: the user needs up to
     /// the motion window to see the stop and the reaction latency to react.
+    /// `control.goal_hold_secs` when the scenario sets it.
     pub fn goal_hold_secs(&self, span: &ResponseSpan) -> f64 {
-        self.goal_hold_secs.unwrap_or(
+        self.control.goal_hold_secs.unwrap_or(
             self.user.motion_window_secs + self.user.reaction_latency_secs + span.to_secs,
         )
     }
@@ -68,8 +60,6 @@ impl Default for EpuckTaskParams {
             tracker: TrackerParams::default(),
             avoidance: AvoidanceParams::default(),
             detector: DetectorParams::default(),
-            goal_hold_secs: None,
-            veto_window_secs: None,
             max_secs: 600.0,
         }
     }
@@ -248,8 +238,10 @@ pub fn run_epuck_episode(
     let span = decoder.detection_span();
     let window_span = decoder.window_span();
     let mut control = params.control.clone();
-    control.goal_hold_secs = params.goal_hold_secs(&span);
-    control.veto_window_secs = params.veto_window_secs.unwrap_or(span.to_secs);
+    // Left open by the scenario: long enough for the user's verdict on the
+    // arrival to reach the detector, and the end of its response span.
+    control.goal_hold_secs = Some(params.goal_hold_secs(&span));
+    control.veto_window_secs = Some(params.control.veto_window_secs.unwrap_or(span.to_secs));
     let mut controller = ContinuousController::new(control, layout.clone(), episode.start)?;
     let t_e = decoder.t_e(params.control.t_e);
     let mut detector = Detector::new(params.detector, t_e)?;

@@ -9,7 +9,7 @@ use errp_bci::{DetectorMode, DetectorParams, MeanAccuracy, OnlineTarget};
 use errp_robot::{GoalLayout, Pose};
 
 use crate::epuck::episode::{EpuckEpisode, EpuckTaskParams};
-use crate::epuck::schema::{EpuckFile, StartFile, c_opt};
+use crate::epuck::schema::{EpuckFile, StartFile};
 use crate::epuck::world::{ArenaSpec, Obstacle};
 use crate::error::{Result, SimError};
 use crate::scenario_file::{field_error, parse_toml, read_scenario, robot_error, scenario_name};
@@ -65,6 +65,9 @@ impl EpuckScenario {
     /// Validates scenario text; `path` names it in errors.
     pub fn parse(text: &str, path: &Path) -> Result<Self> {
         let file: EpuckFile = parse_toml(text, path)?;
+        // Whether a key was written (the typed tables hold defaults).
+        let raw: toml::Table = parse_toml(text, path)?;
+        let given = |table: &str, key: &str| raw.get(table).and_then(|t| t.get(key)).is_some();
         let bad =
             |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
         if file.task != "epuck" {
@@ -149,7 +152,7 @@ impl EpuckScenario {
                 target
                     .validate()
                     .map_err(|e| table_error(path, "user", e))?;
-                if fa.is_some() && file.control.as_ref().is_some_and(|c| c.t_e.is_some()) {
+                if fa.is_some() && given("control", "t_e") {
                     return Err(bad(
                         "control.t_e",
                         "given".into(),
@@ -200,45 +203,7 @@ impl EpuckScenario {
             .validate()
             .map_err(|e| SimError::Scenario(format!("{}: {e}", path.display())))?;
 
-        if let Some(c) = &file.control {
-            let p = &mut params.control;
-            let set = |dst: &mut f64, v: Option<f64>| {
-                if let Some(v) = v {
-                    *dst = v;
-                }
-            };
-            set(&mut p.t_e, c.t_e);
-            set(&mut p.k_turn, c.k_turn);
-            set(&mut p.k_p, c.k_p);
-            set(&mut p.k_n, c.k_n);
-            set(&mut p.sigma_deg, c.sigma_deg);
-            set(&mut p.p_c, c.p_c);
-            set(&mut p.stop_secs, c.stop_secs);
-            set(&mut p.drive_speed_fraction, c.drive_speed_fraction);
-            set(&mut p.turn_speed_fraction, c.turn_speed_fraction);
-            if let Some(strategy) = c.strategy {
-                p.strategy = strategy;
-            }
-        }
-        for (field, v) in [
-            ("goal_hold_secs", c_opt(&file.control, |c| c.goal_hold_secs)),
-            (
-                "veto_window_secs",
-                c_opt(&file.control, |c| c.veto_window_secs),
-            ),
-        ] {
-            if let Some(v) = v
-                && !(v.is_finite() && (0.0..=10.0).contains(&v))
-            {
-                return Err(bad(
-                    &format!("control.{field}"),
-                    v.to_string(),
-                    "a time in [0, 10] s (omit it for the automatic value)",
-                ));
-            }
-        }
-        params.goal_hold_secs = c_opt(&file.control, |c| c.goal_hold_secs);
-        params.veto_window_secs = c_opt(&file.control, |c| c.veto_window_secs);
+        params.control = file.control.clone();
         if let Some(d) = &file.detector {
             let p = &mut params.detector;
             if let Some(m) = d.mode {
@@ -432,6 +397,26 @@ accuracy = 0.7438
         EpuckScenario::parse(text, Path::new("scenarios/x.toml"))
             .unwrap_err()
             .to_string()
+    }
+
+    #[test]
+    fn control_is_the_robots_own_type_and_refuses_what_a_file_may_not_set() {
+        let s = EpuckScenario::parse(
+            &format!("{OK}[control]\nt_e = 0.7\ngoal_hold_secs = 2.5\nstrategy = \"info_gain\"\n"),
+            Path::new("x.toml"),
+        )
+        .unwrap();
+        assert_eq!(s.params.control.t_e, 0.7);
+        assert_eq!(s.params.control.goal_hold_secs, Some(2.5));
+        // Omitted: left to the episode, which derives it from the detector.
+        assert_eq!(s.params.control.veto_window_secs, None);
+        assert_eq!(s.params.control.strategy, errp_robot::Strategy::InfoGain);
+        // The device's assumed accuracy comes from the calibration, and the
+        // controller's own tuning is not a scenario field.
+        for key in ["assumed_accuracy = 0.9", "heading_gain = 1", "tua = 0.3"] {
+            let e = err(&format!("{OK}[control]\n{key}\n"));
+            assert!(e.contains("unknown field") && e.contains("line 8"), "{e}");
+        }
     }
 
     #[test]

@@ -3,7 +3,7 @@
 //! converts centimetres and degrees to SI).
 
 use errp_bci::DetectorMode;
-use errp_robot::Strategy;
+use errp_robot::ContinuousControlParams;
 use serde::Deserialize;
 
 #[derive(Debug, Deserialize)]
@@ -25,8 +25,9 @@ pub(crate) struct EpuckFile {
     #[serde(default = "default_max_secs")]
     pub(crate) max_secs: f64,
     pub(crate) user: UserFile,
+    /// Straight into the robot's type: its field names are the file's.
     #[serde(default)]
-    pub(crate) control: Option<ControlFile>,
+    pub(crate) control: ContinuousControlParams,
     #[serde(default)]
     pub(crate) tracker: Option<TrackerFile>,
     #[serde(default)]
@@ -81,23 +82,6 @@ pub(crate) struct UserFile {
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub(crate) struct ControlFile {
-    pub(crate) t_e: Option<f64>,
-    pub(crate) k_turn: Option<f64>,
-    pub(crate) k_p: Option<f64>,
-    pub(crate) k_n: Option<f64>,
-    pub(crate) sigma_deg: Option<f64>,
-    pub(crate) p_c: Option<f64>,
-    pub(crate) stop_secs: Option<f64>,
-    pub(crate) drive_speed_fraction: Option<f64>,
-    pub(crate) turn_speed_fraction: Option<f64>,
-    pub(crate) goal_hold_secs: Option<f64>,
-    pub(crate) veto_window_secs: Option<f64>,
-    pub(crate) strategy: Option<Strategy>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub(crate) struct TrackerFile {
     pub(crate) rate_hz: Option<f64>,
     pub(crate) position_noise_cm: Option<f64>,
@@ -128,12 +112,4 @@ pub(crate) struct ObstacleFile {
     pub(crate) radius_cm: Option<f64>,
     #[serde(default)]
     pub(crate) angle_deg: f64,
-}
-
-/// `f` of the `[control]` table, if there is one.
-pub(crate) fn c_opt(
-    c: &Option<ControlFile>,
-    f: impl Fn(&ControlFile) -> Option<f64>,
-) -> Option<f64> {
-    c.as_ref().and_then(f)
 }

@@ -230,7 +230,7 @@ pub fn run_grid_scenario(
     record_steps: bool,
     mut on_episode: impl FnMut(usize, &GridEpisodeResult),
 ) -> Result<Vec<GridEpisodeResult>> {
-    let table = QTable::compute(Grid::paper(), &scenario.params.control.q)?;
+    let table = QTable::compute(Grid::paper(), &scenario.params.control.q())?;
     let mut out = Vec::with_capacity(scenario.episodes.len());
     for (k, &(start, goal)) in scenario.episodes.iter().enumerate() {
         let seed = derive_seed(scenario.seed, "grid/episode", k as u64);

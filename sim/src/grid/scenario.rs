@@ -8,7 +8,7 @@
 use std::path::{Path, PathBuf};
 
 use errp_bci::{GoalSet, MeanAccuracy, subject};
-use errp_robot::{Cell, Grid, GridControlParams, QParams, Strategy};
+use errp_robot::{Cell, Grid, GridControlParams};
 use rand::Rng;
 use serde::Deserialize;
 
@@ -52,8 +52,9 @@ struct ScenarioFile {
     free_goals: Option<FreeGoalsFile>,
     #[serde(default = "default_repeats")]
     repeats: usize,
+    /// Straight into the robot's type: its field names are the file's.
     #[serde(default)]
-    control: Option<ControlFile>,
+    control: GridControlParams,
     #[serde(default)]
     timing: Option<TimingFile>,
 }
@@ -117,18 +118,6 @@ struct EpisodeFile {
 #[serde(deny_unknown_fields)]
 struct FreeGoalsFile {
     count: usize,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ControlFile {
-    tau: Option<f64>,
-    epsilon: Option<f64>,
-    p_c: Option<f64>,
-    discount: Option<f64>,
-    goal_reward: Option<f64>,
-    wrong_goal_reward: Option<f64>,
-    strategy: Option<Strategy>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -235,23 +224,10 @@ impl GridScenario {
         }
 
         // Strategy and timing, on top of the paper's defaults.
-        let mut params = GridTaskParams::default();
-        if let Some(c) = &file.control {
-            let d = GridControlParams::default();
-            let q = QParams::default();
-            params.control = GridControlParams {
-                tau: c.tau.unwrap_or(d.tau),
-                epsilon: c.epsilon.unwrap_or(d.epsilon),
-                p_c: c.p_c.unwrap_or(d.p_c),
-                q: QParams {
-                    discount: c.discount.unwrap_or(q.discount),
-                    goal_reward: c.goal_reward.unwrap_or(q.goal_reward),
-                    wrong_goal_reward: c.wrong_goal_reward.unwrap_or(q.wrong_goal_reward),
-                },
-                strategy: c.strategy.unwrap_or(d.strategy),
-                assumed_accuracy: d.assumed_accuracy,
-            };
-        }
+        let mut params = GridTaskParams {
+            control: file.control,
+            ..GridTaskParams::default()
+        };
         // The device knows its decoder's accuracy from the calibration.
         params.control.assumed_accuracy = accuracy;
         params

@@ -65,7 +65,7 @@ pub fn run_table1(
     progress: impl Fn(&str, &TargetingStep) + Sync,
 ) -> Result<Vec<Table1Cell>> {
     let grid = Grid::paper();
-    let table = QTable::compute(grid, &options.params.control.q)?;
+    let table = QTable::compute(grid, &options.params.control.q())?;
     let jobs: Vec<(String, GoalSet, f64, usize)> = subjects()
         .into_iter()
         .enumerate()

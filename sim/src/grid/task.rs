@@ -134,7 +134,7 @@ impl Task for GridTask {
         Ok(GridRunner {
             scenario: s.clone(),
             decoder,
-            table: QTable::compute(Grid::paper(), &s.params.control.q)?,
+            table: QTable::compute(Grid::paper(), &s.params.control.q())?,
         })
     }
 

@@ -20,7 +20,7 @@ fn streamed(accuracy: f64, seed: u64) -> EegDecoder {
 }
 
 pub(crate) fn table(params: &GridTaskParams) -> QTable {
-    QTable::compute(Grid::paper(), &params.control.q).unwrap()
+    QTable::compute(Grid::paper(), &params.control.q()).unwrap()
 }
 
 fn episodes(
