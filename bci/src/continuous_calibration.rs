@@ -7,7 +7,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::calibration::{
     Accuracy, Calibrated, CalibrationParams, CalibrationSession, CalibrationSetup, Protocol,
-    SessionOptions, Setup, check_intervals, cv_seed, out_of_fold_decisions, simulate_session_with,
+    SessionOptions, Setup, check_eog_session, check_intervals, cv_seed, out_of_fold_decisions,
+    simulate_session_with,
 };
 use crate::classify::Classifier;
 use crate::continuous::ContinuousFeatures;
@@ -74,12 +75,7 @@ impl ContinuousCalibrationParams {
             self.trigger_jitter_ms,
             "an SD in [0, 200] ms",
         )?;
-        check(
-            self.eog_session_secs >= 15.0 && self.eog_session_secs.is_finite(),
-            "eog_session_secs",
-            self.eog_session_secs,
-            "at least 15 s",
-        )?;
+        check_eog_session(self.eog_session_secs)?;
         check(
             self.folds >= 2 && self.folds <= self.per_class,
             "folds",

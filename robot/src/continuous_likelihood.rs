@@ -139,14 +139,13 @@ impl ContinuousControlParams {
             self.stop_secs,
             "in (0, 10] s (the paper: 1)",
         )?;
-        for (name, v) in [
-            ("goal_hold_secs", self.goal_hold_secs),
-            ("veto_window_secs", self.veto_window_secs),
-        ] {
-            if let Some(v) = v {
-                check((0.0..=10.0).contains(&v), name, v, "a time in [0, 10] s")?;
-            }
-        }
+        let optional_secs = |name, v: Option<f64>| {
+            v.map_or(Ok(()), |v| {
+                check((0.0..=10.0).contains(&v), name, v, "a time in [0, 10] s")
+            })
+        };
+        optional_secs("goal_hold_secs", self.goal_hold_secs)?;
+        optional_secs("veto_window_secs", self.veto_window_secs)?;
         check(
             half_open01(self.drive_speed_fraction),
             "drive_speed_fraction",

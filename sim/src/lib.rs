@@ -31,7 +31,7 @@ mod stats;
 pub mod task;
 
 pub use error::{Result, SimError};
-pub use output::{PendingFile, write_atomic};
+pub use output::{PendingFile, create_dir, write_atomic};
 pub use paper::{PAPER, PAPER_EPUCK, PAPER_POOLED};
 pub use scenario::{AnyScenario, is_epuck, load_scenario, load_scenario_with, parse_scenario};
 pub use scenario_file::{parse_toml, read_scenario, set_key};

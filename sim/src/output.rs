@@ -5,6 +5,14 @@ use std::path::{Path, PathBuf};
 
 use crate::error::{Result, SimError};
 
+/// Creates directory `dir` and its parents (an existing one is fine).
+pub fn create_dir(dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|source| SimError::Output {
+        path: dir.to_path_buf(),
+        source,
+    })
+}
+
 /// A file being written under a temporary name next to its destination. It
 /// is renamed into place by [`PendingFile::commit`]; dropped uncommitted (an
 /// error, a panic, Ctrl-C unwinding), the temporary is removed, so a failed

@@ -61,10 +61,7 @@ impl TargetCache {
 
     fn store(path: &Path, entry: &Entry) -> Result<()> {
         if let Some(parent) = path.parent() {
-            std::fs::create_dir_all(parent).map_err(|source| errp_sim::SimError::Output {
-                path: parent.to_path_buf(),
-                source,
-            })?;
+            errp_sim::create_dir(parent)?;
         }
         let text = serde_json::to_string(entry).expect("a targeting result serialises");
         write_atomic(path, text.as_bytes())

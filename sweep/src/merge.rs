@@ -6,7 +6,7 @@ use std::io::{BufRead, BufReader, BufWriter, Lines, Write};
 use std::path::{Path, PathBuf};
 
 use errp_sim::PendingFile;
-use errp_sim::{Result, SimError};
+use errp_sim::{Result, SimError, create_dir};
 
 use crate::finish::finish_dir;
 use crate::manifest::{EPISODES, MANIFEST, Manifest};
@@ -84,10 +84,7 @@ pub fn merge_sweeps(dirs: &[PathBuf], out: &Path) -> Result<SweepReport> {
             out.display()
         )));
     }
-    std::fs::create_dir_all(out).map_err(|source| SimError::Output {
-        path: out.to_path_buf(),
-        source,
-    })?;
+    create_dir(out)?;
 
     // Episode g of the sweep is row g / count of shard g % count + 1.
     let header = episodes_header(&spec);

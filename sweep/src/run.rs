@@ -11,7 +11,7 @@ use std::sync::atomic::AtomicBool;
 use errp_sim::epuck::EpuckTask;
 use errp_sim::grid::GridTask;
 use errp_sim::task::Task;
-use errp_sim::{Result, SimError};
+use errp_sim::{Result, SimError, create_dir};
 
 use crate::cache::TargetCache;
 use crate::manifest::{EPISODES, MANIFEST, Manifest};
@@ -91,10 +91,7 @@ pub fn run_sweep(
                 out.display()
             )));
         }
-        std::fs::create_dir_all(out).map_err(|source| SimError::Output {
-            path: out.clone(),
-            source,
-        })?;
+        create_dir(out)?;
         fresh.write(out)?;
     }
 

@@ -66,12 +66,7 @@ impl CalibrationParams {
             self.interval_max_secs,
             "an epoch lasts 0.8 s",
         )?;
-        check(
-            self.eog_session_secs >= 15.0 && self.eog_session_secs.is_finite(),
-            "eog_session_secs",
-            self.eog_session_secs,
-            "at least 15 s",
-        )?;
+        check_eog_session(self.eog_session_secs)?;
         check(self.folds >= 2, "folds", self.folds, "at least 2")
     }
 }
@@ -230,6 +225,17 @@ impl<P: Protocol> Setup<P> {
 
 /// The setup of the discrete calibration session (sec. 2.2).
 pub type CalibrationSetup = Setup<CalibrationParams>;
+
+/// Checks the length of a protocol's EOG recording (for the regression
+/// weights): at least 15 s.
+pub(crate) fn check_eog_session(secs: f64) -> Result<()> {
+    check(
+        secs >= 15.0 && secs.is_finite(),
+        "eog_session_secs",
+        secs,
+        "at least 15 s",
+    )
+}
 
 /// Checks the bounds of the uniform interval between a protocol's events:
 /// the minimum at least 1 s (`why`) and at most the maximum, which is
