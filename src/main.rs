@@ -4,6 +4,7 @@
 
 mod cli;
 mod commands;
+mod save;
 
 use std::process::ExitCode;
 

@@ -38,6 +38,7 @@ fn files_in(dir: &Path) -> Vec<String> {
     v
 }
 
+#[cfg(feature = "rerun")]
 #[test]
 fn calibrate_records_and_exports_at_the_requested_accuracy() {
     let dir = temp_dir("ok");
@@ -77,6 +78,31 @@ fn calibrate_records_and_exports_at_the_requested_accuracy() {
     assert_eq!(&bytes[192..197], b"EDF+C");
     assert!(std::fs::metadata(&rrd).unwrap().len() > 10_000);
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Built without Rerun (`--no-default-features`), `--save` is refused before
+/// any work, with how to rebuild, and nothing is written.
+#[cfg(not(feature = "rerun"))]
+#[test]
+fn save_without_rerun_is_exit_2_saying_how_to_rebuild() {
+    let dir = temp_dir("no-rerun");
+    let rrd = dir.join("x.rrd");
+    for args in [
+        vec!["calibrate", "--save", rrd.to_str().unwrap()],
+        vec![
+            "run",
+            "scenarios/mexico_to_pisa.toml",
+            "--save",
+            rrd.to_str().unwrap(),
+        ],
+    ] {
+        let e = refused(&args);
+        assert!(
+            e.contains("--save") && e.contains("without Rerun") && e.contains("cargo build"),
+            "{e}"
+        );
+        assert!(files_in(&dir).is_empty(), "{:?}", files_in(&dir));
+    }
 }
 
 #[test]

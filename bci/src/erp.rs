@@ -154,6 +154,6 @@ mod tests {
         let at = |n: &str| topo[m.index(n).unwrap()];
         assert!((at("FCz") - 1.0).abs() < 1e-12);
         assert!(at("Cz") > at("Pz") && at("Pz") > at("Oz"));
-        assert_eq!(at("EOG-LA"), 0.0);
+        assert_eq!(at("EOG LA"), 0.0);
     }
 }

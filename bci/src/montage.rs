@@ -16,7 +16,7 @@ pub enum ChannelKind {
 /// One electrode.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Channel {
-    /// Name in 10-10 notation (`FCz`) or `EOG-LA` style for EOG.
+    /// Name in 10-10 notation (`FCz`) or `EOG LA` style for EOG.
     pub name: String,
     /// EEG or EOG.
     pub kind: ChannelKind,

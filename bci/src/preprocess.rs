@@ -212,12 +212,12 @@ fn eog_derivation(montage: &Montage) -> Result<DMatrix<f64>> {
     let n_eeg = montage.n_eeg();
     let mut d = DMatrix::zeros(3, montage.n_eog());
     let col = |name: &str| -> Result<usize> { Ok(montage.index(name)? - n_eeg) };
-    d[(0, col("EOG-LO")?)] = 1.0;
-    d[(0, col("EOG-RO")?)] = -1.0;
-    for n in ["EOG-LA", "EOG-RA"] {
+    d[(0, col("EOG LO")?)] = 1.0;
+    d[(0, col("EOG RO")?)] = -1.0;
+    for n in ["EOG LA", "EOG RA"] {
         d[(1, col(n)?)] = 0.5;
     }
-    for n in ["EOG-LB", "EOG-RB"] {
+    for n in ["EOG LB", "EOG RB"] {
         d[(1, col(n)?)] = -0.5;
     }
     for c in 0..montage.n_eog() {

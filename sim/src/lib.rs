@@ -1,7 +1,9 @@
 //! The world and the loop: synthetic user, episode runners and Rerun recording.
 //!
 //! `errp_sim` is the only crate that touches the Rerun SDK (and, for the
-//! e-puck, rapier2d). It ties the EEG side ([`errp_bci`]) to the agent side
+//! e-puck, rapier2d). Recording is the default-on `rerun` feature: without
+//! it (`--no-default-features`) the crate builds without the Rerun SDK, for
+//! cluster sweeps, and the recording modules are absent. It ties the EEG side ([`errp_bci`]) to the agent side
 //! ([`errp_robot`]) and writes what happened to `.rrd` files.
 //!
 //! One module per task, and what they share:
@@ -22,6 +24,7 @@ mod error;
 pub mod grid;
 mod output;
 mod paper;
+#[cfg(feature = "rerun")]
 pub mod record;
 mod scenario;
 mod scenario_file;

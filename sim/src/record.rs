@@ -44,10 +44,35 @@ pub(crate) fn task_blueprint(
 ) -> Blueprint {
     use rerun::blueprint::{Horizontal, TextLogView, Vertical};
     let events = TextLogView::new("Events").with_origin(paths::LOG);
-    Blueprint::new(Horizontal::new([
-        Vertical::new([scene.into(), events.into()]).into(),
-        Vertical::new(panels).into(),
-    ]))
+    opening_view(
+        // The scene gets the wider column.
+        Blueprint::new(
+            Horizontal::new([
+                Vertical::new([scene.into(), events.into()]).into(),
+                Vertical::new(panels).into(),
+            ])
+            .with_column_shares([3.0, 2.0]),
+        ),
+        SIM_TIME,
+    )
+}
+
+/// What a file shows when it opens: the views over the whole window (the
+/// blueprint and selection panels folded away, one click to unfold) and the
+/// time cursor on `timeline` at the latest data, so a run opens finished
+/// (the whole trajectory, every detection), not as an empty scene at time 0.
+pub(crate) fn opening_view(blueprint: Blueprint, timeline: &str) -> Blueprint {
+    use rerun::blueprint::components::{PanelState, PlayState};
+    use rerun::blueprint::{BlueprintPanel, SelectionPanel, TimePanel};
+    blueprint
+        .with_blueprint_panel(BlueprintPanel::new().with_state(PanelState::Collapsed))
+        .with_selection_panel(SelectionPanel::new().with_state(PanelState::Collapsed))
+        .with_time_panel(
+            TimePanel::new()
+                .with_state(PanelState::Collapsed)
+                .with_timeline(timeline)
+                .with_play_state(PlayState::Following),
+        )
 }
 
 /// An `.rrd` file being recorded. Log to [`RrdFile::stream`]; call

@@ -3,11 +3,10 @@
 use anyhow::{Context, Result};
 use errp_bci::{EdfWriter, GoalSet, MeanAccuracy, SessionOptions, subject, subjects};
 use errp_sim::PendingFile;
-use errp_sim::calibration::{
-    CalibrationRequest, calibration_recording, record_calibration, run_calibration,
-};
+use errp_sim::calibration::{CalibrationRequest, run_calibration};
 
 use crate::cli::{CalibrateArgs, Goals, check_extension};
+use crate::save::check_save;
 
 pub(crate) fn calibrate(args: &CalibrateArgs) -> Result<()> {
     let (accuracy, who) = match &args.subject {
@@ -28,9 +27,7 @@ pub(crate) fn calibrate(args: &CalibrateArgs) -> Result<()> {
             "requested".to_string(),
         ),
     };
-    if let Some(p) = &args.save {
-        check_extension(p, "rrd", "--save")?;
-    }
+    check_save(args.save.as_deref())?;
     if let Some(p) = &args.export {
         check_extension(p, "edf", "--export")?;
     }
@@ -44,8 +41,9 @@ pub(crate) fn calibrate(args: &CalibrateArgs) -> Result<()> {
         }
         None => None,
     };
+    #[cfg(feature = "rerun")]
     let rrd = match &args.save {
-        Some(p) => Some(calibration_recording(p)?),
+        Some(p) => Some(errp_sim::calibration::calibration_recording(p)?),
         None => None,
     };
 
@@ -118,14 +116,12 @@ pub(crate) fn calibrate(args: &CalibrateArgs) -> Result<()> {
             path.display()
         );
     }
+    #[cfg(feature = "rerun")]
     if let Some(file) = rrd {
         let montage = errp_bci::Montage::standard();
-        let path = record_calibration(file, &report, &montage)?;
-        println!(
-            "Wrote {} (open with: rerun {})",
-            path.display(),
-            path.display()
-        );
+        crate::save::wrote(&errp_sim::calibration::record_calibration(
+            file, &report, &montage,
+        )?);
     }
     Ok(())
 }

@@ -1,20 +1,24 @@
 //! `errp run`: a grid or an e-puck scenario, printed per episode and summarised.
 
+#[cfg(feature = "rerun")]
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 use errp_bci::OnlineStep;
+#[cfg(feature = "rerun")]
+use errp_sim::epuck::{ContinuousDecoder, EpuckEpisodeResult, EpuckRecorder, run_epuck_once};
 use errp_sim::epuck::{
-    EpuckRecorder, EpuckRunHeader, EpuckRunRow, EpuckScenario, EpuckSummaryReport, epuck_recording,
-    prepare_continuous_decoder_with, run_epuck_batch, run_epuck_once, summarise,
+    EpuckRunHeader, EpuckRunRow, EpuckScenario, EpuckSummaryReport,
+    prepare_continuous_decoder_with, run_epuck_batch, summarise,
 };
 use errp_sim::grid::{
     DecoderChoice, EegMode, GridEpisodeHeader, GridEpisodeRow, GridRunReport, GridScenario,
-    grid_recording, prepare_decoder, record_grid_run, run_grid_scenario,
+    prepare_decoder, run_grid_scenario,
 };
 use errp_sim::{AnyScenario, load_scenario, load_scenario_with};
 
-use crate::cli::{DecoderArg, RunArgs, calibration_progress, check_extension};
+use crate::cli::{DecoderArg, RunArgs, calibration_progress};
+use crate::save::check_save;
 
 pub(crate) fn run(args: &RunArgs) -> Result<()> {
     // Overrides are keys of the scenario file, set before it is parsed, so
@@ -42,7 +46,9 @@ pub(crate) fn run(args: &RunArgs) -> Result<()> {
             overrides.push(("eeg", toml::Value::String(name.into())));
         }
     }
-    match load_scenario_with(&args.scenario, &overrides)? {
+    let scenario = load_scenario_with(&args.scenario, &overrides)?;
+    check_save(args.save.as_deref())?;
+    match scenario {
         AnyScenario::Grid(s) => {
             if args.runs.is_some() {
                 bail!(
@@ -72,7 +78,8 @@ pub(crate) fn run_grid(args: &RunArgs, mut scenario: GridScenario) -> Result<()>
     if args.accuracy.is_some() {
         scenario.user.push_str(" (--accuracy)");
     }
-    let rrd = open_recording(args, grid_recording)?;
+    #[cfg(feature = "rerun")]
+    let rrd = open_recording(args, errp_sim::grid::grid_recording)?;
     let quiet = args.quiet;
     if !quiet {
         eprintln!(
@@ -108,13 +115,9 @@ pub(crate) fn run_grid(args: &RunArgs, mut scenario: GridScenario) -> Result<()>
         episodes,
     };
     print!("{report}");
+    #[cfg(feature = "rerun")]
     if let Some(file) = rrd {
-        let path = record_grid_run(file, &report)?;
-        println!(
-            "Wrote {} (open with: rerun {})",
-            path.display(),
-            path.display()
-        );
+        crate::save::wrote(&errp_sim::grid::record_grid_run(file, &report)?);
     }
     Ok(())
 }
@@ -126,7 +129,8 @@ pub(crate) fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<(
     if let Some(runs) = args.runs {
         scenario.runs = runs as usize;
     }
-    let rrd = open_recording(args, epuck_recording)?;
+    #[cfg(feature = "rerun")]
+    let rrd = open_recording(args, errp_sim::epuck::epuck_recording)?;
     let quiet = args.quiet;
     let decoder_text = match scenario.online_target {
         None => format!("decoder accuracy {:.2} %", 100.0 * scenario.accuracy.get()),
@@ -181,25 +185,15 @@ pub(crate) fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<(
     if let Some(online) = &decoder.online {
         print!("{online}");
     }
-    let results = match &rrd {
-        Some(file) => {
-            let mut recorder = EpuckRecorder::new(
-                file,
-                &scenario.arena,
-                layout,
-                decoder.t_e(scenario.params.control.t_e),
-            )?;
-            let mut out = Vec::with_capacity(scenario.runs);
-            for k in 0..scenario.runs {
-                recorder.next_run(&format!(
-                    "run {}: the user wants {goal} ({decoder_text})",
-                    k + 1
-                ));
-                out.push(run_epuck_once(&scenario, &decoder, k, &mut recorder)?);
-            }
-            recorder.finish()?;
-            out
-        }
+    #[cfg(feature = "rerun")]
+    let recorded = match &rrd {
+        Some(file) => Some(record_epuck_runs(file, &scenario, &decoder, &decoder_text)?),
+        None => None,
+    };
+    #[cfg(not(feature = "rerun"))]
+    let recorded = None;
+    let results = match recorded {
+        Some(results) => results,
         None => {
             if !quiet && scenario.runs > 1 {
                 eprintln!("  running {} runs in parallel", scenario.runs);
@@ -228,26 +222,50 @@ pub(crate) fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<(
             t_e: decoder.t_e(scenario.params.control.t_e),
         }
     );
+    #[cfg(feature = "rerun")]
     if let Some(file) = rrd {
-        let path = file.finish()?;
-        println!(
-            "Wrote {} (open with: rerun {})",
-            path.display(),
-            path.display()
-        );
+        crate::save::wrote(&file.finish()?);
     }
     Ok(())
 }
 
-/// The `--save` recording, checked and created before any work, so that a
-/// bad or unwritable path fails first.
+/// The `--save` recording, created before any work, so that an unwritable
+/// path fails first.
+#[cfg(feature = "rerun")]
 fn open_recording<T>(
     args: &RunArgs,
     open: impl FnOnce(&Path) -> errp_sim::Result<T>,
 ) -> Result<Option<T>> {
-    let Some(path) = &args.save else {
-        return Ok(None);
-    };
-    check_extension(path, "rrd", "--save")?;
-    Ok(Some(open(path)?))
+    match &args.save {
+        Some(path) => Ok(Some(open(path)?)),
+        None => Ok(None),
+    }
+}
+
+/// The runs of an e-puck scenario one after another, each recorded.
+#[cfg(feature = "rerun")]
+fn record_epuck_runs(
+    file: &errp_sim::record::RrdFile,
+    scenario: &EpuckScenario,
+    decoder: &ContinuousDecoder,
+    decoder_text: &str,
+) -> Result<Vec<EpuckEpisodeResult>> {
+    let layout = &scenario.layout;
+    let goal = &layout.goals()[scenario.episode.goal].name;
+    let mut recorder = EpuckRecorder::new(
+        file,
+        &scenario.arena,
+        layout,
+        decoder.t_e(scenario.params.control.t_e),
+    )?;
+    let mut out = Vec::with_capacity(scenario.runs);
+    for k in 0..scenario.runs {
+        recorder.next_run(&format!(
+            "run {}: the user wants {goal} ({decoder_text})",
+            k + 1
+        ));
+        out.push(run_epuck_once(scenario, decoder, k, &mut recorder)?);
+    }
+    recorder.finish()?;
+    Ok(out)
 }

@@ -1,5 +1,5 @@
 """Reads back what `errp run <e-puck scenario> --save X.rrd` wrote, with an
-independent client (rerun-sdk[datafusion] 0.36.3), and checks the values of
+independent client (rerun-sdk[datafusion] 0.36.3, or the newest, 0.41), and checks the values of
 the trajectory, the belief and the detections against the run's printed
 output.
 
@@ -12,6 +12,15 @@ import subprocess
 import sys
 
 import rerun as rr
+
+
+def open_store(rrd: str):
+    """The recording's chunks, with the reader of this rerun-sdk: 0.36's
+    `rerun.experimental.RrdReader`, or `rerun.chunk.RrdReader` from 0.41."""
+    chunk = getattr(rr, "chunk", None)
+    if chunk is not None and hasattr(chunk, "RrdReader"):
+        return chunk.RrdReader(rrd).stream().collect()
+    return rr.experimental.RrdReader(rrd).stream().collect()
 
 
 def column(store, entity: str, component: str):
@@ -35,15 +44,26 @@ def main(rrd: str, stdout_file: str, start_x: float, start_y: float) -> None:
     assert row, out
     converged, secs, detected = row.group(1).strip(), float(row.group(2)), int(row.group(3))
 
-    store = rr.experimental.RrdReader(rrd).stream().collect()
+    store = open_store(rrd)
 
-    # Belief: one bar chart of 25 probabilities per 62.5 ms window.
-    bars = [v[0]["buffer"] for v in column(store, "/belief/bars", "BarChart:values")]
+    # Belief: one series per city, a value per 62.5 ms window; the 25 values
+    # of a window sum to 1.
+    table = store.reader(index="sim_time", contents="/belief/city/**").to_arrow_table()
+    series = sorted(c for c in table.column_names if c.endswith(":Scalars:scalars"))
+    assert len(series) == 25, series
+    rows = [
+        [v[0] if isinstance(v, list) else v for v in table.column(c).to_pylist()]
+        for c in series
+    ]
     windows = round(secs / 0.0625)
-    assert abs(len(bars) - windows) <= 1, (len(bars), windows)
+    n = sum(1 for v in rows[0] if v is not None)
+    assert abs(n - windows) <= 1, (n, windows)
+    bars = [list(b) for b in zip(*rows) if all(v is not None for v in b)]
     for b in bars:
-        assert len(b) == 25 and abs(sum(b) - 1.0) < 1e-6 and min(b) >= 0.0, b
-    final = bars[-1]
+        assert abs(sum(b) - 1.0) < 1e-6 and min(b) >= 0.0, b
+    # Entity paths escape spaces ("/belief/city/New\\ York").
+    city_of = [c.split("/")[3].split(":")[0].replace("\\ ", " ") for c in series]
+    final = dict(zip(city_of, bars[-1]))
 
     # Trajectory: starts at the start, stays in the arena.
     strips = column(store, "/arena/trajectory", "LineStrips2D:strips")
@@ -57,16 +77,25 @@ def main(rrd: str, stdout_file: str, start_x: float, start_y: float) -> None:
     marks = column(store, "/arena/detections", "Points2D:positions")
     assert len(marks[-1]) == detected, (len(marks[-1]), detected)
 
-    # The goals carry the city names; the converged city's belief is >= p_c.
-    labels = column(store, "/arena/goals", "Points2D:labels")[-1]
+    # The cities carry their names (static labels); the converged city's
+    # belief is >= p_c and the robot ends on it.
+    cities = store.reader(index=None, contents="/arena/cities").to_arrow_table()
+    names = [l for l in cities.column("/arena/cities:Points2D:labels").to_pylist()[0]]
     positions = column(store, "/arena/goals", "Points2D:positions")[-1]
-    names = [l.replace(" (target)", "") for l in labels]
+    assert sorted(names) == sorted(city_of), (names, city_of)
     if "WRONG" not in converged and converged != "time-out":
         i = names.index(converged)
-        assert final[i] >= 0.4, (converged, final[i])
+        assert final[converged] >= 0.4, (converged, final[converged])
         assert math.dist(path[-1], positions[i]) < 5.0, (path[-1], positions[i])
+
+    # The static overview holds the whole trajectory and every detection.
+    overview = store.reader(index=None, contents="/arena/overview/**").to_arrow_table()
+    strips = overview.column("/arena/overview/trajectories:LineStrips2D:strips").to_pylist()[0]
+    assert strips[-1] == path, (len(strips[-1]), len(path))
+    dots = overview.column("/arena/overview/detections:Points2D:positions").to_pylist()[0]
+    assert len(dots) == detected, (len(dots), detected)
     print(
-        f"{rrd}: {len(bars)} belief updates, trajectory of {len(path)} points "
+        f"{rrd}: {len(bars)} belief updates of 25 cities, trajectory of {len(path)} points "
         f"({walked:.0f} cm), {detected} detections, ends on {converged}"
     )
 

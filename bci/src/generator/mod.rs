@@ -334,7 +334,7 @@ mod tests {
                 .iter()
                 .fold(0.0f64, |a, &x| a.max(x.abs()))
         };
-        assert!(peak("EOG-LA") > 100.0);
+        assert!(peak("EOG LA") > 100.0);
         assert!(peak("Fp1") > peak("Fz") && peak("Fz") > peak("Pz"));
     }
 

@@ -464,21 +464,21 @@ fn eye_coefficients(montage: &Montage) -> Result<(Vec<f64>, Vec<f64>)> {
     let pos =
         |name: &str| -> Result<[f64; 3]> { Ok(montage.channels()[montage.index(name)?].position) };
     let (la, ra, lo, ro) = (
-        pos("EOG-LA")?,
-        pos("EOG-RA")?,
-        pos("EOG-LO")?,
-        pos("EOG-RO")?,
+        pos("EOG LA")?,
+        pos("EOG RA")?,
+        pos("EOG LO")?,
+        pos("EOG RO")?,
     );
     let mut blink = Vec::with_capacity(montage.len());
     let mut gaze = Vec::with_capacity(montage.len());
     for c in montage.channels() {
         let (b, g) = match c.name.as_str() {
-            "EOG-LA" => (1.0, 0.1),
-            "EOG-RA" => (1.0, -0.1),
-            "EOG-LB" => (-0.35, 0.1),
-            "EOG-RB" => (-0.35, -0.1),
-            "EOG-LO" => (0.15, 0.5),
-            "EOG-RO" => (0.15, -0.5),
+            "EOG LA" => (1.0, 0.1),
+            "EOG RA" => (1.0, -0.1),
+            "EOG LB" => (-0.35, 0.1),
+            "EOG RB" => (-0.35, -0.1),
+            "EOG LO" => (0.15, 0.5),
+            "EOG RO" => (0.15, -0.5),
             _ => {
                 let d_eye = angle_between(c.position, la).min(angle_between(c.position, ra));
                 let b = 0.6 * (-d_eye / 0.6).exp();

@@ -1,8 +1,10 @@
 //! A calibration run: accuracy targeting, then the calibration session at the
 //! ratio found, scored and trained like the paper's; and its recording.
 
+#[cfg(feature = "rerun")]
 mod view;
 
+#[cfg(feature = "rerun")]
 pub use view::{calibration_recording, record_calibration};
 
 use errp_bci::{

@@ -32,18 +32,21 @@ fn blueprint() -> Blueprint {
                 .into(),
         );
     }
-    Blueprint::new(Horizontal::new([
-        Vertical::new(series).into(),
-        Vertical::new([
-            Spatial2DView::new("Error - correct at the peak")
-                .with_origin("/topography")
-                .into(),
-            TextDocumentView::new("Calibration")
-                .with_origin("/summary")
-                .into(),
-        ])
-        .into(),
-    ]))
+    crate::record::opening_view(
+        Blueprint::new(Horizontal::new([
+            Vertical::new(series).into(),
+            Vertical::new([
+                Spatial2DView::new("Error - correct at the peak")
+                    .with_origin("/topography")
+                    .into(),
+                TextDocumentView::new("Calibration")
+                    .with_origin("/summary")
+                    .into(),
+            ])
+            .into(),
+        ])),
+        crate::record::LATENCY_TIMELINE,
+    )
 }
 
 /// Opens the `.rrd` of a calibration run, with its layout. Open it before

@@ -11,6 +11,7 @@ pub(crate) mod schema;
 pub(crate) mod task;
 pub(crate) mod tracker;
 pub(crate) mod user;
+#[cfg(feature = "rerun")]
 pub(crate) mod view;
 pub(crate) mod world;
 
@@ -33,5 +34,6 @@ pub use scenario::EpuckScenario;
 pub use task::{EpuckRunner, EpuckTask};
 pub use tracker::{CameraTracker, TrackerParams};
 pub use user::{Elicited, Judgement, SeenMotion, SyntheticUser, UserParams};
+#[cfg(feature = "rerun")]
 pub use view::{EpuckRecorder, RUN_GAP_SECS, epuck_recording};
 pub use world::{ArenaSpec, Obstacle, ProximitySensors, World};

@@ -1,17 +1,19 @@
 //! What `errp run <e-puck scenario> --save` records: the arena as seen from
 //! the ceiling (walls, obstacles, the 25 cities coloured by belief, the
 //! e-puck, its trajectory and red marks where errors were detected, as in
-//! Fig. 5), the belief as bars and one series per city, p(error) against
-//! T_e, preprocessed EEG at FCz and Cz, and a log of events, all on the
-//! `sim_time` timeline in seconds. Lengths are in centimetres.
+//! Fig. 5, with a ring on the city the robot heads for), the belief as one
+//! series per city, p(error) against T_e, preprocessed EEG at FCz and Cz,
+//! and a log of events, all on the `sim_time` timeline in seconds. Lengths
+//! are in centimetres. A file opens at its end; every run's trajectory and
+//! detections also stay as a faint static layer, so the whole batch shows
+//! at a glance.
 
 use std::path::Path;
 
 use errp_robot::GoalLayout;
-use rerun::blueprint::{BarChartView, Blueprint, Spatial2DView, TimeSeriesView};
+use rerun::blueprint::{Blueprint, Spatial2DView, TimeSeriesView};
 use rerun::{
-    Arrows2D, BarChart, Color, LineStrips2D, Points2D, RecordingStream, Scalars, SeriesLines,
-    TextLog,
+    Arrows2D, Color, LineStrips2D, Points2D, RecordingStream, Scalars, SeriesLines, TextLog,
 };
 
 use crate::epuck::episode::{EpuckObserver, PhysicsFrame, WindowFrame};
@@ -30,9 +32,6 @@ fn blueprint() -> Blueprint {
     task_blueprint(
         Spatial2DView::new("Arena (cm): e-puck, trajectory, detected errors").with_origin("/arena"),
         vec![
-            BarChartView::new("Belief over the 25 cities")
-                .with_origin("/belief/bars")
-                .into(),
             TimeSeriesView::new("Belief per city")
                 .with_origin("/belief/city")
                 .into(),
@@ -106,6 +105,9 @@ pub struct EpuckRecorder<'a> {
     offset_secs: f64,
     trajectory: Vec<[f32; 2]>,
     detections: Vec<[f32; 2]>,
+    /// Every finished run's trajectory and detections, for the static layer.
+    all_trajectories: Vec<Vec<[f32; 2]>>,
+    all_detections: Vec<[f32; 2]>,
     steps: usize,
     last_secs: f64,
     error: Option<SimError>,
@@ -139,6 +141,21 @@ impl<'a> EpuckRecorder<'a> {
             )
             .map_err(&err)?;
         }
+        // City names beside the icons, alternately above and below by column
+        // so that neighbours' long names do not run into each other.
+        let cell_m = layout.arena_size_m() / 5.0;
+        rec.log_static(
+            "arena/cities",
+            &Points2D::new(layout.goals().iter().map(|g| {
+                let column = (g.x_m / cell_m).floor() as i64;
+                let dy = if column % 2 == 0 { -0.13 } else { 0.13 };
+                cm(g.x_m, g.y_m + dy)
+            }))
+            .with_radii([0.1])
+            .with_colors([Color::from_rgb(90, 90, 90)])
+            .with_labels(layout.goals().iter().map(|g| g.name.as_str())),
+        )
+        .map_err(&err)?;
         log_decoder_series(rec, "T_e").map_err(&err)?;
         for g in layout.goals() {
             rec.log_static(
@@ -155,6 +172,8 @@ impl<'a> EpuckRecorder<'a> {
             offset_secs: 0.0,
             trajectory: Vec::new(),
             detections: Vec::new(),
+            all_trajectories: Vec::new(),
+            all_detections: Vec::new(),
             steps: 0,
             last_secs: 0.0,
             error: None,
@@ -165,6 +184,7 @@ impl<'a> EpuckRecorder<'a> {
     pub fn next_run(&mut self, start_goal_and_user: &str) {
         if self.steps > 0 {
             self.offset_secs += self.last_secs + RUN_GAP_SECS;
+            self.log_overview();
         }
         self.trajectory.clear();
         self.detections.clear();
@@ -179,9 +199,36 @@ impl<'a> EpuckRecorder<'a> {
         self.keep(r);
     }
 
-    /// The first recording error, if any (logging goes on regardless).
-    pub fn finish(self) -> Result<()> {
+    /// Logs the last run's overview; returns the first recording error, if
+    /// any (logging goes on regardless).
+    pub fn finish(mut self) -> Result<()> {
+        if self.steps > 0 {
+            self.log_overview();
+        }
         self.error.map_or(Ok(()), Err)
+    }
+
+    /// Adds the run that just ended to the static layer: its trajectory in
+    /// faint blue, its detections in faint red, under the live ones.
+    fn log_overview(&mut self) {
+        self.all_trajectories.push(self.trajectory.clone());
+        self.all_detections.extend_from_slice(&self.detections);
+        let r = self.rec.log_static(
+            "arena/overview/trajectories",
+            &LineStrips2D::new(self.all_trajectories.clone())
+                .with_colors([Color::from_unmultiplied_rgba(40, 90, 200, 70)])
+                .with_radii([0.5])
+                .with_draw_order(-1.0),
+        );
+        self.keep(r);
+        let r = self.rec.log_static(
+            "arena/overview/detections",
+            &Points2D::new(self.all_detections.clone())
+                .with_colors([Color::from_unmultiplied_rgba(220, 30, 30, 90)])
+                .with_radii([2.0])
+                .with_draw_order(-1.0),
+        );
+        self.keep(r);
     }
 
     fn keep(&mut self, r: std::result::Result<(), rerun::RecordingStreamError>) {
@@ -234,30 +281,27 @@ impl EpuckObserver for EpuckRecorder<'_> {
 
     fn on_window(&mut self, f: &WindowFrame) {
         self.at(f.time_secs);
-        let labels: Vec<String> = self
-            .layout
-            .goals()
-            .iter()
-            .enumerate()
-            .map(|(i, g)| {
-                if i == f.target {
-                    format!("{} (target)", g.name)
-                } else {
-                    g.name.clone()
-                }
-            })
-            .collect();
         let r = self.rec.log(
             "arena/goals",
             &Points2D::new(self.layout.goals().iter().map(|g| cm(g.x_m, g.y_m)))
                 .with_radii([5.0])
-                .with_colors(f.belief.iter().map(|&p| belief_colour(p)))
-                .with_labels(labels),
+                .with_colors(f.belief.iter().map(|&p| belief_colour(p))),
         );
         self.keep(r);
-        let r = self
-            .rec
-            .log("belief/bars", &BarChart::new(f.belief.clone()));
+        // The city the robot heads for: an orange ring.
+        let t = &self.layout.goals()[f.target];
+        let ring: Vec<[f32; 2]> = (0..=32)
+            .map(|k| {
+                let a = k as f64 / 32.0 * std::f64::consts::TAU;
+                cm(t.x_m + 0.075 * a.cos(), t.y_m + 0.075 * a.sin())
+            })
+            .collect();
+        let r = self.rec.log(
+            "arena/target",
+            &LineStrips2D::new([ring])
+                .with_colors([Color::from_rgb(230, 120, 20)])
+                .with_radii([0.7]),
+        );
         self.keep(r);
         for (i, &p) in f.belief.iter().enumerate() {
             let path = format!("belief/city/{}", self.layout.goals()[i].name);

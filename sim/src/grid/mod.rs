@@ -9,6 +9,7 @@ pub(crate) mod run;
 pub(crate) mod scenario;
 pub(crate) mod table1;
 pub(crate) mod task;
+#[cfg(feature = "rerun")]
 pub(crate) mod view;
 
 pub use decoder::{
@@ -25,4 +26,5 @@ pub use run::{
 pub use scenario::{DecoderChoice, EegMode, GridScenario, free_pairs};
 pub use table1::{FIXED_PAIRS, Table1Cell, Table1Options, accuracy_time_correlation, run_table1};
 pub use task::{GridRunner, GridTask};
+#[cfg(feature = "rerun")]
 pub use view::{grid_recording, record_grid_run};
