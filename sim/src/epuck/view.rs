@@ -213,22 +213,22 @@ impl<'a> EpuckRecorder<'a> {
     fn log_overview(&mut self) {
         self.all_trajectories.push(self.trajectory.clone());
         self.all_detections.extend_from_slice(&self.detections);
-        let r = self.rec.log_static(
-            "arena/overview/trajectories",
-            &LineStrips2D::new(self.all_trajectories.clone())
-                .with_colors([Color::from_unmultiplied_rgba(40, 90, 200, 70)])
-                .with_radii([0.5])
-                .with_draw_order(-1.0),
-        );
-        self.keep(r);
-        let r = self.rec.log_static(
-            "arena/overview/detections",
-            &Points2D::new(self.all_detections.clone())
-                .with_colors([Color::from_unmultiplied_rgba(220, 30, 30, 90)])
-                .with_radii([2.0])
-                .with_draw_order(-1.0),
-        );
-        self.keep(r);
+        let trajectories = LineStrips2D::new(self.all_trajectories.clone())
+            .with_colors([Color::from_unmultiplied_rgba(40, 90, 200, 70)])
+            .with_radii([0.5])
+            .with_draw_order(-1.0);
+        let detections = Points2D::new(self.all_detections.clone())
+            .with_colors([Color::from_unmultiplied_rgba(220, 30, 30, 90)])
+            .with_radii([2.0])
+            .with_draw_order(-1.0);
+        let layers: [(&str, &dyn rerun::AsComponents); 2] = [
+            ("arena/overview/trajectories", &trajectories),
+            ("arena/overview/detections", &detections),
+        ];
+        for (path, layer) in layers {
+            let r = self.rec.log_static(path, layer);
+            self.keep(r);
+        }
     }
 
     fn keep(&mut self, r: std::result::Result<(), rerun::RecordingStreamError>) {
