@@ -10,7 +10,7 @@
 
 use std::path::Path;
 
-use errp_robot::GoalLayout;
+use errp_robot::{GoalLayout, LAYOUT_GRID_CELLS};
 use rerun::blueprint::{Blueprint, Spatial2DView, TimeSeriesView};
 use rerun::{
     Arrows2D, Color, LineStrips2D, Points2D, RecordingStream, Scalars, SeriesLines, TextLog,
@@ -143,7 +143,7 @@ impl<'a> EpuckRecorder<'a> {
         }
         // City names beside the icons, alternately above and below by column
         // so that neighbours' long names do not run into each other.
-        let cell_m = layout.arena_size_m() / 5.0;
+        let cell_m = layout.arena_size_m() / f64::from(LAYOUT_GRID_CELLS);
         rec.log_static(
             "arena/cities",
             &Points2D::new(layout.goals().iter().map(|g| {
