@@ -115,8 +115,14 @@ impl fmt::Display for Table1Report<'_> {
             "{:<10} {:>8}  {:>18}  {:>22}  {:>24}  {:>22}",
             "", "", "ours [paper]", "ours [paper]", "ours [paper]", "ours [paper]"
         )?;
+        // A statistic over no defined value (every run lacked a class) is
+        // shown as "-", not NaN.
         let ours = |(m, sd): (f64, f64), (pm, psd): (f64, f64), d: usize| {
-            format!("{m:.d$}+-{sd:.d$} [{pm:.d$}+-{psd:.d$}]")
+            if m.is_finite() {
+                format!("{m:.d$}+-{sd:.d$} [{pm:.d$}+-{psd:.d$}]")
+            } else {
+                format!("- [{pm:.d$}+-{psd:.d$}]")
+            }
         };
         for set in [GoalSet::Fixed, GoalSet::Free] {
             let set_name = if set == GoalSet::Fixed {
@@ -144,7 +150,12 @@ impl fmt::Display for Table1Report<'_> {
                 all.extend(c.runs.iter());
             }
             let stat = |g: &dyn Fn(&GridEpisodeResult) -> f64| {
-                mean_sd(&all.iter().map(|r| g(r)).collect::<Vec<_>>())
+                mean_sd(
+                    &all.iter()
+                        .map(|r| g(r))
+                        .filter(|v| v.is_finite())
+                        .collect::<Vec<_>>(),
+                )
             };
             let (paper_mean, paper_r, paper_p) = PAPER_POOLED
                 .iter()
@@ -171,9 +182,14 @@ impl fmt::Display for Table1Report<'_> {
                 ),
             )?;
             let (r, p) = accuracy_time_correlation(cells, set);
+            let ours_r = if r.is_finite() {
+                format!("r = {r:.2}, p = {p:.2e}")
+            } else {
+                "r undefined (fewer than 3 runs with both classes)".to_string()
+            };
             writeln!(
                 f,
-                "           accuracy vs total time ({set_name} goals): r = {r:.2}, p = {p:.2e}   [paper: r = {paper_r}, p = {paper_p:.2e}]"
+                "           accuracy vs total time ({set_name} goals): {ours_r}   [paper: r = {paper_r}, p = {paper_p:.2e}]"
             )?;
         }
         Ok(())
@@ -214,6 +230,45 @@ accuracy = 0.8
         };
         out.push_str(&report.to_string());
         assert_snapshot("grid_report", &out);
+    }
+
+    /// A run that took no action of one class has no mean accuracy; it is
+    /// left out of that column's statistics and of the correlation instead
+    /// of making them NaN (`errp table1 --episodes 3 --seed 5` once printed
+    /// `NaN +- NaN`).
+    #[test]
+    fn a_run_without_errors_does_not_poison_table1() {
+        let options = Table1Options {
+            repeats: 1,
+            seed: 1,
+            decoder: DecoderChoice::Oracle,
+            eeg: EegMode::Bank,
+            params: crate::grid::params::GridTaskParams::default(),
+        };
+        let mut cells = run_table1(&options, |_, _| {}).unwrap();
+        let before = cells[0].stat(|r| r.online.mean());
+        // A sixth run of S1 on the fixed goals with no erroneous action.
+        let mut clean = cells[0].runs[0].clone();
+        clean.online.n_error = 0;
+        clean.online.error = f64::NAN;
+        assert!(clean.online.mean().is_nan());
+        cells[0].runs.push(clean);
+        assert_eq!(cells[0].stat(|r| r.online.mean()), before);
+        let (r, _) = accuracy_time_correlation(&cells, GoalSet::Fixed);
+        assert!(r.is_finite());
+        let text = Table1Report(&cells).to_string();
+        assert!(!text.contains("NaN"), "{text}");
+        // With no run defining it, the column reads "-".
+        for c in &mut cells {
+            for run in &mut c.runs {
+                run.online.error = f64::NAN;
+            }
+        }
+        let text = Table1Report(&cells).to_string();
+        assert!(
+            !text.contains("NaN") && text.contains("r undefined"),
+            "{text}"
+        );
     }
 
     #[test]

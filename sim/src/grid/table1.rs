@@ -37,9 +37,17 @@ pub struct Table1Cell {
 }
 
 impl Table1Cell {
-    /// (mean, sd) of a per-run quantity.
+    /// (mean, sd) of a per-run quantity over the runs where it is defined
+    /// (a run's mean accuracy is not when it took no action of a class).
     pub fn stat(&self, f: impl Fn(&GridEpisodeResult) -> f64) -> (f64, f64) {
-        mean_sd(&self.runs.iter().map(f).collect::<Vec<_>>())
+        mean_sd(
+            &self
+                .runs
+                .iter()
+                .map(f)
+                .filter(|v| v.is_finite())
+                .collect::<Vec<_>>(),
+        )
     }
 }
 
@@ -146,13 +154,15 @@ pub fn run_table1(
 }
 
 /// Pearson r and p between each run's online mean accuracy and its total
-/// time, over every run of a goal set (the paper: r = -0.47, p = 0.038
-/// fixed; r = -0.79, p = 3e-5 free).
+/// time, over every run of a goal set that has a mean accuracy (the paper:
+/// r = -0.47, p = 0.038 fixed; r = -0.79, p = 3e-5 free).
 pub fn accuracy_time_correlation(cells: &[Table1Cell], goals: GoalSet) -> (f64, f64) {
+    // A run with no action of a class has no mean accuracy: left out.
     let runs: Vec<&GridEpisodeResult> = cells
         .iter()
         .filter(|c| c.goals == goals)
         .flat_map(|c| c.runs.iter())
+        .filter(|r| r.online.mean().is_finite())
         .collect();
     let acc: Vec<f64> = runs.iter().map(|r| r.online.mean()).collect();
     let time: Vec<f64> = runs.iter().map(|r| r.total_secs).collect();
