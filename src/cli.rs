@@ -30,7 +30,7 @@ pub(crate) struct CalibrateArgs {
     #[arg(long, value_enum, default_value = "fixed", requires = "subject")]
     pub(crate) goals: Goals,
     /// Seed of the synthetic user and session.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = parse_seed, allow_negative_numbers = true)]
     pub(crate) seed: u64,
     /// Record grand averages, a topography and the summary to this `.rrd`.
     #[arg(long, value_name = "FILE.rrd")]
@@ -75,15 +75,15 @@ pub(crate) struct RunArgs {
     /// scenarios/grid_fixed_goals.toml.
     pub(crate) scenario: PathBuf,
     /// Override the scenario's seed.
-    #[arg(long)]
+    #[arg(long, value_parser = parse_seed, allow_negative_numbers = true)]
     pub(crate) seed: Option<u64>,
     /// Override the scenario's decoder (grid scenarios).
     #[arg(long, value_enum)]
     pub(crate) decoder: Option<DecoderArg>,
     /// Override the decoder's accuracy (mean of the per-class rates, in
-    /// (0.5, 1)).
-    #[arg(long, value_parser = parse_accuracy, allow_negative_numbers = true)]
-    pub(crate) accuracy: Option<MeanAccuracy>,
+    /// (0.5, 1); 1 for the grid's oracle decoder).
+    #[arg(long, value_parser = parse_run_accuracy, allow_negative_numbers = true)]
+    pub(crate) accuracy: Option<f64>,
     /// Override the number of runs (e-puck scenarios); each run has its own
     /// seed derived from the scenario's.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=100_000))]
@@ -109,7 +109,7 @@ pub(crate) struct Table1Args {
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=1000))]
     pub(crate) episodes: u64,
     /// Base seed.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = parse_seed, allow_negative_numbers = true)]
     pub(crate) seed: u64,
     /// EEG decoder (default) or oracle.
     #[arg(long, value_enum, default_value = "eeg")]
@@ -134,6 +134,27 @@ pub(crate) fn parse_accuracy(s: &str) -> Result<MeanAccuracy, String> {
         format!(
             "{s} is out of range: give a mean accuracy strictly between 0.5 (chance) and 1 \
              as a fraction, e.g. 0.7438 for 74.38 %"
+        )
+    })
+}
+
+/// `--accuracy` of `errp run`: a mean accuracy in (0.5, 1), or 1 (for the
+/// grid's oracle; `errp run` checks the decoder).
+pub(crate) fn parse_run_accuracy(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v == 1.0 => Ok(v),
+        _ => parse_accuracy(s)
+            .map(|a| a.get())
+            .map_err(|e| format!("{e} (or 1 with --decoder oracle)")),
+    }
+}
+
+/// A seed: a whole number from 0 to 2^64 - 1.
+pub(crate) fn parse_seed(s: &str) -> Result<u64, String> {
+    s.trim().parse::<u64>().map_err(|_| {
+        format!(
+            "{s:?} is not a seed: give a whole number from 0 to {}",
+            u64::MAX
         )
     })
 }

@@ -4,6 +4,7 @@
 
 mod cli;
 mod commands;
+mod interrupt;
 mod save;
 
 use std::process::ExitCode;
@@ -52,6 +53,7 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    interrupt::install();
     let result = match cli.command {
         Command::Calibrate(args) => calibrate::calibrate(&args),
         Command::Run(args) => run::run(&args),
@@ -63,15 +65,32 @@ fn main() -> ExitCode {
         Command::Merge(args) => sweep::merge(&args),
         Command::Sweep(args) => match sweep::sweep(&args) {
             Ok(true) => Ok(()),
-            Ok(false) => return ExitCode::from(130),
+            Ok(false) => return ExitCode::from(interrupt::EXIT_INTERRUPTED),
             Err(e) => Err(e),
         },
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", error_text(&e));
             ExitCode::from(2)
         }
     }
+}
+
+/// The error and its causes, each once: a cause whose text its parent
+/// already ends with (an I/O error a file error quotes) is not repeated.
+fn error_text(e: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in e.chain() {
+        let part = cause.to_string();
+        if text.ends_with(&part) {
+            continue;
+        }
+        if !text.is_empty() {
+            text.push_str(": ");
+        }
+        text.push_str(&part);
+    }
+    text
 }

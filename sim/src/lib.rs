@@ -14,7 +14,8 @@
 //! - [`record`]: `.rrd` files and the timelines they share;
 //! - [`task`]: what a Monte Carlo driver (the sweep) needs of a task;
 //! - at the top: scenario files of either task, the paper's numbers,
-//!   statistics, atomic output files and the error type.
+//!   statistics, atomic output files, the host and process behind files
+//!   (`host`) and the error type.
 
 #![warn(clippy::unwrap_used, clippy::print_stdout, clippy::iter_over_hash_type)]
 
@@ -22,6 +23,7 @@ pub mod calibration;
 pub mod epuck;
 mod error;
 pub mod grid;
+pub mod host;
 mod output;
 mod paper;
 #[cfg(feature = "rerun")]
@@ -34,10 +36,17 @@ mod stats;
 pub mod task;
 
 pub use error::{Result, SimError};
-pub use output::{PendingFile, create_dir, write_atomic};
+pub use output::{
+    PendingFile, create_dir, forget_if_interrupted, remove_if_interrupted, remove_unfinished,
+    write_atomic,
+};
 pub use paper::{PAPER, PAPER_EPUCK, PAPER_POOLED};
-pub use scenario::{AnyScenario, is_epuck, load_scenario, load_scenario_with, parse_scenario};
-pub use scenario_file::{parse_toml, read_scenario, set_key};
+pub use scenario::{
+    AnyScenario, is_epuck, load_scenario, load_scenario_with, parse_scenario, parse_scenario_table,
+};
+pub use scenario_file::{
+    MAX_KEY_PARTS, MAX_SCENARIO_BYTES, parse_toml, read_scenario, set_key, table_into, truncate,
+};
 pub use stats::{
     StreamingPearson, correlation_p_value, incomplete_beta, mean_sd, median, pearson,
     wilson_interval,

@@ -1,9 +1,57 @@
-//! Output files that appear whole or not at all.
+//! Output files that appear whole or not at all, and what is removed when
+//! the program is interrupted.
+//!
+//! A file is written under a temporary name beside its destination
+//! (`.NAME.partial-HOST-PID-RANDOM`, created exclusively: unique across the
+//! hosts that share a network directory) and renamed into place when
+//! complete. Temporaries are removed when dropped, by
+//! [`remove_unfinished`] (the command line calls it on Ctrl-C or SIGTERM),
+//! and, when a process died without either (SIGKILL, out of memory), by
+//! the next [`PendingFile::create`] in the same directory on the same host.
 
+use std::collections::BTreeSet;
 use std::fs::File;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 use crate::error::{Result, SimError};
+use crate::host::{host_name, process_gone, random_suffix};
+
+/// Files this process removes if it is interrupted: temporaries being
+/// written, locks it holds.
+static UNFINISHED: Mutex<BTreeSet<PathBuf>> = Mutex::new(BTreeSet::new());
+
+fn unfinished() -> std::sync::MutexGuard<'static, BTreeSet<PathBuf>> {
+    // A panic elsewhere while the set was held leaves it usable.
+    UNFINISHED.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Registers `path` to be removed by [`remove_unfinished`] (a directory
+/// only if it is empty by then).
+pub fn remove_if_interrupted(path: &Path) {
+    unfinished().insert(path.to_path_buf());
+}
+
+/// Takes `path` off the list of [`remove_if_interrupted`].
+pub fn forget_if_interrupted(path: &Path) {
+    unfinished().remove(path);
+}
+
+/// Removes every registered temporary and lock of this process (and a
+/// registered directory, if that leaves it empty), and returns how many
+/// were there. For a signal handler, just before the process exits: what
+/// was being written would otherwise stay behind.
+pub fn remove_unfinished() -> usize {
+    let mut set = unfinished();
+    let n = set.len();
+    // Children sort after their parents: removed first.
+    for path in std::mem::take(&mut *set).into_iter().rev() {
+        if std::fs::remove_file(&path).is_err() {
+            let _ = std::fs::remove_dir(&path);
+        }
+    }
+    n
+}
 
 /// Creates directory `dir` and its parents (an existing one is fine).
 pub fn create_dir(dir: &Path) -> Result<()> {
@@ -11,6 +59,49 @@ pub fn create_dir(dir: &Path) -> Result<()> {
         path: dir.to_path_buf(),
         source,
     })
+}
+
+/// The prefix of the temporaries of `name`: `.NAME.partial-`.
+fn partial_prefix(name: &std::ffi::OsStr) -> String {
+    format!(".{}.partial-", name.to_string_lossy())
+}
+
+/// Removes the temporaries in `dest`'s directory (of any file) left by
+/// processes of this host that are gone (killed, or out of memory). Those
+/// of other hosts, whose processes cannot be seen from here, and of live
+/// processes are left alone.
+fn remove_stale_partials(dest: &Path) {
+    let dir = match dest.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let host = host_name();
+    for entry in entries.flatten().take(100_000) {
+        let file = entry.file_name();
+        let Some(rest) = file
+            .to_str()
+            .filter(|f| f.starts_with('.'))
+            .and_then(|f| f.split_once(".partial-"))
+            .map(|(_, rest)| rest)
+        else {
+            continue;
+        };
+        // HOST-PID-RANDOM, the host possibly holding dashes itself.
+        let mut parts = rest.rsplitn(3, '-');
+        let (random, pid, owner) = (parts.next(), parts.next(), parts.next());
+        let random_ok =
+            random.is_some_and(|r| r.len() == 16 && r.bytes().all(|b| b.is_ascii_hexdigit()));
+        if let (true, Some(pid), Some(owner)) =
+            (random_ok, pid.and_then(|p| p.parse::<u32>().ok()), owner)
+            && owner == host
+            && process_gone(pid, None)
+        {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
 }
 
 /// A file being written under a temporary name next to its destination. It
@@ -26,7 +117,8 @@ pub struct PendingFile {
 
 impl PendingFile {
     /// Reserves `dest`: creates the temporary file now, so that an unwritable
-    /// destination is reported before any long computation.
+    /// destination is reported before any long computation. Temporaries of
+    /// `dest` left by dead processes of this host are removed first.
     pub fn create(dest: impl AsRef<Path>) -> Result<(Self, File)> {
         let dest = dest.as_ref().to_path_buf();
         let fail = |source| SimError::Output {
@@ -45,11 +137,25 @@ impl PendingFile {
                 "the path is a directory",
             )));
         }
-        let mut temp_name = std::ffi::OsString::from(".");
-        temp_name.push(name);
-        temp_name.push(format!(".partial-{}", std::process::id()));
-        let temp = dest.with_file_name(temp_name);
-        let file = File::create(&temp).map_err(fail)?;
+        remove_stale_partials(&dest);
+        let prefix = format!(
+            "{}{}-{}",
+            partial_prefix(name),
+            host_name(),
+            std::process::id()
+        );
+        let mut tries = 0;
+        let (temp, file) = loop {
+            let temp = dest.with_file_name(format!("{prefix}-{:016x}", random_suffix()));
+            match File::options().write(true).create_new(true).open(&temp) {
+                Ok(file) => break (temp, file),
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && tries < 8 => {
+                    tries += 1;
+                }
+                Err(e) => return Err(fail(e)),
+            }
+        };
+        remove_if_interrupted(&temp);
         Ok((
             Self {
                 dest,
@@ -76,6 +182,7 @@ impl PendingFile {
             path: self.dest.clone(),
             source,
         })?;
+        forget_if_interrupted(&self.temp);
         self.committed = true;
         Ok(self.dest.clone())
     }
@@ -85,6 +192,7 @@ impl Drop for PendingFile {
     fn drop(&mut self) {
         if !self.committed {
             let _ = std::fs::remove_file(&self.temp);
+            forget_if_interrupted(&self.temp);
         }
     }
 }
@@ -123,6 +231,47 @@ mod tests {
         assert!(temp.exists());
         drop(p);
         assert!(!temp.exists() && !dir.join("b.txt").exists());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_dead_processs_temporary_is_removed_and_the_others_are_kept() {
+        let dir = std::env::temp_dir().join(format!("errp-stale-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let host = host_name();
+        // Pids above the kernel's pid_max (at most 2^22) run nothing.
+        let r = "0123456789abcdef";
+        let dead = dir.join(format!(".a.txt.partial-{host}-9999999-{r}"));
+        let dead_other_file = dir.join(format!(".b.rrd.partial-{host}-9999999-{r}"));
+        let live = dir.join(format!(".a.txt.partial-{host}-{}-{r}", std::process::id()));
+        let elsewhere = dir.join(format!(".a.txt.partial-another-host-9999999-{r}"));
+        let not_ours = dir.join(".a.txt.partial-notes");
+        for p in [&dead, &dead_other_file, &live, &elsewhere, &not_ours] {
+            std::fs::write(p, b"partial").unwrap();
+        }
+        write_atomic(&dir.join("a.txt"), b"whole").unwrap();
+        assert!(!dead.exists() && !dead_other_file.exists());
+        assert!(live.exists() && elsewhere.exists() && not_ours.exists());
+        assert_eq!(std::fs::read(dir.join("a.txt")).unwrap(), b"whole");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn temporaries_are_named_by_host_and_process() {
+        let dir = std::env::temp_dir().join(format!("errp-names-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let (a, _fa) = PendingFile::create(dir.join("x.csv")).unwrap();
+        let (b, _fb) = PendingFile::create(dir.join("x.csv")).unwrap();
+        let name = a
+            .temp_path()
+            .file_name()
+            .unwrap()
+            .to_string_lossy()
+            .into_owned();
+        let want = format!(".x.csv.partial-{}-{}-", host_name(), std::process::id());
+        assert!(name.starts_with(&want), "{name}");
+        assert_ne!(a.temp_path(), b.temp_path());
+        drop((a, b));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -52,9 +52,22 @@ pub fn load_scenario_with(
         set_key(&mut table, key, value.clone())
             .map_err(|e| SimError::Scenario(format!("{}: {key}: {e}", path.display())))?;
     }
-    let text = toml::to_string(&table)
-        .map_err(|e| SimError::Scenario(format!("{}: {e}", path.display())))?;
-    parse_scenario(&text, path)
+    parse_scenario_table(&table, path)
+}
+
+/// Validates a scenario of either task given as a TOML table (a file's with
+/// values set from the command line or a sweep). Errors name `path` and the
+/// field, but no line: the table is not the file as written.
+pub fn parse_scenario_table(table: &toml::Table, path: &Path) -> Result<AnyScenario> {
+    if table.get("task").and_then(toml::Value::as_str) == Some("epuck") {
+        Ok(AnyScenario::Epuck(Box::new(EpuckScenario::from_table(
+            table, path,
+        )?)))
+    } else {
+        Ok(AnyScenario::Grid(Box::new(GridScenario::from_table(
+            table, path,
+        )?)))
+    }
 }
 
 /// Validates scenario text of either task; `path` names it in errors.

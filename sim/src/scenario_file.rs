@@ -8,22 +8,181 @@ use toml::{Table, Value};
 
 use crate::error::{Result, SimError};
 
-/// The text of the scenario file at `path`.
+/// The largest scenario file read, in bytes: a scenario is a page of
+/// TOML; anything far larger is not one.
+pub const MAX_SCENARIO_BYTES: u64 = 1 << 20;
+
+/// The deepest dotted key (`arena.obstacle.center_cm` has three parts) that
+/// may be set in a scenario.
+pub const MAX_KEY_PARTS: usize = 4;
+
+/// The text of the scenario file at `path` (at most
+/// [`MAX_SCENARIO_BYTES`]).
 pub fn read_scenario(path: &Path) -> Result<String> {
-    std::fs::read_to_string(path).map_err(|e| {
+    use std::io::Read;
+    let cannot = |e: &dyn std::fmt::Display| {
         SimError::Scenario(format!("{}: cannot read the scenario: {e}", path.display()))
-    })
+    };
+    let file = std::fs::File::open(path).map_err(|e| cannot(&e))?;
+    if file.metadata().is_ok_and(|m| m.is_dir()) {
+        return Err(cannot(&"it is a directory, not a TOML file"));
+    }
+    let mut bytes = Vec::new();
+    file.take(MAX_SCENARIO_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| cannot(&e))?;
+    if bytes.len() as u64 > MAX_SCENARIO_BYTES {
+        return Err(cannot(&format!(
+            "it is over {} KiB; a scenario file is a page of TOML",
+            MAX_SCENARIO_BYTES / 1024
+        )));
+    }
+    String::from_utf8(bytes).map_err(|_| cannot(&"it is not UTF-8 text"))
 }
 
-/// Scenario text parsed as TOML into `T`; errors name `path`.
+/// Scenario text parsed as TOML into `T`; errors name `path`, the line, the
+/// field (as a dotted key), the value and what is accepted.
 pub fn parse_toml<T: DeserializeOwned>(text: &str, path: &Path) -> Result<T> {
-    toml::from_str(text).map_err(|e| {
-        SimError::Scenario(format!("{}: {}", path.display(), e.to_string().trim_end()))
-    })
+    toml::from_str(text).map_err(|e| toml_error(path, Some(text), &e))
+}
+
+/// A scenario as a TOML table (a file's, with values set from the command
+/// line or a sweep) into `T`. Errors name the field but no line: the table
+/// is not the file as written.
+pub fn table_into<T: DeserializeOwned>(table: &Table, path: &Path) -> Result<T> {
+    table
+        .clone()
+        .try_into()
+        .map_err(|e| toml_error(path, None, &e))
+}
+
+/// A TOML error of the scenario at `path` (`text`: the file as written, for
+/// the line number) in the words of the scenario: the dotted field, its
+/// value and what is accepted, not serde's Rust types.
+fn toml_error(path: &Path, text: Option<&str>, e: &toml::de::Error) -> SimError {
+    // Without its input, toml names the key path (`in `control.tau``)
+    // instead of quoting the line.
+    let mut bare = e.clone();
+    bare.set_input(None);
+    let shown = bare.to_string();
+    let shown = shown.trim_end();
+    let (message, key) = match shown.rsplit_once("\nin `") {
+        Some((m, k)) => (m.trim_end(), Some(k.trim_end_matches('`'))),
+        None => (shown, None),
+    };
+    let line = text.zip(e.span()).map(|(t, s)| {
+        t.as_bytes()[..s.start.min(t.len())]
+            .iter()
+            .filter(|&&b| b == b'\n')
+            .count()
+            + 1
+    });
+    let at = match line {
+        Some(l) => format!("{} line {l}", path.display()),
+        None => path.display().to_string(),
+    };
+    let message = plain_types(message);
+    // A syntax error: toml's own text, with the line quoted.
+    if key.is_none()
+        && !message.starts_with("unknown field")
+        && !message.starts_with("missing field")
+    {
+        if text.is_some() && e.span().is_some() {
+            return SimError::Scenario(format!("{}: {}", path.display(), e.to_string().trim_end()));
+        }
+        return SimError::Scenario(format!("{at}: {message}"));
+    }
+    let within = |name: &str| match key {
+        Some(k) => format!("{k}.{name}"),
+        None => name.to_string(),
+    };
+    if let Some(rest) = message.strip_prefix("unknown field `")
+        && let Some((name, expected)) = rest.split_once('`')
+    {
+        let expected = expected.trim_start_matches(',').trim();
+        return SimError::Scenario(format!(
+            "{at}: unknown field `{}`; {expected}",
+            within(name)
+        ));
+    }
+    if let Some(rest) = message.strip_prefix("missing field `")
+        && let Some((name, _)) = rest.split_once('`')
+    {
+        return SimError::Scenario(format!("{at}: missing field `{}`", within(name)));
+    }
+    let key = key.unwrap_or("?");
+    match value_and_expected(&message) {
+        Some((value, expected)) => SimError::Scenario(format!(
+            "{at}: field `{key}` = {value} is invalid: expected {expected}"
+        )),
+        None => SimError::Scenario(format!("{at}: field `{key}`: {message}")),
+    }
+}
+
+/// serde's Rust type names in words.
+fn plain_types(message: &str) -> String {
+    let mut m = message.to_string();
+    for (rust, words) in [
+        ("expected usize", "expected a whole number >= 0"),
+        ("expected u64", "expected a whole number >= 0"),
+        ("expected u32", "expected a whole number >= 0"),
+        ("expected i64", "expected a whole number"),
+        ("expected f64", "expected a number"),
+        ("expected a borrowed string", "expected a string"),
+        ("expected a sequence", "expected an array"),
+    ] {
+        if let Some(rest) = m.strip_suffix(rust) {
+            m = format!("{rest}{words}");
+        }
+    }
+    m
+}
+
+/// The value and the expectation of serde's "invalid type: X, expected Y"
+/// and "invalid value: X, expected Y" messages.
+fn value_and_expected(message: &str) -> Option<(String, String)> {
+    if let Some(rest) = message.strip_prefix("invalid length ") {
+        let (n, expected) = rest.split_once(", expected ")?;
+        return Some((format!("an array of {n}"), expected.to_string()));
+    }
+    let rest = message
+        .strip_prefix("invalid type: ")
+        .or_else(|| message.strip_prefix("invalid value: "))?;
+    let (unexpected, expected) = rest.rsplit_once(", expected ")?;
+    let value = match unexpected {
+        "sequence" => "an array".to_string(),
+        "map" => "a table".to_string(),
+        u => [
+            "integer ",
+            "floating point ",
+            "boolean ",
+            "string ",
+            "character ",
+        ]
+        .iter()
+        .find_map(|p| u.strip_prefix(p))
+        .unwrap_or(u)
+        .trim_matches('`')
+        .to_string(),
+    };
+    let expected = if expected.starts_with("struct ") || expected == "a map" {
+        "a table".to_string()
+    } else {
+        expected.to_string()
+    };
+    Some((value, expected))
 }
 
 /// Sets `key` (dotted) in `table` to `value`, creating tables on the way.
 pub fn set_key(table: &mut Table, key: &str, value: Value) -> std::result::Result<(), String> {
+    let n = key.split('.').count();
+    if n > MAX_KEY_PARTS || key.split('.').any(|p| p.is_empty()) {
+        return Err(format!(
+            "`{}` is not a scenario field: a field is a dotted key of 1 to {MAX_KEY_PARTS} \
+             non-empty parts (e.g. control.tau)",
+            truncate(key, 80)
+        ));
+    }
     let mut parts = key.split('.').peekable();
     let mut t = table;
     while let Some(part) = parts.next() {
@@ -39,6 +198,53 @@ pub fn set_key(table: &mut Table, key: &str, value: Value) -> std::result::Resul
             .ok_or_else(|| format!("`{part}` in `{key}` is not a table in the scenario"))?;
     }
     Err(format!("`{key}` is empty"))
+}
+
+/// Two values `[x, y]`, exactly: an array of any other length is an error
+/// (serde's fixed-size arrays ignore extra items).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Pair<T>(pub(crate) [T; 2]);
+
+impl<'de, T: serde::Deserialize<'de>> serde::Deserialize<'de> for Pair<T> {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        // A scenario file is at most 1 MiB, so the array is bounded.
+        let items: Vec<T> = Vec::deserialize(d)?;
+        let n = items.len();
+        <[T; 2]>::try_from(items)
+            .map(Pair)
+            .map_err(|_| serde::de::Error::invalid_length(n, &"two values [x, y]"))
+    }
+}
+
+/// A whole number in `[lo, hi]` from a TOML number (an integer, or a float
+/// such as `1e3` with no fraction), or the error for `field`, whose range
+/// text ends with `note` (e.g. " (default 1000)").
+pub(crate) fn whole(
+    path: &Path,
+    field: &str,
+    value: f64,
+    lo: u64,
+    hi: u64,
+    note: &str,
+) -> Result<usize> {
+    if value.is_finite() && value.fract() == 0.0 && value >= lo as f64 && value <= hi as f64 {
+        Ok(value as usize)
+    } else {
+        Err(field_error(
+            path,
+            field,
+            value.to_string(),
+            &format!("a whole number from {lo} to {hi}{note}"),
+        ))
+    }
+}
+
+/// At most `n` characters of `text`, marked when cut.
+pub fn truncate(text: &str, n: usize) -> String {
+    match text.char_indices().nth(n) {
+        Some((i, _)) => format!("{}...", &text[..i]),
+        None => text.to_string(),
+    }
 }
 
 /// The error for a bad `field` of the scenario at `path`.

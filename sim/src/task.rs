@@ -25,7 +25,7 @@ pub struct TaskInfo {
     pub name: &'static str,
     /// The task's own columns of an episode row, between `success` and the
     /// online accuracy columns, in the order of [`EpisodeRow::fields`].
-    pub columns: &'static [&'static str],
+    pub columns: &'static [Column],
     /// The column of the cost a sweep summarises (over successful episodes).
     pub cost_column: &'static str,
     /// The cost as a table heading, with its unit.
@@ -41,6 +41,93 @@ pub struct TaskInfo {
     /// Short names of sweepable scenario parameters and their dotted keys in
     /// the scenario file; the alias list and its help text derive from it.
     pub sweepable: &'static [(&'static str, &'static str)],
+}
+
+/// A column of a task's episode rows: its name and what it may hold.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Column {
+    /// The CSV header's name.
+    pub name: &'static str,
+    /// What a field of it may hold.
+    pub kind: ColumnKind,
+}
+
+impl Column {
+    /// A column `name` of `kind`.
+    pub const fn new(name: &'static str, kind: ColumnKind) -> Self {
+        Self { name, kind }
+    }
+}
+
+/// What a field of an episode row may hold: checked when a sweep's rows
+/// are read back (a resume, a merge), so a corrupted or edited row is found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ColumnKind {
+    /// A whole number >= 0.
+    Count,
+    /// A coordinate of the 5x5 grid, 0 to 4.
+    Cell,
+    /// A grid coordinate, or empty (no goal).
+    OptCell,
+    /// A finite number >= 0 (seconds, metres).
+    NonNegative,
+    /// A number from 0 to 1, or empty (undefined).
+    OptRate,
+    /// A finite number >= 0, or empty (undefined).
+    OptNonNegative,
+    /// One of the 25 cities.
+    City,
+    /// One of the 25 cities, or empty (no goal).
+    OptCity,
+}
+
+impl ColumnKind {
+    /// What the kind accepts, for error messages.
+    pub fn expected(self) -> &'static str {
+        match self {
+            ColumnKind::Count => "a whole number >= 0",
+            ColumnKind::Cell => "a grid coordinate from 0 to 4",
+            ColumnKind::OptCell => "a grid coordinate from 0 to 4, or empty (no goal)",
+            ColumnKind::NonNegative => "a number >= 0",
+            ColumnKind::OptRate => "a number from 0 to 1, or empty (undefined)",
+            ColumnKind::OptNonNegative => "a number >= 0, or empty (undefined)",
+            ColumnKind::City => "one of the 25 cities",
+            ColumnKind::OptCity => "one of the 25 cities, or empty (no goal)",
+        }
+    }
+
+    /// True if `text` is a field of this kind, written as the sweep writes
+    /// it.
+    pub fn accepts(self, text: &str) -> bool {
+        let count = |t: &str| t.bytes().all(|b| b.is_ascii_digit()) && t.parse::<u64>().is_ok();
+        let number = |t: &str| t.parse::<f64>().ok().filter(|x| x.is_finite());
+        let cell = |t: &str| t.len() == 1 && (b'0'..=b'4').contains(&t.as_bytes()[0]);
+        let city = |t: &str| {
+            static NAMES: std::sync::OnceLock<Vec<String>> = std::sync::OnceLock::new();
+            NAMES
+                .get_or_init(|| {
+                    errp_robot::GoalLayout::cities()
+                        .names()
+                        .iter()
+                        .map(|n| n.to_string())
+                        .collect()
+                })
+                .iter()
+                .any(|n| n == t)
+        };
+        match self {
+            ColumnKind::Count => count(text),
+            ColumnKind::Cell => cell(text),
+            ColumnKind::OptCell => text.is_empty() || cell(text),
+            ColumnKind::NonNegative => number(text).is_some_and(|x| x >= 0.0),
+            ColumnKind::OptRate => {
+                text.is_empty() || number(text).is_some_and(|x| (0.0..=1.0).contains(&x))
+            }
+            ColumnKind::OptNonNegative => text.is_empty() || number(text).is_some_and(|x| x >= 0.0),
+            ColumnKind::City => city(text),
+            ColumnKind::OptCity => text.is_empty() || city(text),
+        }
+    }
 }
 
 /// The calibrated decoder behind one or more levels of a sweep, as
@@ -151,8 +238,36 @@ pub trait Task: 'static {
     /// Runs episode `k` of a level from `seed`.
     fn run_episode(runner: &Self::Runner, k: usize, seed: u64) -> Result<EpisodeRow>;
 
+    /// Checks what the task knows of episode `k`'s row before running it
+    /// (its start and goal) and how its fields must agree (`success` is 1
+    /// exactly when the committed goal is the user's), for a row read back
+    /// from disk. `fields` are the task's columns, each already of its
+    /// [`ColumnKind`]. The error names the column and what it must be.
+    fn check_fields(
+        scenario: &Self::Scenario,
+        k: usize,
+        success: bool,
+        fields: &[&str],
+    ) -> std::result::Result<(), FieldError>;
+
     /// The words and paper points of a figure of `scenario`'s sweep.
     fn figure(scenario: &Self::Scenario) -> FigureText;
+
+    /// About how many bytes a prepared decoder of `scenario` holds while a
+    /// sweep runs (its epoch bank, say), so that a sweep too large for
+    /// memory is refused before it starts. Small decoders: 0.
+    fn decoder_bytes(_scenario: &Self::Scenario) -> usize {
+        0
+    }
+}
+
+/// A field of a row read back that is not what it must be.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FieldError {
+    /// The column.
+    pub column: &'static str,
+    /// What it must be.
+    pub expected: String,
 }
 
 /// A rate as a CSV field: empty when undefined.

@@ -34,7 +34,7 @@ pub(crate) fn calibrate(args: &CalibrateArgs) -> Result<()> {
     // Reserve the outputs first: an unwritable path fails before the work.
     let mut edf = match &args.export {
         Some(p) => {
-            let (pending, file) = PendingFile::create(p)?;
+            let (pending, file) = PendingFile::create(p).context("--export")?;
             let montage = errp_bci::Montage::standard();
             let writer = EdfWriter::new(std::io::BufWriter::new(file), &montage, 256.0)?;
             Some((pending, writer))
@@ -43,7 +43,7 @@ pub(crate) fn calibrate(args: &CalibrateArgs) -> Result<()> {
     };
     #[cfg(feature = "rerun")]
     let rrd = match &args.save {
-        Some(p) => Some(errp_sim::calibration::calibration_recording(p)?),
+        Some(p) => Some(errp_sim::calibration::calibration_recording(p).context("--save")?),
         None => None,
     };
 

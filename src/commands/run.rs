@@ -20,16 +20,34 @@ use errp_sim::{AnyScenario, load_scenario, load_scenario_with};
 use crate::cli::{DecoderArg, RunArgs, calibration_progress};
 use crate::save::check_save;
 
+/// The most e-puck runs one recording holds.
+const MAX_RECORDED_RUNS: usize = 100;
+
 pub(crate) fn run(args: &RunArgs) -> Result<()> {
     // Overrides are keys of the scenario file, set before it is parsed, so
     // they are checked and carried through exactly as the file's own.
     let mut overrides: Vec<(&str, toml::Value)> = Vec::new();
     if let Some(a) = args.accuracy {
-        overrides.push(("user.accuracy", toml::Value::Float(a.get())));
+        overrides.push(("user.accuracy", toml::Value::Float(a)));
     }
     // The file as written is checked first, so that its own errors quote
     // its own lines; the overrides are then set in a copy of its TOML.
-    let epuck = matches!(load_scenario(&args.scenario)?, AnyScenario::Epuck(_));
+    let as_written = load_scenario(&args.scenario)?;
+    let epuck = matches!(as_written, AnyScenario::Epuck(_));
+    if args.accuracy == Some(1.0) {
+        let oracle = match (&as_written, args.decoder) {
+            (AnyScenario::Grid(_), Some(d)) => matches!(d, DecoderArg::Oracle),
+            (AnyScenario::Grid(s), None) => s.decoder == DecoderChoice::Oracle,
+            (AnyScenario::Epuck(_), _) => false,
+        };
+        if !oracle {
+            bail!(
+                "--accuracy 1: only the grid's oracle decoder may be perfect (with --decoder \
+                 oracle); the EEG decoders take a mean accuracy strictly between 0.5 and 1, \
+                 e.g. 0.95"
+            );
+        }
+    }
     if !epuck {
         if let Some(d) = args.decoder {
             let name = match d {
@@ -48,6 +66,16 @@ pub(crate) fn run(args: &RunArgs) -> Result<()> {
     }
     let scenario = load_scenario_with(&args.scenario, &overrides)?;
     check_save(args.save.as_deref())?;
+    if let (AnyScenario::Epuck(s), Some(_)) = (&scenario, &args.save) {
+        let runs = args.runs.map_or(s.runs, |r| r as usize);
+        if runs > MAX_RECORDED_RUNS {
+            bail!(
+                "--save with {runs} runs: a recording holds at most {MAX_RECORDED_RUNS} runs \
+                 (each adds about 2.5 MB to the file and 9 MB of memory while it is written); \
+                 record fewer (--runs {MAX_RECORDED_RUNS}), or run them all without --save"
+            );
+        }
+    }
     match scenario {
         AnyScenario::Grid(s) => {
             if args.runs.is_some() {
@@ -237,7 +265,7 @@ fn open_recording<T>(
     open: impl FnOnce(&Path) -> errp_sim::Result<T>,
 ) -> Result<Option<T>> {
     match &args.save {
-        Some(path) => Ok(Some(open(path)?)),
+        Some(path) => Ok(Some(open(path).context("--save")?)),
         None => Ok(None),
     }
 }

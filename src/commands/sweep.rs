@@ -3,17 +3,18 @@
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
 use errp_sweep::{
-    DecoderInfo, Manifest, Shard, SweepObserver, SweepOptions, SweepOutcome, SweepReport,
-    SweepSpec, SweepTask, TargetCache, aliases, finish_dir, merge_sweeps, parse_accuracies,
-    parse_axis, read_task, run_sweep,
+    DecoderInfo, MAX_EPISODES, Shard, SweepObserver, SweepOptions, SweepOutcome, SweepReport,
+    SweepSpec, SweepTask, TargetCache, aliases, merge_sweeps, parse_accuracies, parse_axis,
+    read_task, run_sweep,
 };
+
+use crate::cli::parse_seed;
+use crate::interrupt;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 /// The task of a sweep, as the flag takes it.
@@ -55,11 +56,11 @@ pub struct SweepArgs {
     /// strategy, fov_deg, ...; or any dotted path into the scenario file.
     #[arg(long = "param", value_name = "NAME=VALUES", long_help = param_help())]
     params: Vec<String>,
-    /// Episodes per level.
-    #[arg(long, default_value_t = 200)]
-    episodes: usize,
+    /// Episodes per level (1 to 1000000).
+    #[arg(long, default_value_t = 200, value_parser = clap::value_parser!(u64).range(1..=MAX_EPISODES as u64))]
+    episodes: u64,
     /// Sweep seed: every calibration and episode seed derives from it.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = parse_seed, allow_negative_numbers = true)]
     seed: u64,
     /// Output directory (rerunning into it resumes).
     #[arg(long, value_name = "DIR")]
@@ -71,9 +72,10 @@ pub struct SweepArgs {
     /// `errp merge`.
     #[arg(long, value_name = "K/N")]
     shard: Option<String>,
-    /// Worker threads (default: one per core). Results do not depend on it.
-    #[arg(long)]
-    threads: Option<usize>,
+    /// Worker threads, 1 to 1024 (default: one per core). Results do not
+    /// depend on it.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
+    threads: Option<u64>,
     /// Where targeting results are cached (default: $ERRP_CACHE_DIR, else
     /// $XDG_CACHE_HOME/errp, else ~/.cache/errp).
     #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
@@ -81,6 +83,10 @@ pub struct SweepArgs {
     /// Do not read or write the targeting cache.
     #[arg(long)]
     no_cache: bool,
+    /// On resume, drop an invalid row of DIR/episodes.csv (and the rows
+    /// after it) and run them again, instead of stopping at it.
+    #[arg(long)]
+    repair: bool,
     /// No progress output.
     #[arg(long)]
     quiet: bool,
@@ -179,6 +185,8 @@ impl SweepObserver for Progress {
     }
 
     fn episodes_done(&self, done: usize, total: usize) {
+        // Rows are on disk from now on: a signal stops between episodes.
+        interrupt::graceful(true);
         if let Some(bar) = &self.bar {
             if bar.message() != "episodes" {
                 bar.set_message("episodes");
@@ -186,6 +194,13 @@ impl SweepObserver for Progress {
                 bar.reset_eta();
             }
             bar.set_position(done as u64);
+        }
+    }
+
+    fn note(&self, text: &str) {
+        match &self.bar {
+            Some(bar) => bar.println(format!("note: {text}")),
+            None => eprintln!("note: {text}"),
         }
     }
 }
@@ -240,12 +255,6 @@ pub fn sweep(args: &SweepArgs) -> Result<bool> {
         }
         (SweepTask::Epuck, None) => {}
     }
-    if args.episodes == 0 {
-        bail!("--episodes must be at least 1");
-    }
-    if args.threads == Some(0) {
-        bail!("--threads must be at least 1");
-    }
     let spec = SweepSpec {
         task,
         scenario_path: path,
@@ -257,7 +266,7 @@ pub fn sweep(args: &SweepArgs) -> Result<bool> {
             .map(|p| parse_axis(task, p))
             .collect::<errp_sim::Result<_>>()?,
         fixed,
-        episodes: args.episodes,
+        episodes: args.episodes as usize,
         seed: args.seed,
     };
     let shard = match &args.shard {
@@ -274,21 +283,16 @@ pub fn sweep(args: &SweepArgs) -> Result<bool> {
         cache,
         shard,
         chunk: 0,
+        repair: args.repair,
     };
     // Validate every level before printing anything or starting work
     // (`run_sweep` checks them again, before it creates the directory).
     spec.levels()?;
-
-    let cancel = Arc::new(AtomicBool::new(false));
-    {
-        let cancel = cancel.clone();
-        // A second Ctrl-C stops at once; rows on disk are kept either way.
-        let _ = ctrlc::set_handler(move || {
-            if cancel.swap(true, Ordering::SeqCst) {
-                std::process::exit(130);
-            }
-        });
+    // A cache that cannot be used is not an error, but the user is told.
+    if let Some(why) = opts.cache.problem() {
+        eprintln!("warning: {why}");
     }
+
     let progress = Progress::new(args.quiet);
     progress.line(&format!(
         "Sweeping {} ({}): {} levels x {} episodes{}, seed {}, into {}",
@@ -305,15 +309,20 @@ pub fn sweep(args: &SweepArgs) -> Result<bool> {
         opts.out.display()
     ));
     let started = wall_clock();
-    let run = || run_sweep(&spec, &opts, &cancel, &progress);
+    let run = || {
+        run_sweep(&spec, &opts, &interrupt::CANCEL, &progress)
+            .map_err(|e| name_flag(e, "--out", &opts.out))
+    };
     let outcome = match args.threads {
         Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
+            .num_threads(n as usize)
             .build()
             .context("cannot start the worker threads")?
-            .install(run)?,
-        None => run()?,
+            .install(run),
+        None => run(),
     };
+    interrupt::graceful(false);
+    let outcome = outcome?;
     if let Some(bar) = &progress.bar {
         bar.finish_and_clear();
     }
@@ -327,7 +336,7 @@ pub fn sweep(args: &SweepArgs) -> Result<bool> {
             );
             Ok(false)
         }
-        SweepOutcome::Complete { ran, total } => {
+        SweepOutcome::Complete { ran, total, report } => {
             if !args.quiet {
                 eprintln!(
                     "{ran} episodes in {secs:.1} s ({:.0} per second){}",
@@ -339,9 +348,7 @@ pub fn sweep(args: &SweepArgs) -> Result<bool> {
                     }
                 );
             }
-            if shard.is_all() {
-                let manifest = Manifest::read(&opts.out)?;
-                let report = finish_dir(&opts.out, &manifest)?;
+            if let Some(report) = report {
                 print_report(&report);
             } else {
                 println!(
@@ -366,9 +373,23 @@ fn print_report(report: &SweepReport) {
 
 /// Runs `errp merge`.
 pub fn merge(args: &MergeArgs) -> Result<()> {
-    let report = merge_sweeps(&args.dirs, Path::new(&args.out))?;
+    let report = merge_sweeps(&args.dirs, Path::new(&args.out))
+        .map_err(|e| name_flag(e, "--out", &args.out))?;
     print_report(&report);
     Ok(())
+}
+
+/// An error about a file under `dir` (an output directory given by `flag`)
+/// names the flag; other errors name their own files.
+fn name_flag(e: errp_sim::SimError, flag: &str, dir: &Path) -> anyhow::Error {
+    use errp_sim::SimError;
+    match &e {
+        SimError::Output { path, .. } | SimError::Input { path, .. } if path.starts_with(dir) => {
+            let text = format!("{flag} {}", dir.display());
+            anyhow::Error::new(e).context(text)
+        }
+        _ => e.into(),
+    }
 }
 
 /// The long help of `--param`, listing every short name (from the sweep's

@@ -1,7 +1,8 @@
 //! Whole sweeps, as `errp sweep` runs them, on 1 and 2 threads: the grid's
 //! 11 levels x 200 episodes with the EEG decoder (epoch bank), cold (the
 //! accuracy targeting searched) and warm (targeting from the cache), and
-//! e-puck episodes per second. Run with `cargo bench -p errp_sim --bench sweep`.
+//! e-puck episodes per second; and the check of every row when a finished
+//! sweep is rerun. Run with `cargo bench -p errp_sweep --bench sweep`.
 
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
@@ -68,6 +69,7 @@ fn sweep(spec: &SweepSpec, threads: usize, cache: &TargetCache, name: &str) {
         cache: cache.clone(),
         shard: Shard::ALL,
         chunk: 0,
+        repair: false,
     };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -99,6 +101,33 @@ fn grid_11x200_cached(bencher: Bencher, threads: usize) {
 #[divan::bench(args = [1, 2], sample_count = 2, sample_size = 1)]
 fn epuck_40_episodes(bencher: Bencher, threads: usize) {
     cached(bencher, threads, epuck_spec, 40, "epuck");
+}
+
+/// Rerunning a finished sweep of 4 levels x 10000 oracle grid episodes:
+/// every row of `episodes.csv` read back and checked (fields, seed,
+/// checksum), then the summary and plots written again. What a resume or a
+/// merge pays per row.
+#[divan::bench(sample_count = 3, sample_size = 1)]
+fn recheck_40000_rows(bencher: Bencher) {
+    let toml = "task = \"grid\"\ndecoder = \"oracle\"\n[user]\naccuracy = 0.8\n\
+                [free_goals]\ncount = 50\n";
+    let spec = spec(SweepTask::Grid, "oracle.toml", toml, "0.6:0.9:0.1", 10_000);
+    let out = scratch("recheck");
+    let _ = std::fs::remove_dir_all(&out);
+    let opts = SweepOptions {
+        out: out.clone(),
+        cache: TargetCache::disabled(),
+        shard: Shard::ALL,
+        chunk: 0,
+        repair: false,
+    };
+    let cancel = AtomicBool::new(false);
+    run_sweep(&spec, &opts, &cancel, &()).unwrap();
+    bencher.bench_local(|| {
+        let outcome = run_sweep(&spec, &opts, &cancel, &()).unwrap();
+        assert!(matches!(outcome, SweepOutcome::Complete { ran: 0, .. }));
+    });
+    let _ = std::fs::remove_dir_all(&out);
 }
 
 /// Benches a sweep of `episodes` episodes per level made by `spec`, its

@@ -19,6 +19,8 @@ use errp_sim::write_atomic;
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct TargetCache {
     dir: Option<PathBuf>,
+    /// No directory because none could be found (not by choice).
+    unset: bool,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -32,12 +34,16 @@ impl TargetCache {
     pub fn new(dir: impl Into<PathBuf>) -> Self {
         Self {
             dir: Some(dir.into()),
+            unset: false,
         }
     }
 
     /// No cache: every targeting is searched.
     pub fn disabled() -> Self {
-        Self { dir: None }
+        Self {
+            dir: None,
+            unset: false,
+        }
     }
 
     /// The default place: `$ERRP_CACHE_DIR`, else `$XDG_CACHE_HOME/errp`,
@@ -51,7 +57,33 @@ impl TargetCache {
         let dir = env("ERRP_CACHE_DIR")
             .or_else(|| env("XDG_CACHE_HOME").map(|d| d.join("errp")))
             .or_else(|| env("HOME").map(|d| d.join(".cache").join("errp")));
-        Self { dir }
+        Self {
+            unset: dir.is_none(),
+            dir,
+        }
+    }
+
+    /// Why this cache will not keep anything, if it will not: no
+    /// directory could be found, or the directory cannot be written (it is
+    /// tried now, with a temporary file). A sweep runs without it, each
+    /// targeting searched afresh.
+    pub fn problem(&self) -> Option<String> {
+        let unused = "so every decoder's accuracy targeting is searched again on every run";
+        if self.unset {
+            return Some(format!(
+                "no targeting cache: $ERRP_CACHE_DIR, $XDG_CACHE_HOME and $HOME are all unset, \
+                 {unused} (give --cache DIR, or --no-cache to turn it off)"
+            ));
+        }
+        let dir = self.dir.as_ref()?;
+        let probe = errp_sim::create_dir(dir)
+            .and_then(|()| errp_sim::PendingFile::create(dir.join("write-test")).map(drop));
+        probe.err().map(|e| {
+            format!(
+                "the targeting cache cannot be written ({e}), {unused} (give another --cache \
+                 DIR, or --no-cache)"
+            )
+        })
     }
 
     /// The cache directory, if any.

@@ -17,6 +17,7 @@
 mod cache;
 mod figure;
 mod finish;
+mod lock;
 mod manifest;
 mod merge;
 mod observer;
@@ -33,15 +34,16 @@ pub use cache::TargetCache;
 pub use errp_sim::task::DecoderInfo;
 pub use figure::sweep_plot;
 pub use finish::finish_dir;
+pub use lock::{DirLock, HEARTBEAT, Holder, LOCK, STALE_AFTER};
 pub use manifest::{EPISODES, MANIFEST, Manifest};
 pub use merge::merge_sweeps;
 pub use observer::SweepObserver;
 pub use plot::{LevelPoint, PaperPoint, PlotError, Series, SweepPlot};
-pub use rows::episodes_header;
+pub use rows::{CHECKSUM, episodes_header};
 pub use run::{SweepOptions, SweepOutcome, run_sweep};
 pub use spec::{
-    Axis, Level, Shard, SweepSpec, SweepTask, aliases, parse_accuracies, parse_axis, parse_values,
-    read_task, sweepable,
+    Axis, Level, MAX_EPISODES, MAX_LEVELS, Shard, SweepSpec, SweepTask, aliases, parse_accuracies,
+    parse_axis, parse_values, read_task, sweepable,
 };
 pub use summary::{LevelSummary, SweepReport, summarise_dir};
 pub use table::summary_csv;

@@ -24,8 +24,12 @@ pub struct Manifest {
     pub decoders: Vec<DecoderInfo>,
 }
 
-/// Version of the sweep directory layout.
-pub const FORMAT: u32 = 1;
+/// Version of the sweep directory layout (2: rows end in a checksum).
+pub const FORMAT: u32 = 2;
+
+/// The largest `sweep.json` read (it holds the scenario's text, at most
+/// 1 MiB, and a line per decoder).
+pub const MAX_MANIFEST_BYTES: u64 = 16 << 20;
 
 impl Manifest {
     /// A manifest with no decoders yet.
@@ -39,19 +43,48 @@ impl Manifest {
         }
     }
 
-    /// Reads `dir/sweep.json`.
+    /// Reads `dir/sweep.json` (at most [`MAX_MANIFEST_BYTES`]), which must
+    /// be of this version's [`FORMAT`].
     pub fn read(dir: &Path) -> Result<Self> {
+        use std::io::Read;
         let path = dir.join(MANIFEST);
-        let text = std::fs::read_to_string(&path).map_err(|source| SimError::Input {
+        let input = |source| SimError::Input {
             path: path.clone(),
             source,
-        })?;
-        serde_json::from_str(&text).map_err(|e| {
+        };
+        let mut text = String::new();
+        std::fs::File::open(&path)
+            .map_err(input)?
+            .take(MAX_MANIFEST_BYTES + 1)
+            .read_to_string(&mut text)
+            .map_err(input)?;
+        let not_ours = |why: String| {
             SimError::Sweep(format!(
-                "{}: not a sweep manifest ({e}); was it written by `errp sweep`?",
+                "{}: not a sweep manifest ({why}); was it written by `errp sweep`?",
                 path.display()
             ))
-        })
+        };
+        if text.len() as u64 > MAX_MANIFEST_BYTES {
+            return Err(not_ours(format!(
+                "it is over {} MiB",
+                MAX_MANIFEST_BYTES >> 20
+            )));
+        }
+        #[derive(Deserialize)]
+        struct Format {
+            format: u32,
+        }
+        let format = serde_json::from_str::<Format>(&text)
+            .map_err(|e| not_ours(e.to_string()))?
+            .format;
+        if format != FORMAT {
+            return Err(SimError::Sweep(format!(
+                "{}: a sweep directory of format {format}, written by another version of errp \
+                 (this one reads format {FORMAT}); rerun the sweep into a new --out",
+                path.display()
+            )));
+        }
+        serde_json::from_str(&text).map_err(|e| not_ours(e.to_string()))
     }
 
     /// Writes `dir/sweep.json` atomically.

@@ -2,20 +2,29 @@
 //! run writes, byte for byte.
 
 use std::fs::File;
-use std::io::{BufRead, BufReader, BufWriter, Lines, Write};
+use std::io::{BufReader, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use errp_sim::PendingFile;
+use errp_sim::epuck::EpuckTask;
+use errp_sim::grid::GridTask;
+use errp_sim::task::Task;
 use errp_sim::{Result, SimError, create_dir};
 
 use crate::finish::finish_dir;
+use crate::lock::DirLock;
 use crate::manifest::{EPISODES, MANIFEST, Manifest};
-use crate::rows::episodes_header;
+use crate::rows::{RowCheck, episodes_header};
+use crate::spec::{Level, SweepSpec, SweepTask};
 use crate::summary::SweepReport;
+use crate::writer::read_row;
 
 /// Merges the shard directories `dirs` (every shard of one sweep, in any
 /// order) into `out`: `episodes.csv` in sweep order, then the summary, plots
-/// and manifest of an unsharded run.
+/// and manifest of an unsharded run. Every row of every shard is checked
+/// as a resume checks it (fields, seeds, checksum); a shard that is
+/// incomplete, damaged or still being written is refused, naming the file
+/// and line, and a refused merge leaves no `out` it created.
 pub fn merge_sweeps(dirs: &[PathBuf], out: &Path) -> Result<SweepReport> {
     if dirs.is_empty() {
         return Err(SimError::Sweep("merge needs the shard directories".into()));
@@ -78,35 +87,77 @@ pub fn merge_sweeps(dirs: &[PathBuf], out: &Path) -> Result<SweepReport> {
             out.display()
         )));
     }
+    for (k, d) in inputs.iter().enumerate() {
+        if let Some(h) = DirLock::holder(d) {
+            return Err(SimError::Sweep(format!(
+                "shard {}/{count} in {} is still being written (errp on host {}, pid {}); \
+                 merge once it has finished",
+                k + 1,
+                d.display(),
+                h.host,
+                h.pid
+            )));
+        }
+    }
     if out.join(MANIFEST).exists() {
         return Err(SimError::Sweep(format!(
             "{} already holds a sweep; choose another --out or delete it",
             out.display()
         )));
     }
+    let levels = spec.levels()?;
+    let created = !out.exists();
     create_dir(out)?;
+    let result = DirLock::acquire(out, "--out").and_then(|lock| {
+        let report = match spec.task {
+            SweepTask::Grid => merge_rows::<GridTask>(&spec, &levels, &inputs, out),
+            SweepTask::Epuck => merge_rows::<EpuckTask>(&spec, &levels, &inputs, out),
+        }
+        .and_then(|()| {
+            let manifest = Manifest {
+                shard: None,
+                ..first.clone()
+            };
+            finish_dir(out, &manifest)
+        });
+        drop(lock);
+        report
+    });
+    if result.is_err() && created {
+        let _ = std::fs::remove_dir_all(out);
+    }
+    result
+}
 
+/// Writes `out/episodes.csv` from the shards' rows in sweep order, checking
+/// every row as a resume does; nothing is left if one fails.
+fn merge_rows<T: Task>(
+    spec: &SweepSpec,
+    levels: &[Level],
+    inputs: &[&Path],
+    out: &Path,
+) -> Result<()> {
+    let count = inputs.len();
+    let check = RowCheck::<T>::new(spec, levels)?;
     // Episode g of the sweep is row g / count of shard g % count + 1.
-    let header = episodes_header(&spec);
-    let mut readers: Vec<(Lines<BufReader<File>>, PathBuf)> = Vec::with_capacity(count);
-    for d in &inputs {
+    let header = episodes_header(spec);
+    let mut readers: Vec<(BufReader<File>, PathBuf)> = Vec::with_capacity(count);
+    let mut line = Vec::new();
+    for d in inputs {
         let path = d.join(EPISODES);
-        let file = File::open(&path).map_err(|source| SimError::Input {
+        let input = |source| SimError::Input {
             path: path.clone(),
             source,
-        })?;
-        let mut lines = BufReader::new(file).lines();
-        let h = lines.next().transpose().map_err(|source| SimError::Input {
-            path: path.clone(),
-            source,
-        })?;
-        if h.as_deref() != Some(header.as_str()) {
+        };
+        let mut reader = BufReader::new(File::open(&path).map_err(input)?);
+        let whole = read_row(&mut reader, &mut line).map_err(input)?;
+        if whole != Some(true) || line != header.as_bytes() {
             return Err(SimError::Sweep(format!(
                 "{}: its header is not this sweep's",
                 path.display()
             )));
         }
-        readers.push((lines, path));
+        readers.push((reader, path));
     }
     let dest = out.join(EPISODES);
     let (pending, file) = PendingFile::create(&dest)?;
@@ -116,25 +167,50 @@ pub fn merge_sweeps(dirs: &[PathBuf], out: &Path) -> Result<SweepReport> {
     };
     let mut w = BufWriter::new(file);
     writeln!(w, "{header}").map_err(io)?;
+    let rerun = "rerun that shard's command (it resumes; add --repair to run the bad rows \
+                 again), then merge";
     for g in 0..spec.total_episodes() {
-        let (lines, path) = &mut readers[g % count];
-        let line = lines
-            .next()
-            .transpose()
+        let (reader, path) = &mut readers[g % count];
+        let lineno = g / count + 2;
+        let whole = read_row(reader, &mut line).map_err(|source| SimError::Input {
+            path: path.clone(),
+            source,
+        })?;
+        match whole {
+            None => {
+                return Err(SimError::Sweep(format!(
+                    "{} is incomplete: it ends before line {lineno} (episode {g} of the \
+                     sweep); {rerun}",
+                    path.display()
+                )));
+            }
+            Some(false) => {
+                return Err(SimError::Sweep(format!(
+                    "{} is incomplete: line {lineno} is cut short (no end of line); {rerun}",
+                    path.display()
+                )));
+            }
+            Some(true) => {}
+        }
+        let text = std::str::from_utf8(&line).map_err(|_| {
+            SimError::Sweep(format!(
+                "{} line {lineno}: the row is not text (damage on disk); {rerun}",
+                path.display()
+            ))
+        })?;
+        check
+            .check(g, text)
+            .map_err(|fault| fault.error(path, lineno, rerun))?;
+        writeln!(w, "{text}").map_err(io)?;
+    }
+    for (reader, path) in &mut readers {
+        if read_row(reader, &mut line)
             .map_err(|source| SimError::Input {
                 path: path.clone(),
                 source,
             })?
-            .ok_or_else(|| {
-                SimError::Sweep(format!(
-                    "{} is incomplete: rerun that shard's command to finish it, then merge",
-                    path.display()
-                ))
-            })?;
-        writeln!(w, "{line}").map_err(io)?;
-    }
-    for (lines, path) in &mut readers {
-        if lines.next().is_some() {
+            .is_some()
+        {
             return Err(SimError::Sweep(format!(
                 "{} has more rows than its shard of the sweep",
                 path.display()
@@ -144,11 +220,7 @@ pub fn merge_sweeps(dirs: &[PathBuf], out: &Path) -> Result<SweepReport> {
     let file = w.into_inner().map_err(|e| io(e.into_error()))?;
     file.sync_all().map_err(io)?;
     pending.commit()?;
-    let manifest = Manifest {
-        shard: None,
-        ..first.clone()
-    };
-    finish_dir(out, &manifest)
+    Ok(())
 }
 
 /// True if `a` and `b` name the same existing directory.

@@ -1,4 +1,4 @@
-//! What a sweep reports as it goes: decoders calibrated, episodes done.
+//! What a sweep reports as it goes: decoders calibrated, episodes done, notes.
 
 use errp_sim::task::DecoderInfo;
 
@@ -9,6 +9,9 @@ pub trait SweepObserver: Sync {
     fn decoder_ready(&self, _info: &DecoderInfo, _done: usize, _total: usize) {}
     /// `done` of this run's `total` episodes are on disk.
     fn episodes_done(&self, _done: usize, _total: usize) {}
+    /// Something the user should know that is not an error (rows dropped
+    /// by `--repair`).
+    fn note(&self, _text: &str) {}
 }
 
 impl SweepObserver for () {}

@@ -4,22 +4,28 @@
 use std::collections::HashMap;
 use std::fs::OpenOptions;
 use std::io::{Seek, SeekFrom, Write};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
 use errp_sim::epuck::EpuckTask;
 use errp_sim::grid::GridTask;
 use errp_sim::task::Task;
-use errp_sim::{Result, SimError, create_dir};
+use errp_sim::{Result, SimError, create_dir, forget_if_interrupted, remove_if_interrupted};
 
 use crate::cache::TargetCache;
+use crate::finish::finish_dir;
+use crate::lock::{DirLock, LOCK};
 use crate::manifest::{EPISODES, MANIFEST, Manifest};
 use crate::observer::SweepObserver;
 use crate::prepare::prepare_all;
-use crate::rows::episodes_header;
+use crate::rows::{RowCheck, episodes_header};
 use crate::spec::{Level, Shard, SweepSpec, SweepTask};
-use crate::writer::{EpisodeJob, resume_rows};
+use crate::summary::SweepReport;
+use crate::writer::{EpisodeJob, Resumed, Slice, resume_rows};
+
+/// The most memory a sweep's decoders may hold, bytes.
+pub const MAX_DECODER_BYTES: usize = 8 << 30;
 
 /// How a sweep runs (none of it changes the results).
 #[derive(Debug, Clone)]
@@ -33,6 +39,9 @@ pub struct SweepOptions {
     /// Episodes run in parallel before each write to disk (0: a default by
     /// task).
     pub chunk: usize,
+    /// On resume, drop an invalid row of `episodes.csv` and every row after
+    /// it, and run them again (without it, an invalid row is an error).
+    pub repair: bool,
 }
 
 /// How a call to [`run_sweep`] ended.
@@ -44,6 +53,10 @@ pub enum SweepOutcome {
         ran: usize,
         /// Episodes of the slice.
         total: usize,
+        /// The summary of a whole sweep, whose `summary.csv`, plots and
+        /// final `sweep.json` are written (none for a shard: `errp merge`
+        /// writes them).
+        report: Option<SweepReport>,
     },
     /// Stopped by the cancel flag; rerunning resumes.
     Interrupted {
@@ -54,27 +67,38 @@ pub enum SweepOutcome {
     },
 }
 
-/// Runs (or resumes) a sweep's slice into `opts.out`. `cancel` is polled
-/// between chunks: when it is set the rows written so far stay, and the same
-/// call later resumes. Results do not depend on the thread count (run it
-/// inside a rayon pool to choose one), on `opts.chunk`, or on interruptions.
+/// Runs (or resumes) a sweep's slice into `opts.out`, holding the
+/// directory's lock ([`DirLock`]) throughout; a whole sweep is also
+/// finished (summary, plots, final manifest). `cancel` is polled between
+/// episodes: when it is set the rows written so far stay, and the same call
+/// later resumes. Results do not depend on the thread count (run it inside
+/// a rayon pool to choose one), on `opts.chunk`, or on interruptions.
+///
+/// A directory that does not exist is created; one that exists must hold
+/// this sweep (its `sweep.json`) or nothing. Every row already on disk is
+/// checked before it is kept. A refused or failed start leaves no new
+/// directory behind.
 pub fn run_sweep(
     spec: &SweepSpec,
     opts: &SweepOptions,
     cancel: &AtomicBool,
     observer: &dyn SweepObserver,
 ) -> Result<SweepOutcome> {
-    if spec.episodes == 0 {
-        return Err(SimError::Sweep("--episodes must be at least 1".into()));
-    }
-    if spec.accuracies.is_empty() {
-        return Err(SimError::Sweep("--accuracy gives no level".into()));
-    }
     let levels = spec.levels()?;
     let out = &opts.out;
+    let created = !out.exists();
+    create_dir(out)?;
+    // Undo a directory this call created, if it ends before any row.
+    let undo = |e: SimError| {
+        if created {
+            let _ = std::fs::remove_dir_all(out);
+            forget_if_interrupted(out);
+        }
+        e
+    };
+    let lock = DirLock::acquire(out, "--out").map_err(undo)?;
     let fresh = Manifest::new(spec, opts.shard);
     let manifest_path = out.join(MANIFEST);
-    let episodes_path = out.join(EPISODES);
     if manifest_path.exists() {
         let old = Manifest::read(out)?;
         if old.spec != fresh.spec || old.shard != fresh.shard {
@@ -85,20 +109,66 @@ pub fn run_sweep(
             )));
         }
     } else {
-        if episodes_path.exists() {
+        let others = foreign_files(out)?;
+        if !others.is_empty() {
+            drop(lock);
             return Err(SimError::Sweep(format!(
-                "{} has an {EPISODES} but no {MANIFEST}; choose another --out",
-                out.display()
+                "--out {} holds files that are not a sweep's ({}); give a new or empty \
+                 directory",
+                out.display(),
+                others.join(", ")
             )));
         }
-        create_dir(out)?;
-        fresh.write(out)?;
+    }
+    // A directory made here goes if the sweep is interrupted before its
+    // first row (`sweep.json` is written once the decoders are ready).
+    if created {
+        remove_if_interrupted(out);
     }
 
-    match spec.task {
+    let outcome = match spec.task {
         SweepTask::Grid => run_levels::<GridTask>(spec, opts, &levels, fresh, cancel, observer),
         SweepTask::Epuck => run_levels::<EpuckTask>(spec, opts, &levels, fresh, cancel, observer),
+    };
+    // A new directory that failed before its first row goes.
+    let outcome = match outcome {
+        Err(e) if !out.join(EPISODES).exists() => return Err(undo(e)),
+        other => other?,
+    };
+    let outcome = match outcome {
+        SweepOutcome::Complete { ran, total, .. } if opts.shard.is_all() => {
+            let manifest = Manifest::read(out)?;
+            SweepOutcome::Complete {
+                ran,
+                total,
+                report: Some(finish_dir(out, &manifest)?),
+            }
+        }
+        other => other,
+    };
+    drop(lock);
+    Ok(outcome)
+}
+
+/// The entries of `dir` that no sweep writes (the first few, by name).
+fn foreign_files(dir: &Path) -> Result<Vec<String>> {
+    let entries = std::fs::read_dir(dir).map_err(|source| SimError::Input {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let mut names: Vec<String> = entries
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n != LOCK && !(n.starts_with('.') && n.contains(".partial-")))
+        .take(1000)
+        .collect();
+    names.sort();
+    if names.len() > 5 {
+        let more = names.len() - 5;
+        names.truncate(5);
+        names.push(format!("and {more} more"));
     }
+    Ok(names)
 }
 
 /// Prepares the levels' decoders (one per distinct calibration, in
@@ -136,6 +206,24 @@ fn run_levels<T: Task>(
         key_of.push(d);
     }
     let distinct: Vec<&T::Scenario> = first.iter().map(|&i| scenarios[i]).collect();
+    // What the decoders will hold (their shared parts about as much as the
+    // largest), refused before the work if it is more than a sweep may take.
+    let largest = distinct
+        .iter()
+        .map(|s| T::decoder_bytes(s))
+        .max()
+        .unwrap_or(0);
+    let bytes = distinct.iter().map(|s| T::decoder_bytes(s)).sum::<usize>() + 2 * largest;
+    if bytes > MAX_DECODER_BYTES {
+        return Err(SimError::Sweep(format!(
+            "the sweep's {} decoders would hold about {:.1} GiB (their epoch banks), more than \
+             the {} GiB a sweep may take: sweep fewer levels at once, lower bank_per_class, \
+             or stream the EEG (--eeg stream)",
+            distinct.len(),
+            bytes as f64 / (1u64 << 30) as f64,
+            MAX_DECODER_BYTES >> 30
+        )));
+    }
     let shared = T::shared(&scenarios)?;
     let prepared = prepare_all::<T>(
         &distinct,
@@ -160,15 +248,29 @@ fn run_levels<T: Task>(
         .collect::<Result<_>>()?;
 
     // Episodes of this slice, in sweep order.
-    let items: Vec<usize> = (0..spec.total_episodes())
-        .filter(|&g| opts.shard.owns(g))
-        .collect();
+    let items = Slice::new(opts.shard, spec.total_episodes());
     let header = episodes_header(spec);
-    let mut done = if episodes_path.exists() {
-        resume_rows(&episodes_path, &header, spec, &items)?
+    let check = RowCheck::<T>::new(spec, levels)?;
+    let resumed = if episodes_path.exists() {
+        resume_rows(&episodes_path, &header, &check, items, opts.repair)?
     } else {
-        usize::MAX
+        Resumed::Empty
     };
+    let mut done = match resumed {
+        Resumed::Empty => usize::MAX,
+        Resumed::Rows { rows, dropped } => {
+            if let Some((line, why, n)) = dropped {
+                observer.note(&format!(
+                    "--repair: {} line {line}: {why}; dropped it and the {} row(s) after it, \
+                     to run them again",
+                    episodes_path.display(),
+                    n - 1
+                ));
+            }
+            rows
+        }
+    };
+    forget_if_interrupted(out);
     let mut file = OpenOptions::new()
         .create(true)
         .append(true)
@@ -188,7 +290,7 @@ fn run_levels<T: Task>(
         done = 0;
     }
     let already = done;
-    observer.episodes_done(done, items.len());
+    observer.episodes_done(done, items.len);
     let sync_every = if opts.chunk > 0 {
         opts.chunk
     } else {
@@ -198,21 +300,22 @@ fn run_levels<T: Task>(
         spec,
         levels,
         runners: &runners,
-        items: &items,
+        items,
         cancel,
         observer,
         sync_every,
         window: 64 * rayon::current_num_threads(),
     };
     done = job.run(file, done, &episodes_path)?;
-    if done < items.len() {
+    if done < items.len {
         return Ok(SweepOutcome::Interrupted {
             done,
-            total: items.len(),
+            total: items.len,
         });
     }
     Ok(SweepOutcome::Complete {
         ran: done - already,
-        total: items.len(),
+        total: items.len,
+        report: None,
     })
 }

@@ -16,7 +16,7 @@ use errp_sim::epuck::EpuckTask;
 use errp_sim::grid::GridTask;
 pub use errp_sim::task::format_number;
 use errp_sim::task::{Task, TaskInfo};
-use errp_sim::{AnyScenario, is_epuck, parse_scenario};
+use errp_sim::{AnyScenario, is_epuck, parse_scenario_table};
 use errp_sim::{Result, SimError};
 use errp_sim::{parse_toml, read_scenario, set_key};
 
@@ -149,6 +149,22 @@ pub fn value_text(v: &Value) -> String {
     }
 }
 
+/// Most episodes per level.
+pub const MAX_EPISODES: usize = 1_000_000;
+
+/// Most levels in a sweep (accuracies times every swept value).
+pub const MAX_LEVELS: usize = 1000;
+
+/// The first value that appears twice in `values` (as the CSV writes it).
+fn repeated(values: &[Value]) -> Option<String> {
+    let texts: Vec<String> = values.iter().map(value_text).collect();
+    texts
+        .iter()
+        .enumerate()
+        .find(|(i, t)| texts[..*i].contains(t))
+        .map(|(_, t)| t.clone())
+}
+
 /// Rounds away the binary noise of `a + k * step` (`0.30000000000000004`).
 fn tidy(x: f64) -> f64 {
     let r = (x * 1e12).round() / 1e12;
@@ -250,6 +266,11 @@ pub fn parse_accuracies(text: &str) -> Result<Vec<f64>> {
         }
         out.push(a);
     }
+    if let Some(twice) = repeated(&out.iter().map(|a| Value::Float(*a)).collect::<Vec<_>>()) {
+        return Err(SimError::Sweep(format!(
+            "--accuracy {text:?} is invalid: {twice} is given twice (each level once)"
+        )));
+    }
     Ok(out)
 }
 
@@ -303,10 +324,28 @@ pub fn parse_axis(task: SweepTask, text: &str) -> Result<Axis> {
             "--param {name}: sweep the accuracy with --accuracy and set the seed with --seed"
         )));
     }
+    if key.split('.').count() > errp_sim::MAX_KEY_PARTS
+        || !key
+            .split('.')
+            .all(|p| !p.is_empty() && p.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_'))
+    {
+        return Err(SimError::Sweep(format!(
+            "--param {}: not a scenario field: a field is a dotted key of 1 to {} parts of \
+             letters, digits and _ (e.g. control.tau)",
+            errp_sim::truncate(name, 60),
+            errp_sim::MAX_KEY_PARTS
+        )));
+    }
+    let values = parse_values(values, &format!("--param {name}"))?;
+    if let Some(twice) = repeated(&values) {
+        return Err(SimError::Sweep(format!(
+            "--param {name}: {twice} is given twice (each value once)"
+        )));
+    }
     Ok(Axis {
         name: name.to_string(),
         key,
-        values: parse_values(values, &format!("--param {name}"))?,
+        values,
     })
 }
 
@@ -374,9 +413,71 @@ impl SweepSpec {
         errp_bci::rng::derive_seed(level, "sweep/episode", k as u64)
     }
 
+    /// Checks the sweep's size and that no level is given twice: the
+    /// episodes per level, the number of levels, and axes that are distinct
+    /// parameters.
+    pub fn check(&self) -> Result<()> {
+        if !(1..=MAX_EPISODES).contains(&self.episodes) {
+            return Err(SimError::Sweep(format!(
+                "--episodes {} is invalid: expected 1 to {MAX_EPISODES} episodes per level",
+                self.episodes
+            )));
+        }
+        if self.accuracies.is_empty() {
+            return Err(SimError::Sweep("--accuracy gives no level".into()));
+        }
+        let levels = self
+            .axes
+            .iter()
+            .try_fold(self.accuracies.len(), |n, a| n.checked_mul(a.values.len()));
+        if levels.is_none_or(|n| n > MAX_LEVELS) {
+            let sizes: Vec<String> = std::iter::once(self.accuracies.len())
+                .chain(self.axes.iter().map(|a| a.values.len()))
+                .map(|n| n.to_string())
+                .collect();
+            return Err(SimError::Sweep(format!(
+                "{} levels ({}) is too many: a sweep has at most {MAX_LEVELS} (accuracies \
+                 times every --param's values); split it into several sweeps",
+                levels.map_or("more than 2^64".into(), |n| n.to_string()),
+                sizes.join(" x ")
+            )));
+        }
+        for (i, a) in self.axes.iter().enumerate() {
+            if let Some(b) = self.axes[..i]
+                .iter()
+                .find(|b| b.name == a.name || b.key == a.key)
+            {
+                return Err(SimError::Sweep(format!(
+                    "--param {} and --param {} both set {}: give one --param per field, with \
+                     all its values (e.g. tau=0.3,0.5)",
+                    b.name, a.name, a.key
+                )));
+            }
+            if let Some(twice) = repeated(&a.values) {
+                return Err(SimError::Sweep(format!(
+                    "--param {}: {twice} is given twice (each value once)",
+                    a.name
+                )));
+            }
+        }
+        if let Some(twice) = repeated(
+            &self
+                .accuracies
+                .iter()
+                .map(|a| Value::Float(*a))
+                .collect::<Vec<_>>(),
+        ) {
+            return Err(SimError::Sweep(format!(
+                "--accuracy: {twice} is given twice (each level once)"
+            )));
+        }
+        Ok(())
+    }
+
     /// Builds and validates every level's scenario. An invalid swept value
     /// is reported with the level and the scenario's own field error.
     pub fn levels(&self) -> Result<Vec<Level>> {
+        self.check()?;
         let base: Table = parse_toml(&self.scenario_toml, &self.scenario_path)?;
         (0..self.n_levels())
             .map(|index| {
@@ -409,8 +510,7 @@ impl SweepSpec {
                 for (k, v) in sets {
                     set_key(&mut t, k, v).map_err(context)?;
                 }
-                let text = toml::to_string(&t).map_err(|e| context(e.to_string()))?;
-                let scenario = parse_scenario(&text, &self.scenario_path)
+                let scenario = parse_scenario_table(&t, &self.scenario_path)
                     .map_err(|e| context(e.to_string()))?;
                 Ok(Level {
                     index,
@@ -502,6 +602,29 @@ mod tests {
         }
         for bad in ["0/3", "4/3", "1/0", "x", "1/2/3"] {
             assert!(Shard::parse(bad).is_err(), "{bad}");
+        }
+    }
+
+    proptest::proptest! {
+        /// Whatever the command line says, the parsers answer with values
+        /// or an error naming the flag: no panic, no huge allocation.
+        #[test]
+        fn any_flag_text_parses_or_is_refused_naming_the_flag(text in "\\PC{0,40}|[-0-9.,:e]{0,30}") {
+            if let Err(e) = parse_values(&text, "--param x") {
+                proptest::prop_assert!(e.to_string().contains("--param x"));
+            }
+            match parse_accuracies(&text) {
+                Ok(v) => proptest::prop_assert!(v.iter().all(|a| *a > 0.5 && *a <= 1.0) && v.len() <= 10_000),
+                Err(e) => proptest::prop_assert!(e.to_string().contains("--accuracy")),
+            }
+            for task in [SweepTask::Grid, SweepTask::Epuck] {
+                if let Err(e) = parse_axis(task, &text) {
+                    proptest::prop_assert!(e.to_string().contains("--param"), "{}", e);
+                }
+            }
+            if let Ok(s) = Shard::parse(&text) {
+                proptest::prop_assert!(s.index >= 1 && s.index <= s.count);
+            }
         }
     }
 

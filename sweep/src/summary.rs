@@ -52,7 +52,7 @@ impl LevelSummary {
 }
 
 /// A finished sweep's summary.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct SweepReport {
     /// Task.
     pub task: SweepTask,

@@ -1,7 +1,7 @@
 //! Streaming episode rows to `episodes.csv` in sweep order, and resuming a cut file.
 
 use std::fs::{File, OpenOptions};
-use std::io::{BufRead, BufReader, Write};
+use std::io::{BufRead, BufReader, Read, Write};
 use std::path::Path;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -10,8 +10,8 @@ use errp_sim::task::Task;
 use errp_sim::{Result, SimError};
 
 use crate::observer::SweepObserver;
-use crate::rows::run_row;
-use crate::spec::{Level, SweepSpec};
+use crate::rows::{MAX_ROW_BYTES, RowCheck, RowFault, run_row};
+use crate::spec::{Level, Shard, SweepSpec};
 
 /// The episodes of a slice, run on every thread of the current pool and
 /// written to `episodes.csv` in sweep order as they complete: a worker takes
@@ -22,7 +22,7 @@ pub(crate) struct EpisodeJob<'a, T: Task> {
     pub(crate) spec: &'a SweepSpec,
     pub(crate) levels: &'a [Level],
     pub(crate) runners: &'a [T::Runner],
-    pub(crate) items: &'a [usize],
+    pub(crate) items: Slice,
     pub(crate) cancel: &'a AtomicBool,
     pub(crate) observer: &'a dyn SweepObserver,
     pub(crate) sync_every: usize,
@@ -67,7 +67,7 @@ impl<T: Task> EpisodeJob<'_, T> {
                             break;
                         }
                         let i = next.fetch_add(1, Ordering::SeqCst);
-                        if i >= self.items.len() {
+                        if i >= self.items.len {
                             break;
                         }
                         // Do not run too far ahead of the oldest unfinished row.
@@ -80,7 +80,7 @@ impl<T: Task> EpisodeJob<'_, T> {
                                 break;
                             }
                         }
-                        let (l, k) = split(self.spec, self.items[i]);
+                        let (l, k) = split(self.spec, self.items.episode(i));
                         let row = run_row::<T>(self.spec, &self.levels[l], &self.runners[l], k);
                         let mut guard = state.lock().expect("a worker panicked");
                         let st = &mut *guard;
@@ -103,7 +103,7 @@ impl<T: Task> EpisodeJob<'_, T> {
                         if text.is_empty() {
                             continue;
                         }
-                        let sync = st.unsynced >= self.sync_every || st.written == self.items.len();
+                        let sync = st.unsynced >= self.sync_every || st.written == self.items.len;
                         let mut result = st.file.write_all(text.as_bytes());
                         if sync && result.is_ok() {
                             result = st.file.sync_data();
@@ -114,7 +114,7 @@ impl<T: Task> EpisodeJob<'_, T> {
                             moved.notify_all();
                             break;
                         }
-                        self.observer.episodes_done(st.written, self.items.len());
+                        self.observer.episodes_done(st.written, self.items.len);
                         moved.notify_all();
                     }
                 });
@@ -134,78 +134,159 @@ pub(crate) fn split(spec: &SweepSpec, g: usize) -> (usize, usize) {
     (g / spec.episodes, g % spec.episodes)
 }
 
-/// Checks the rows already in `path` against the slice and drops a last
-/// line cut short by a crash. Returns how many complete rows it holds.
-pub(crate) fn resume_rows(
+/// The episodes of one shard, in sweep order, computed rather than listed:
+/// a sweep's memory does not grow with its number of episodes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Slice {
+    shard: Shard,
+    /// Episodes of the slice.
+    pub(crate) len: usize,
+}
+
+impl Slice {
+    /// The episodes of `shard` among `total`.
+    pub(crate) fn new(shard: Shard, total: usize) -> Self {
+        let first = shard.index - 1;
+        let len = if total > first {
+            (total - first).div_ceil(shard.count)
+        } else {
+            0
+        };
+        Self { shard, len }
+    }
+
+    /// The sweep episode of the slice's row `i`.
+    pub(crate) fn episode(&self, i: usize) -> usize {
+        self.shard.index - 1 + i * self.shard.count
+    }
+}
+
+/// Reads one row of at most [`MAX_ROW_BYTES`] into `line`, without its
+/// newline: `None` at the end, `Some(false)` for a last row with no
+/// newline (cut short by a crash), `Some(true)` for a whole row.
+pub(crate) fn read_row(
+    reader: &mut impl BufRead,
+    line: &mut Vec<u8>,
+) -> std::io::Result<Option<bool>> {
+    line.clear();
+    let n = reader
+        .by_ref()
+        .take(MAX_ROW_BYTES as u64 + 1)
+        .read_until(b'\n', line)?;
+    if n == 0 {
+        return Ok(None);
+    }
+    if line.last() == Some(&b'\n') {
+        line.pop();
+        return Ok(Some(true));
+    }
+    if line.len() > MAX_ROW_BYTES {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("a line is longer than {MAX_ROW_BYTES} bytes: this is not a sweep's CSV"),
+        ));
+    }
+    Ok(Some(false))
+}
+
+/// What [`resume_rows`] found.
+pub(crate) enum Resumed {
+    /// No header yet (a new file, or one cut inside its header).
+    Empty,
+    /// This many whole, valid rows; `dropped` rows from an invalid one on
+    /// were removed (`--repair`): (line, why, rows).
+    Rows {
+        rows: usize,
+        dropped: Option<(usize, String, usize)>,
+    },
+}
+
+/// Checks every row already in `path` against the slice (each field, the
+/// checksum), drops a last row cut short by a crash, and returns what it
+/// holds. An invalid row is an error naming the line and the field, unless
+/// `repair`: then it and every row after it are dropped, to be run again.
+pub(crate) fn resume_rows<T: Task>(
     path: &Path,
     header: &str,
-    spec: &SweepSpec,
-    items: &[usize],
-) -> Result<usize> {
-    let file = File::open(path).map_err(|source| SimError::Input {
+    check: &RowCheck<'_, T>,
+    items: Slice,
+    repair: bool,
+) -> Result<Resumed> {
+    let input = |source| SimError::Input {
         path: path.to_path_buf(),
         source,
-    })?;
+    };
+    let file = File::open(path).map_err(input)?;
     let mut reader = BufReader::new(file);
-    let mut line = String::new();
+    let mut line = Vec::new();
     let mut good_bytes = 0u64;
     let mut rows = 0usize;
     let mut first = true;
-    let bad = |why: String| {
+    let mut dropped = None;
+    let not_ours = |why: String| {
         SimError::Sweep(format!(
             "{}: {why}; it does not belong to this sweep: choose another --out or delete it",
             path.display()
         ))
     };
-    loop {
-        line.clear();
-        let n = reader
-            .read_line(&mut line)
-            .map_err(|source| SimError::Input {
-                path: path.to_path_buf(),
-                source,
-            })?;
-        if n == 0 || !line.ends_with('\n') {
-            break; // end, or a row cut short: dropped below
+    while let Some(whole) = read_row(&mut reader, &mut line).map_err(input)? {
+        if !whole {
+            break; // a row cut short by a crash: dropped below
         }
-        let text = line.trim_end_matches('\n');
+        let n = line.len() as u64 + 1;
         if first {
-            if text != header {
-                return Err(bad("its header differs".into()));
+            if line != header.as_bytes() {
+                return Err(not_ours("its header differs".into()));
             }
             first = false;
-        } else {
-            let Some(&g) = items.get(rows) else {
-                return Err(bad("it has more rows than the sweep".into()));
-            };
-            let (level, k) = split(spec, g);
-            let mut cols = text.split(',');
-            let lv = cols.next().and_then(|c| c.parse::<usize>().ok());
-            let ep = cols
-                .nth(1 + spec.axes.len())
-                .and_then(|c| c.parse::<usize>().ok());
-            if lv != Some(level) || ep != Some(k) {
-                return Err(bad(format!(
-                    "row {} should be level {level} episode {k}",
-                    rows + 1
-                )));
-            }
-            rows += 1;
+            good_bytes += n;
+            continue;
         }
-        good_bytes += n as u64;
+        let lineno = rows + 2;
+        let fault = match std::str::from_utf8(&line) {
+            Err(_) => Some(RowFault {
+                column: String::new(),
+                value: String::new(),
+                expected: "it is not text (damage on disk)".into(),
+            }),
+            Ok(text) => {
+                if rows >= items.len {
+                    return Err(not_ours("it has more rows than the sweep".into()));
+                }
+                check.check(items.episode(rows), text).err()
+            }
+        };
+        if let Some(fault) = fault {
+            if !repair {
+                return Err(fault.error(
+                    path,
+                    lineno,
+                    "rerun the same command with --repair to drop this row and those after \
+                     it and run them again",
+                ));
+            }
+            let mut after = 0usize;
+            while read_row(&mut reader, &mut line).map_err(input)?.is_some() {
+                after += 1;
+            }
+            let why = fault.describe();
+            dropped = Some((lineno, why, after + 1));
+            break;
+        }
+        rows += 1;
+        good_bytes += n;
     }
     drop(reader);
-    let file = OpenOptions::new()
-        .write(true)
-        .open(path)
-        .map_err(|source| SimError::Output {
-            path: path.to_path_buf(),
-            source,
-        })?;
-    file.set_len(good_bytes)
-        .map_err(|source| SimError::Output {
-            path: path.to_path_buf(),
-            source,
-        })?;
-    Ok(if first { usize::MAX } else { rows })
+    let output = |source| SimError::Output {
+        path: path.to_path_buf(),
+        source,
+    };
+    let file = OpenOptions::new().write(true).open(path).map_err(output)?;
+    file.set_len(good_bytes).map_err(output)?;
+    file.sync_all().map_err(output)?;
+    Ok(if first {
+        Resumed::Empty
+    } else {
+        Resumed::Rows { rows, dropped }
+    })
 }

@@ -3,7 +3,8 @@
 Usage: check_sweep.py DIR LEVELS EPISODES
 
 Checks, independently of the Rust code: every file is there and whole; the
-episodes are one row per (level, episode) in order; every summary statistic
+episodes are one row per (level, episode) in order, each ending in the
+CRC-32 of the rest of its line (recomputed with zlib); every summary statistic
 (success rate, Wilson interval, mean/sd/median cost of the successful
 episodes, Pearson r and p against online accuracy, via NumPy and SciPy; for
 the e-puck the detector's mean hit rate and false alarms per minute)
@@ -16,6 +17,7 @@ import json
 import math
 import sys
 import xml.etree.ElementTree as ET
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -48,6 +50,11 @@ def main():
     for i, r in enumerate(rows):
         assert int(r["level"]) == i // episodes and int(r["episode"]) == i % episodes, (i, r)
         assert r["success"] in ("0", "1")
+    lines = (d / "episodes.csv").read_bytes().split(b"\n")
+    assert lines[0].endswith(b",crc32") and lines[-1] == b"", lines[0]
+    for i, line in enumerate(lines[1:-1]):
+        body, crc = line.rsplit(b",", 1)
+        assert crc.decode() == f"{zlib.crc32(body):08x}", (i + 2, line)
 
     summary = list(csv.DictReader(open(d / "summary.csv", newline="")))
     assert len(summary) == levels, len(summary)

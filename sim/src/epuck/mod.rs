@@ -30,7 +30,10 @@ pub use run::{
     prepare_continuous_decoder, prepare_continuous_decoder_with, prepare_epuck_decoder,
     run_epuck_batch, run_epuck_once, summarise,
 };
-pub use scenario::EpuckScenario;
+pub use scenario::{
+    EpuckScenario, MAX_OBSTACLES, MAX_REACTION_LATENCY_MS, MAX_REELICIT_SECS, MAX_RUN_SECS,
+    MAX_RUNS, MAX_TRACKER_HZ,
+};
 pub use task::{EpuckRunner, EpuckTask};
 pub use tracker::{CameraTracker, TrackerParams};
 pub use user::{Elicited, Judgement, SeenMotion, SyntheticUser, UserParams};

@@ -12,7 +12,22 @@ use crate::epuck::episode::{EpuckEpisode, EpuckTaskParams};
 use crate::epuck::schema::{EpuckFile, StartFile};
 use crate::epuck::world::{ArenaSpec, Obstacle};
 use crate::error::{Result, SimError};
-use crate::scenario_file::{field_error, parse_toml, read_scenario, robot_error, scenario_name};
+use crate::scenario_file::{
+    field_error, parse_toml, read_scenario, robot_error, scenario_name, table_into, whole,
+};
+
+/// Most runs of one e-puck scenario.
+pub const MAX_RUNS: u64 = 100_000;
+/// The longest time-out of a run, s.
+pub const MAX_RUN_SECS: f64 = 3600.0;
+/// Most obstacles in the arena.
+pub const MAX_OBSTACLES: usize = 100;
+/// The longest reaction latency of the synthetic user, ms.
+pub const MAX_REACTION_LATENCY_MS: f64 = 2000.0;
+/// The longest time before a persisting error elicits another ErrP, s.
+pub const MAX_REELICIT_SECS: f64 = 60.0;
+/// The fastest overhead camera, frames per second.
+pub const MAX_TRACKER_HZ: f64 = 1000.0;
 
 /// A parameter error of `errp_bci` as a field error of the scenario's
 /// `[table]`.
@@ -65,8 +80,19 @@ impl EpuckScenario {
     /// Validates scenario text; `path` names it in errors.
     pub fn parse(text: &str, path: &Path) -> Result<Self> {
         let file: EpuckFile = parse_toml(text, path)?;
-        // Whether a key was written (the typed tables hold defaults).
         let raw: toml::Table = parse_toml(text, path)?;
+        Self::from_file(file, &raw, path)
+    }
+
+    /// Validates a scenario given as a TOML table (a file's with values set
+    /// from the command line or a sweep); errors name fields, not lines.
+    pub fn from_table(table: &toml::Table, path: &Path) -> Result<Self> {
+        Self::from_file(table_into(table, path)?, table, path)
+    }
+
+    /// `raw` is the same scenario as a plain table: whether a key was
+    /// written (the typed tables hold defaults).
+    fn from_file(file: EpuckFile, raw: &toml::Table, path: &Path) -> Result<Self> {
         let given = |table: &str, key: &str| raw.get(table).and_then(|t| t.get(key)).is_some();
         let bad =
             |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
@@ -140,8 +166,14 @@ impl EpuckScenario {
         // accuracy, or the targeted hit rate.
         let (online_target, accuracy) = match (u.accuracy, u.hit_rate, u.false_alarms_per_min) {
             (Some(a), None, None) => {
-                let a = MeanAccuracy::new(a)
-                    .map_err(|e| bad("user.accuracy", a.to_string(), &e.to_string()))?;
+                let a = MeanAccuracy::new(a).map_err(|_| {
+                    bad(
+                        "user.accuracy",
+                        a.to_string(),
+                        "a mean accuracy strictly between 0.5 (chance) and 1, e.g. 0.95 \
+                             (the mean of the decoder's two cross-validated class rates)",
+                    )
+                })?;
                 (None, a)
             }
             (None, Some(h), fa) => {
@@ -162,7 +194,7 @@ impl EpuckScenario {
                 }
                 // A hit rate is below 1, so this is a mean accuracy.
                 let assumed = MeanAccuracy::new(h.max(0.51))
-                    .map_err(|e| bad("user.hit_rate", h.to_string(), &e.to_string()))?;
+                    .map_err(|_| bad("user.hit_rate", h.to_string(), "a hit rate in (0, 1)"))?;
                 (Some(target), assumed)
             }
             (None, None, Some(f)) => {
@@ -193,9 +225,30 @@ impl EpuckScenario {
             params.user.fov_rad = v.to_radians();
         }
         if let Some(v) = file.user.reaction_latency_ms {
+            if !(v.is_finite() && (0.0..=MAX_REACTION_LATENCY_MS).contains(&v)) {
+                return Err(bad(
+                    "user.reaction_latency_ms",
+                    v.to_string(),
+                    &format!(
+                        "a delay from 0 to {MAX_REACTION_LATENCY_MS} ms (default {})",
+                        params.user.reaction_latency_secs * 1000.0
+                    ),
+                ));
+            }
             params.user.reaction_latency_secs = v / 1000.0;
         }
         if let Some(v) = file.user.reelicit_secs {
+            if !(v.is_finite() && (0.5..=MAX_REELICIT_SECS).contains(&v)) {
+                return Err(bad(
+                    "user.reelicit_secs",
+                    v.to_string(),
+                    &format!(
+                        "a time from 0.5 s (an ErrP lasts about that long) to \
+                         {MAX_REELICIT_SECS} s (default {})",
+                        params.user.reelicit_secs
+                    ),
+                ));
+            }
             params.user.reelicit_secs = v;
         }
         params
@@ -213,7 +266,14 @@ impl EpuckScenario {
                 };
             }
             if let Some(n) = d.smooth_windows {
-                p.smooth_windows = n;
+                p.smooth_windows = whole(
+                    path,
+                    "detector.smooth_windows",
+                    n,
+                    1,
+                    16,
+                    " windows (up to 1 s of 62.5 ms steps)",
+                )?;
             }
             if let Some(r) = d.refractory_secs {
                 p.refractory_secs = r;
@@ -239,12 +299,33 @@ impl EpuckScenario {
 
         if let Some(t) = &file.tracker {
             if let Some(v) = t.rate_hz {
+                if !(v.is_finite() && (1.0..=MAX_TRACKER_HZ).contains(&v)) {
+                    return Err(bad(
+                        "tracker.rate_hz",
+                        v.to_string(),
+                        &format!("a frame rate from 1 to {MAX_TRACKER_HZ} Hz (default 30)"),
+                    ));
+                }
                 params.tracker.rate_hz = v;
             }
             if let Some(v) = t.position_noise_cm {
+                if !(v.is_finite() && (0.0..=50.0).contains(&v)) {
+                    return Err(bad(
+                        "tracker.position_noise_cm",
+                        v.to_string(),
+                        "a standard deviation from 0 to 50 cm (default 0.2)",
+                    ));
+                }
                 params.tracker.position_noise_m = v / 100.0;
             }
             if let Some(v) = t.heading_noise_deg {
+                if !(v.is_finite() && (0.0..=180.0).contains(&v)) {
+                    return Err(bad(
+                        "tracker.heading_noise_deg",
+                        v.to_string(),
+                        "a standard deviation from 0 to 180 degrees (default 1)",
+                    ));
+                }
                 params.tracker.heading_noise_rad = v.to_radians();
             }
         }
@@ -255,16 +336,25 @@ impl EpuckScenario {
         if let Some(v) = file.avoidance.as_ref().and_then(|a| a.enabled) {
             params.avoidance.enabled = v;
         }
-        if !(file.max_secs.is_finite() && file.max_secs > 0.0) {
+        if !(file.max_secs.is_finite() && file.max_secs > 0.0 && file.max_secs <= MAX_RUN_SECS) {
             return Err(bad(
                 "max_secs",
                 file.max_secs.to_string(),
-                "a time-out > 0 s (default 600)",
+                &format!("a time-out > 0 s and at most {MAX_RUN_SECS} s (default 600)"),
             ));
         }
         params.max_secs = file.max_secs;
-        if file.runs == 0 {
-            return Err(bad("runs", "0".into(), "at least 1"));
+        let runs = match file.runs {
+            Some(n) => whole(path, "runs", n, 1, MAX_RUNS, " (default 1)")?,
+            None => 1,
+        };
+        let obstacles = file.arena.as_ref().map_or(0, |a| a.obstacle.len());
+        if obstacles > MAX_OBSTACLES {
+            return Err(bad(
+                "arena.obstacle",
+                format!("{obstacles} obstacles"),
+                &format!("at most {MAX_OBSTACLES} [[arena.obstacle]] tables"),
+            ));
         }
 
         let mut arena = ArenaSpec {
@@ -278,7 +368,7 @@ impl EpuckScenario {
             .enumerate()
         {
             let field = |f: &str| format!("arena.obstacle[{k}].{f}");
-            let [cx, cy] = o.center_cm;
+            let [cx, cy] = o.center_cm.0;
             if !(cx.is_finite()
                 && cy.is_finite()
                 && (0.0..=size_cm).contains(&cx)
@@ -292,9 +382,12 @@ impl EpuckScenario {
             }
             let obstacle = match o.shape.as_str() {
                 "box" => {
-                    let [w, h] = o.size_cm.ok_or_else(|| {
-                        bad(&field("size_cm"), "missing".into(), "[width_cm, height_cm]")
-                    })?;
+                    let [w, h] = o
+                        .size_cm
+                        .ok_or_else(|| {
+                            bad(&field("size_cm"), "missing".into(), "[width_cm, height_cm]")
+                        })?
+                        .0;
                     if !(w.is_finite() && h.is_finite() && w > 0.0 && h > 0.0) {
                         return Err(bad(
                             &field("size_cm"),
@@ -338,6 +431,24 @@ impl EpuckScenario {
                     ));
                 }
             };
+            // Inside the walls: an obstacle through a wall is a wall the
+            // arena does not have.
+            let (lo, hi) = obstacle.bounds();
+            let inside = |v: f64| (-1e-9..=size_m + 1e-9).contains(&v);
+            if !(inside(lo.0) && inside(lo.1) && inside(hi.0) && inside(hi.1)) {
+                return Err(bad(
+                    &field("center_cm"),
+                    format!("[{cx}, {cy}]"),
+                    &format!(
+                        "an obstacle inside the walls: this one spans x {:.1} to {:.1} cm and \
+                         y {:.1} to {:.1} cm, beyond the arena's 0 to {size_cm} cm",
+                        100.0 * lo.0,
+                        100.0 * hi.0,
+                        100.0 * lo.1,
+                        100.0 * hi.1
+                    ),
+                ));
+            }
             // Every goal must stay reachable: the robot has to fit on it.
             if let Some(g) = layout
                 .goals()
@@ -372,7 +483,7 @@ impl EpuckScenario {
             seed: file.seed,
             accuracy,
             online_target,
-            runs: file.runs,
+            runs,
             episode: EpuckEpisode { start, goal },
             arena,
             layout,
@@ -527,7 +638,11 @@ accuracy = 0.7438
                 "arena.obstacle[0].shape",
                 "star",
             ),
-            (format!("{OK}max_secs = -1.0\n"), "max_secs", "-1"),
+            (
+                OK.replace("[user]", "max_secs = -1.0\n[user]"),
+                "max_secs",
+                "-1",
+            ),
             (OK.replace("\"epuck\"", "\"epuk\""), "task", "epuk"),
         ] {
             let e = err(&text);

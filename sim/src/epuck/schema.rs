@@ -2,9 +2,14 @@
 //! before any value is checked (sim/src/epuck/scenario.rs checks them and
 //! converts centimetres and degrees to SI).
 
+use std::fmt;
+
 use errp_bci::DetectorMode;
 use errp_robot::ContinuousControlParams;
 use serde::Deserialize;
+use serde::de::{self, SeqAccess, Visitor};
+
+use crate::scenario_file::Pair;
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -20,8 +25,8 @@ pub(crate) struct EpuckFile {
     #[serde(default = "default_heading")]
     pub(crate) start_heading_deg: f64,
     pub(crate) goal: String,
-    #[serde(default = "default_runs")]
-    pub(crate) runs: usize,
+    #[serde(default)]
+    pub(crate) runs: Option<f64>,
     #[serde(default = "default_max_secs")]
     pub(crate) max_secs: f64,
     pub(crate) user: UserFile,
@@ -42,7 +47,7 @@ pub(crate) struct EpuckFile {
 #[serde(deny_unknown_fields)]
 pub(crate) struct DetectorFile {
     pub(crate) mode: Option<DetectorMode>,
-    pub(crate) smooth_windows: Option<usize>,
+    pub(crate) smooth_windows: Option<f64>,
     pub(crate) refractory_secs: Option<f64>,
 }
 
@@ -54,19 +59,42 @@ pub(crate) fn default_heading() -> f64 {
     90.0
 }
 
-pub(crate) fn default_runs() -> usize {
-    1
-}
-
 pub(crate) fn default_max_secs() -> f64 {
     600.0
 }
 
-#[derive(Debug, Deserialize)]
-#[serde(untagged)]
+/// Where the e-puck starts: a city's name or a position in centimetres.
+#[derive(Debug)]
 pub(crate) enum StartFile {
     City(String),
     Cm([f64; 2]),
+}
+
+impl<'de> Deserialize<'de> for StartFile {
+    fn deserialize<D: de::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Start;
+        impl<'de> Visitor<'de> for Start {
+            type Value = StartFile;
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str("a city (\"Mexico\") or a position [x_cm, y_cm]")
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<StartFile, E> {
+                Ok(StartFile::City(v.to_string()))
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<StartFile, A::Error> {
+                // A scenario file is at most 1 MiB, so the array is bounded.
+                let mut v: Vec<f64> = Vec::new();
+                while let Some(x) = seq.next_element()? {
+                    v.push(x);
+                }
+                let n = v.len();
+                <[f64; 2]>::try_from(v)
+                    .map(StartFile::Cm)
+                    .map_err(|_| de::Error::invalid_length(n, &"a position [x_cm, y_cm]"))
+            }
+        }
+        d.deserialize_any(Start)
+    }
 }
 
 #[derive(Debug, Deserialize)]
@@ -105,9 +133,9 @@ pub(crate) struct ArenaFile {
 #[serde(deny_unknown_fields)]
 pub(crate) struct ObstacleFile {
     pub(crate) shape: String,
-    pub(crate) center_cm: [f64; 2],
+    pub(crate) center_cm: Pair<f64>,
     #[serde(default)]
-    pub(crate) size_cm: Option<[f64; 2]>,
+    pub(crate) size_cm: Option<Pair<f64>>,
     #[serde(default)]
     pub(crate) radius_cm: Option<f64>,
     #[serde(default)]

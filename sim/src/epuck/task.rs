@@ -11,7 +11,8 @@ use crate::error::Result;
 use crate::paper::PAPER_EPUCK;
 use crate::scenario::AnyScenario;
 use crate::task::{
-    DecoderInfo, EpisodeRow, FigureText, PaperPoint, Task, TaskInfo, format_number, rate_field,
+    Column, ColumnKind, DecoderInfo, EpisodeRow, FieldError, FigureText, PaperPoint, Task,
+    TaskInfo, format_number, rate_field,
 };
 
 /// The continuous e-puck (sec. 5): the cost is seconds to convergence.
@@ -29,19 +30,19 @@ impl Task for EpuckTask {
     const INFO: TaskInfo = TaskInfo {
         name: "epuck",
         columns: &[
-            "goal",
-            "committed",
-            "time_secs",
-            "path_m",
-            "errps",
-            "detected",
-            "false_alarms",
-            "missed",
-            "detected_turning",
-            "detected_driving",
-            "detected_on_goal",
-            "hit_rate",
-            "false_alarms_per_min",
+            Column::new("goal", ColumnKind::City),
+            Column::new("committed", ColumnKind::OptCity),
+            Column::new("time_secs", ColumnKind::NonNegative),
+            Column::new("path_m", ColumnKind::NonNegative),
+            Column::new("errps", ColumnKind::Count),
+            Column::new("detected", ColumnKind::Count),
+            Column::new("false_alarms", ColumnKind::Count),
+            Column::new("missed", ColumnKind::Count),
+            Column::new("detected_turning", ColumnKind::Count),
+            Column::new("detected_driving", ColumnKind::Count),
+            Column::new("detected_on_goal", ColumnKind::Count),
+            Column::new("hit_rate", ColumnKind::OptRate),
+            Column::new("false_alarms_per_min", ColumnKind::OptNonNegative),
         ],
         cost_column: "time_secs",
         cost_label: "time (s)",
@@ -161,6 +162,46 @@ impl Task for EpuckTask {
             fields,
             online: r.online,
         })
+    }
+
+    /// The goal is the scenario's; success is a commitment to it; the
+    /// detections by phase add up to all detections.
+    fn check_fields(
+        s: &EpuckScenario,
+        _k: usize,
+        success: bool,
+        f: &[&str],
+    ) -> std::result::Result<(), FieldError> {
+        let goal = &s.layout.goals()[s.episode.goal].name;
+        if f[0] != goal {
+            return Err(FieldError {
+                column: "goal",
+                expected: format!("{goal}, the scenario's goal"),
+            });
+        }
+        if success != (f[1] == goal) {
+            return Err(FieldError {
+                column: "committed",
+                expected: format!("{goal} exactly when success is 1"),
+            });
+        }
+        let count = |i: usize| f[i].parse::<u64>().unwrap_or(0);
+        let detected = count(5);
+        if count(8) + count(9) + count(10) != detected {
+            return Err(FieldError {
+                column: "detected_on_goal",
+                expected: format!(
+                    "a count that makes the detections by phase add up to detected = {detected}"
+                ),
+            });
+        }
+        if count(6) > detected {
+            return Err(FieldError {
+                column: "false_alarms",
+                expected: format!("at most detected = {detected}"),
+            });
+        }
+        Ok(())
     }
 
     fn figure(s: &EpuckScenario) -> FigureText {

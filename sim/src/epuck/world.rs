@@ -41,6 +41,29 @@ pub enum Obstacle {
 }
 
 impl Obstacle {
+    /// The corners of the axis-aligned rectangle around the obstacle:
+    /// ((x min, y min), (x max, y max)), m.
+    pub fn bounds(&self) -> ((f64, f64), (f64, f64)) {
+        match *self {
+            Obstacle::Circle { x_m, y_m, radius_m } => (
+                (x_m - radius_m, y_m - radius_m),
+                (x_m + radius_m, y_m + radius_m),
+            ),
+            Obstacle::Box {
+                x_m,
+                y_m,
+                half_width_m,
+                half_height_m,
+                angle_rad,
+            } => {
+                let (s, c) = angle_rad.sin_cos();
+                let rx = (half_width_m * c).abs() + (half_height_m * s).abs();
+                let ry = (half_width_m * s).abs() + (half_height_m * c).abs();
+                ((x_m - rx, y_m - ry), (x_m + rx, y_m + ry))
+            }
+        }
+    }
+
     /// Distance from the point to the obstacle's boundary (negative inside).
     pub fn signed_distance(&self, x: f64, y: f64) -> f64 {
         match *self {

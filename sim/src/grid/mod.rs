@@ -23,7 +23,10 @@ pub use run::{
     GridRunReport, GridShared, PreparedGrid, eeg_decoder, pooled_accuracy, prepare_decoder,
     prepare_grid_decoder, run_grid_scenario,
 };
-pub use scenario::{DecoderChoice, EegMode, GridScenario, free_pairs};
+pub use scenario::{
+    DecoderChoice, EegMode, GridScenario, MAX_ACTIONS, MAX_BANK_PER_CLASS, MAX_EPISODES,
+    MAX_INTERVAL_SECS, MAX_PAIRS, free_pairs,
+};
 pub use table1::{FIXED_PAIRS, Table1Cell, Table1Options, accuracy_time_correlation, run_table1};
 pub use task::{GridRunner, GridTask};
 #[cfg(feature = "rerun")]

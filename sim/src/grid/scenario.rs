@@ -15,7 +15,21 @@ use serde::Deserialize;
 use crate::error::Result;
 use crate::grid::decoder::PErrorChoice;
 use crate::grid::params::GridTaskParams;
-use crate::scenario_file::{field_error, parse_toml, read_scenario, robot_error, scenario_name};
+use crate::scenario_file::{
+    Pair, field_error, parse_toml, read_scenario, robot_error, scenario_name, table_into, whole,
+};
+
+/// Most epochs per class in an epoch bank (about 9 KB each, per level of a
+/// sweep).
+pub const MAX_BANK_PER_CLASS: u64 = 20_000;
+/// Most `[[episode]]` pairs, free goals or repeats in a scenario file.
+pub const MAX_PAIRS: u64 = 10_000;
+/// Most episodes a scenario runs (pairs times repeats).
+pub const MAX_EPISODES: usize = 100_000;
+/// Most actions an episode may take before it gives up.
+pub const MAX_ACTIONS: u64 = 10_000;
+/// The longest inter-action interval, s.
+pub const MAX_INTERVAL_SECS: f64 = 60.0;
 
 /// Which decoder turns the user's assessments into p(error).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -43,15 +57,15 @@ struct ScenarioFile {
     p_error: PErrorChoice,
     #[serde(default = "default_eeg_mode")]
     eeg: EegMode,
-    #[serde(default = "default_bank_per_class")]
-    bank_per_class: usize,
+    #[serde(default)]
+    bank_per_class: Option<f64>,
     user: UserFile,
     #[serde(default)]
     episode: Vec<EpisodeFile>,
     #[serde(default)]
     free_goals: Option<FreeGoalsFile>,
-    #[serde(default = "default_repeats")]
-    repeats: usize,
+    #[serde(default)]
+    repeats: Option<f64>,
     /// Straight into the robot's type: its field names are the file's.
     #[serde(default)]
     control: GridControlParams,
@@ -70,12 +84,6 @@ fn default_p_error() -> PErrorChoice {
 }
 fn default_eeg_mode() -> EegMode {
     EegMode::Stream
-}
-fn default_bank_per_class() -> usize {
-    1000
-}
-fn default_repeats() -> usize {
-    1
 }
 
 /// How the EEG reaches the decoder during episodes.
@@ -110,14 +118,14 @@ enum GoalSetFile {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct EpisodeFile {
-    start: [i64; 2],
-    goal: [i64; 2],
+    start: Pair<i64>,
+    goal: Pair<i64>,
 }
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct FreeGoalsFile {
-    count: usize,
+    count: f64,
 }
 
 #[derive(Debug, Deserialize)]
@@ -126,7 +134,7 @@ struct TimingFile {
     interval_min_secs: Option<f64>,
     interval_max_secs: Option<f64>,
     epoch_secs: Option<f64>,
-    max_actions: Option<usize>,
+    max_actions: Option<f64>,
 }
 
 /// A validated grid scenario.
@@ -167,7 +175,16 @@ impl GridScenario {
 
     /// Validates scenario text; `path` names it in errors.
     pub fn parse(text: &str, path: &Path) -> Result<Self> {
-        let file: ScenarioFile = parse_toml(text, path)?;
+        Self::from_file(parse_toml(text, path)?, path)
+    }
+
+    /// Validates a scenario given as a TOML table (a file's with values set
+    /// from the command line or a sweep); errors name fields, not lines.
+    pub fn from_table(table: &toml::Table, path: &Path) -> Result<Self> {
+        Self::from_file(table_into(table, path)?, path)
+    }
+
+    fn from_file(file: ScenarioFile, path: &Path) -> Result<Self> {
         let bad =
             |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
         if file.task != "grid" {
@@ -239,37 +256,55 @@ impl GridScenario {
             params.interval_min_secs = t.interval_min_secs.unwrap_or(d.interval_min_secs);
             params.interval_max_secs = t.interval_max_secs.unwrap_or(d.interval_max_secs);
             params.epoch_secs = t.epoch_secs.unwrap_or(d.epoch_secs);
-            params.max_actions = t.max_actions.unwrap_or(d.max_actions);
+            if let Some(n) = t.max_actions {
+                params.max_actions = whole(
+                    path,
+                    "timing.max_actions",
+                    n,
+                    1,
+                    MAX_ACTIONS,
+                    &format!(" (default {})", d.max_actions),
+                )?;
+            }
         }
-        if !(params.interval_min_secs.is_finite() && params.interval_min_secs >= 0.8) {
+        let (min, max) = (params.interval_min_secs, params.interval_max_secs);
+        if !(min.is_finite() && (0.8..=MAX_INTERVAL_SECS).contains(&min)) {
             return Err(bad(
                 "timing.interval_min_secs",
-                params.interval_min_secs.to_string(),
-                "at least 0.8 s (an epoch) (the paper: 3)",
+                min.to_string(),
+                &format!("a time from 0.8 s (an epoch) to {MAX_INTERVAL_SECS} s (the paper: 3)"),
             ));
         }
-        if !(params.interval_max_secs.is_finite()
-            && params.interval_max_secs >= params.interval_min_secs)
-        {
+        if !(max.is_finite() && max >= min && max <= MAX_INTERVAL_SECS) {
             return Err(bad(
                 "timing.interval_max_secs",
-                params.interval_max_secs.to_string(),
-                "a number of seconds >= interval_min_secs (the paper: 3.5)",
+                max.to_string(),
+                &format!(
+                    "a time from interval_min_secs ({min} s) to {MAX_INTERVAL_SECS} s (the \
+                     paper: 3.5)"
+                ),
             ));
         }
-        if !(params.epoch_secs.is_finite() && params.epoch_secs > 0.0) {
+        if !(params.epoch_secs.is_finite() && params.epoch_secs > 0.0 && params.epoch_secs <= min) {
             return Err(bad(
                 "timing.epoch_secs",
                 params.epoch_secs.to_string(),
-                "a number > 0",
+                &format!(
+                    "a time > 0 s and at most interval_min_secs ({min} s): the EEG counted \
+                     per action fits between two actions (the paper: 0.8)"
+                ),
             ));
-        }
-        if params.max_actions == 0 {
-            return Err(bad("timing.max_actions", "0".into(), "at least 1"));
         }
 
         // Episodes: fixed pairs and/or free goals drawn from the seed.
         let grid = errp_robot::Grid::paper();
+        if file.episode.len() as u64 > MAX_PAIRS {
+            return Err(bad(
+                "episode",
+                format!("{} tables", file.episode.len()),
+                &format!("at most {MAX_PAIRS} [[episode]] tables (use `repeats`)"),
+            ));
+        }
         let mut pairs = Vec::new();
         for (k, e) in file.episode.iter().enumerate() {
             let cell = |field: &str, v: [i64; 2]| -> Result<Cell> {
@@ -285,7 +320,7 @@ impl GridScenario {
                     ))
                 }
             };
-            let (s, g) = (cell("start", e.start)?, cell("goal", e.goal)?);
+            let (s, g) = (cell("start", e.start.0)?, cell("goal", e.goal.0)?);
             if s == g {
                 return Err(bad(
                     &format!("episode[{k}].goal"),
@@ -296,11 +331,9 @@ impl GridScenario {
             pairs.push((s, g));
         }
         if let Some(free) = &file.free_goals {
-            if free.count == 0 {
-                return Err(bad("free_goals.count", "0".into(), "at least 1"));
-            }
+            let count = whole(path, "free_goals.count", free.count, 1, MAX_PAIRS, "")?;
             let mut rng = errp_bci::rng::stream(file.seed, "scenario/free-goals");
-            pairs.extend(free_pairs(&grid, free.count, &mut rng));
+            pairs.extend(free_pairs(&grid, count, &mut rng));
         }
         if pairs.is_empty() {
             return Err(bad(
@@ -309,19 +342,34 @@ impl GridScenario {
                 "at least one [[episode]] with start and goal, or a [free_goals] table",
             ));
         }
-        if file.bank_per_class == 0 {
-            return Err(bad(
+        let bank_per_class = match file.bank_per_class {
+            Some(n) => whole(
+                path,
                 "bank_per_class",
-                "0".into(),
-                "at least 1 (default 1000)",
+                n,
+                1,
+                MAX_BANK_PER_CLASS,
+                " (default 1000)",
+            )?,
+            None => 1000,
+        };
+        let repeats = match file.repeats {
+            Some(n) => whole(path, "repeats", n, 1, MAX_PAIRS, " (default 1)")?,
+            None => 1,
+        };
+        if pairs.len() * repeats > MAX_EPISODES {
+            return Err(bad(
+                "repeats",
+                repeats.to_string(),
+                &format!(
+                    "at most {MAX_EPISODES} episodes in all: {} pairs x {repeats} repeats is \
+                     {}",
+                    pairs.len(),
+                    pairs.len() * repeats
+                ),
             ));
         }
-        if file.repeats == 0 {
-            return Err(bad("repeats", "0".into(), "at least 1"));
-        }
-        let episodes = (0..file.repeats)
-            .flat_map(|_| pairs.iter().copied())
-            .collect();
+        let episodes = (0..repeats).flat_map(|_| pairs.iter().copied()).collect();
         Ok(Self {
             path: path.to_path_buf(),
             name: scenario_name(file.name, path),
@@ -330,7 +378,7 @@ impl GridScenario {
             decoder: file.decoder,
             p_error: file.p_error,
             eeg: file.eeg,
-            bank_per_class: file.bank_per_class,
+            bank_per_class,
             accuracy,
             user,
             episodes,

@@ -10,11 +10,16 @@ use crate::error::Result;
 use crate::grid::decoder::AssessmentDecoder;
 use crate::grid::episode::run_grid_episode;
 use crate::grid::run::{GridShared, prepare_grid_decoder};
-use crate::grid::scenario::{DecoderChoice, GridScenario};
+use crate::grid::scenario::{DecoderChoice, EegMode, GridScenario};
+
+/// About the memory of one epoch in a bank: 312 features and the FCz
+/// trace, as f64.
+const BANK_EPOCH_BYTES: usize = 5_000;
 use crate::paper::PAPER;
 use crate::scenario::AnyScenario;
 use crate::task::{
-    DecoderInfo, EpisodeRow, FigureText, PaperPoint, Task, TaskInfo, format_number, overall,
+    Column, ColumnKind, DecoderInfo, EpisodeRow, FieldError, FigureText, PaperPoint, Task,
+    TaskInfo, format_number, overall,
 };
 
 /// The discrete 5x5 grid (sec. 4): the cost is actions to convergence.
@@ -33,19 +38,19 @@ impl Task for GridTask {
     const INFO: TaskInfo = TaskInfo {
         name: "grid",
         columns: &[
-            "start_x",
-            "start_y",
-            "goal_x",
-            "goal_y",
-            "committed_x",
-            "committed_y",
-            "actions",
-            "net_secs",
-            "total_secs",
-            "errors",
-            "detected",
-            "false_alarms",
-            "missed",
+            Column::new("start_x", ColumnKind::Cell),
+            Column::new("start_y", ColumnKind::Cell),
+            Column::new("goal_x", ColumnKind::Cell),
+            Column::new("goal_y", ColumnKind::Cell),
+            Column::new("committed_x", ColumnKind::OptCell),
+            Column::new("committed_y", ColumnKind::OptCell),
+            Column::new("actions", ColumnKind::Count),
+            Column::new("net_secs", ColumnKind::NonNegative),
+            Column::new("total_secs", ColumnKind::NonNegative),
+            Column::new("errors", ColumnKind::Count),
+            Column::new("detected", ColumnKind::Count),
+            Column::new("false_alarms", ColumnKind::Count),
+            Column::new("missed", ColumnKind::Count),
         ],
         cost_column: "actions",
         cost_label: "actions",
@@ -175,6 +180,57 @@ impl Task for GridTask {
         })
     }
 
+    /// The start and goal are the scenario's pair `k`; success is a
+    /// commitment to the goal; the detections and misses add up to the
+    /// errors.
+    fn check_fields(
+        s: &GridScenario,
+        k: usize,
+        success: bool,
+        f: &[&str],
+    ) -> std::result::Result<(), FieldError> {
+        let (start, goal) = s.episodes[k % s.episodes.len()];
+        let want = [start.x, start.y, goal.x, goal.y].map(|v| v.to_string());
+        for (i, w) in want.iter().enumerate() {
+            if f[i] != w {
+                return Err(FieldError {
+                    column: Self::INFO.columns[i].name,
+                    expected: format!("{w}: episode {k} runs from cell {} to {}", start, goal),
+                });
+            }
+        }
+        let committed = (f[4], f[5]);
+        if committed.0.is_empty() != committed.1.is_empty() {
+            return Err(FieldError {
+                column: "committed_y",
+                expected: "empty exactly when committed_x is".into(),
+            });
+        }
+        if success != (committed == (f[2], f[3])) {
+            return Err(FieldError {
+                column: "committed_x",
+                expected: format!("the goal ({}, {}) exactly when success is 1", f[2], f[3]),
+            });
+        }
+        let count = |i: usize| f[i].parse::<u64>().unwrap_or(0);
+        if count(10) + count(12) != count(9) {
+            return Err(FieldError {
+                column: "missed",
+                expected: format!("errors - detected = {}", count(9).saturating_sub(count(10))),
+            });
+        }
+        Ok(())
+    }
+
+    /// An EEG decoder reading a bank holds `bank_per_class` epochs of each
+    /// class (features and the FCz trace, about 5 KB each).
+    fn decoder_bytes(s: &GridScenario) -> usize {
+        match (s.decoder, s.eeg) {
+            (DecoderChoice::Eeg, EegMode::Bank) => 2 * s.bank_per_class * BANK_EPOCH_BYTES,
+            _ => 0,
+        }
+    }
+
     fn figure(s: &GridScenario) -> FigureText {
         FigureText {
             task: "Grid task".into(),
@@ -231,7 +287,7 @@ mod tests {
         let cost = GridTask::INFO
             .columns
             .iter()
-            .position(|c| *c == GridTask::INFO.cost_column)
+            .position(|c| c.name == GridTask::INFO.cost_column)
             .unwrap();
         assert!(row.fields[cost].parse::<usize>().unwrap() > 0);
     }

@@ -1,6 +1,7 @@
 //! The integration tests of `errp_sim`, one binary: the grid task with the
-//! EEG decoder, the e-puck task end to end, and the determinism contracts.
-
+//! EEG decoder, the e-puck task end to end, the determinism contracts, and
+//! property tests of the scenario loaders (`scenario_fuzz`).
 mod determinism;
 mod epuck;
 mod grid;
+mod scenario_fuzz;

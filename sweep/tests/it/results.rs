@@ -1,112 +1,15 @@
-//! Sweeps: sharded + merged equals unsharded, 1 thread equals 2, a resumed
-//! sweep equals an uninterrupted one, and the numbers move the right way.
+//! What sweeps compute: sharded + merged equals unsharded, 1 thread equals
+//! 2, a resumed sweep equals an uninterrupted one, and the numbers move the
+//! right way.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use errp_sweep::{
-    Manifest, Shard, SweepObserver, SweepOptions, SweepOutcome, SweepSpec, SweepTask, TargetCache,
-    finish_dir, merge_sweeps, parse_accuracies, parse_axis, run_sweep,
+    Manifest, Shard, SweepObserver, SweepOutcome, SweepSpec, merge_sweeps, run_sweep,
 };
 
-/// A grid scenario with the EEG decoder on a small epoch bank.
-const GRID_EEG: &str = r#"
-task = "grid"
-decoder = "eeg"
-eeg = "bank"
-bank_per_class = 150
-[user]
-accuracy = 0.8
-[[episode]]
-start = [0, 0]
-goal = [4, 4]
-[[episode]]
-start = [4, 0]
-goal = [1, 3]
-[[episode]]
-start = [2, 2]
-goal = [0, 4]
-"#;
-
-/// The same with the oracle decoder (no EEG): fast enough for many episodes.
-const GRID_ORACLE: &str = r#"
-task = "grid"
-decoder = "oracle"
-[user]
-accuracy = 0.8
-[free_goals]
-count = 50
-"#;
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("errp-sweep-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
-}
-
-/// A cache shared by the tests of this binary, so each level's targeting is
-/// searched once.
-fn cache() -> TargetCache {
-    TargetCache::new(std::env::temp_dir().join(format!("errp-sweep-cache-{}", std::process::id())))
-}
-
-fn spec(text: &str, accuracy: &str, params: &[&str], episodes: usize) -> SweepSpec {
-    SweepSpec {
-        task: SweepTask::Grid,
-        scenario_path: "test.toml".into(),
-        scenario_toml: text.into(),
-        accuracies: parse_accuracies(accuracy).unwrap(),
-        axes: params
-            .iter()
-            .map(|p| parse_axis(SweepTask::Grid, p).unwrap())
-            .collect(),
-        fixed: vec![],
-        episodes,
-        seed: 5,
-    }
-}
-
-fn options(out: &Path, shard: Shard, chunk: usize) -> SweepOptions {
-    SweepOptions {
-        out: out.to_path_buf(),
-        cache: cache(),
-        shard,
-        chunk,
-    }
-}
-
-/// Runs a sweep to the end on `threads` threads and writes its summary.
-fn complete(spec: &SweepSpec, out: &Path, shard: Shard, threads: usize) {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .unwrap();
-    let outcome = pool
-        .install(|| run_sweep(spec, &options(out, shard, 7), &AtomicBool::new(false), &()))
-        .unwrap();
-    assert!(
-        matches!(outcome, SweepOutcome::Complete { .. }),
-        "{outcome:?}"
-    );
-    if shard.is_all() {
-        finish_dir(out, &Manifest::read(out).unwrap()).unwrap();
-    }
-}
-
-fn read(dir: &Path, name: &str) -> Vec<u8> {
-    std::fs::read(dir.join(name)).unwrap_or_else(|e| panic!("{}: {e}", dir.join(name).display()))
-}
-
-fn assert_same_files(a: &Path, b: &Path) {
-    for name in ["episodes.csv", "summary.csv", "sweep.json"] {
-        assert!(
-            read(a, name) == read(b, name),
-            "{name} differs between {} and {}",
-            a.display(),
-            b.display()
-        );
-    }
-}
+use crate::{GRID_EEG, GRID_ORACLE, assert_same_files, complete, options, read, spec, temp_dir};
 
 #[test]
 fn sharded_and_merged_equals_unsharded_and_threads_do_not_matter() {
@@ -209,14 +112,11 @@ fn an_interrupted_or_crashed_sweep_resumes_to_the_same_files() {
             )
         })
         .unwrap();
-    assert_eq!(
-        outcome,
-        SweepOutcome::Complete {
-            ran: 160 - done + 1,
-            total: 160
-        }
-    );
-    finish_dir(&resumed, &Manifest::read(&resumed).unwrap()).unwrap();
+    let SweepOutcome::Complete { ran, total, report } = outcome else {
+        panic!("{outcome:?}")
+    };
+    assert_eq!((ran, total), (160 - done + 1, 160));
+    assert!(report.is_some());
     assert_same_files(&whole, &resumed);
 
     // The same directory with other parameters is refused, untouched.

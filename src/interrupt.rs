@@ -1,0 +1,48 @@
+//! Ctrl-C, SIGTERM and SIGHUP: what the program leaves behind when it is
+//! stopped.
+//!
+//! Outside a sweep's episodes, a signal removes every file still being
+//! written (the temporaries of `--save`, `--export` and the sweep's files,
+//! and the sweep's lock) and exits at once with code 130. While a sweep
+//! writes episodes, the first signal asks it to stop after the episodes in
+//! flight (every row on disk is kept, and the same command resumes); a
+//! second one exits at once, as above.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Set by the first signal while a sweep writes episodes.
+pub(crate) static CANCEL: AtomicBool = AtomicBool::new(false);
+
+/// True while a sweep writes episodes (a signal then stops it gracefully).
+static GRACEFUL: AtomicBool = AtomicBool::new(false);
+
+/// The exit code of an interrupted command.
+pub(crate) const EXIT_INTERRUPTED: u8 = 130;
+
+/// Installs the handler (once, at start-up).
+pub(crate) fn install() {
+    // Without a handler (an unusual platform) the default action stays:
+    // the process ends, and the next run removes what it left.
+    let _ = ctrlc::set_handler(|| {
+        if GRACEFUL.load(Ordering::SeqCst) && !CANCEL.swap(true, Ordering::SeqCst) {
+            eprintln!(
+                "\nStopping after the episodes in progress (every row on disk is kept; signal \
+                 again to stop at once)"
+            );
+            return;
+        }
+        let removed = errp_sim::remove_unfinished();
+        if removed > 0 {
+            eprintln!("\nInterrupted: removed {removed} unfinished file(s)");
+        } else {
+            eprintln!("\nInterrupted");
+        }
+        std::process::exit(i32::from(EXIT_INTERRUPTED));
+    });
+}
+
+/// From now on a signal stops the sweep between episodes (`true`), or at
+/// once (`false`).
+pub(crate) fn graceful(on: bool) {
+    GRACEFUL.store(on, Ordering::SeqCst);
+}
