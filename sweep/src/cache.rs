@@ -134,3 +134,130 @@ impl TargetingCache for TargetCache {
         Ok((entry.result, false))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use errp_bci::Accuracy;
+
+    fn result(ratio: f64) -> TargetingResult {
+        let accuracy = Accuracy {
+            correct: 0.8,
+            error: 0.7,
+            n_correct: 320,
+            n_error: 80,
+        };
+        TargetingResult {
+            requested: 0.75,
+            ratio,
+            accuracy,
+            steps: vec![errp_bci::TargetingStep { ratio, accuracy }],
+        }
+    }
+
+    fn scratch(name: &str) -> PathBuf {
+        std::env::temp_dir().join(format!(
+            "errp-cache-{name}-{:x}",
+            errp_sim::host::random_suffix()
+        ))
+    }
+
+    fn entries(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn a_hit_reads_back_bit_for_bit_and_a_damaged_entry_is_a_miss() {
+        let dir = scratch("hit");
+        let cache = TargetCache::new(&dir);
+        let ratio = 0.1 + 0.2; // not a short decimal
+        let (r, hit) = cache
+            .get_or_search("k", "a", &mut || Ok(result(ratio)))
+            .unwrap();
+        assert!(!hit && r.ratio == ratio);
+        let (r, hit) = cache
+            .get_or_search("k", "a", &mut || panic!("a hit searches nothing"))
+            .unwrap();
+        assert!(hit && r.ratio.to_bits() == ratio.to_bits());
+        // Another request is another entry.
+        let (_, hit) = cache
+            .get_or_search("k", "b", &mut || Ok(result(0.5)))
+            .unwrap();
+        assert!(!hit);
+        // An entry cut short (or for another request) is searched again and
+        // rewritten whole.
+        let name = entries(&dir).into_iter().next().unwrap();
+        let text = std::fs::read_to_string(dir.join(&name)).unwrap();
+        std::fs::write(dir.join(&name), &text[..text.len() / 2]).unwrap();
+        let mut searched = 0;
+        for _ in 0..2 {
+            let _ = cache
+                .get_or_search("k", "a", &mut || {
+                    searched += 1;
+                    Ok(result(ratio))
+                })
+                .unwrap();
+            let _ = cache
+                .get_or_search("k", "b", &mut || {
+                    searched += 1;
+                    Ok(result(0.5))
+                })
+                .unwrap();
+        }
+        assert_eq!(searched, 1, "the damaged entry once, then hits");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Writers of one entry at once (threads here; hosts and processes on
+    /// a shared file system alike) each write their own temporary: the
+    /// entry is whole and nothing else is left.
+    #[test]
+    fn writers_of_one_entry_at_once_leave_it_whole() {
+        let dir = scratch("writers");
+        let cache = TargetCache::new(&dir);
+        std::thread::scope(|s| {
+            for _ in 0..8 {
+                s.spawn(|| {
+                    let (r, _) = cache
+                        .get_or_search("k", "same", &mut || {
+                            std::thread::sleep(std::time::Duration::from_millis(20));
+                            Ok(result(0.42))
+                        })
+                        .unwrap();
+                    assert_eq!(r.ratio, 0.42);
+                });
+            }
+        });
+        let names = entries(&dir);
+        assert_eq!(names.len(), 1, "{names:?}");
+        let (r, hit) = cache
+            .get_or_search("k", "same", &mut || panic!("whole: a hit"))
+            .unwrap();
+        assert!(hit && r == result(0.42));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_cache_that_cannot_be_kept_says_why() {
+        assert!(TargetCache::disabled().problem().is_none());
+        let ok = scratch("ok");
+        assert!(TargetCache::new(&ok).problem().is_none());
+        assert!(entries(&ok).is_empty(), "the write test leaves nothing");
+        let e = TargetCache::new("/proc/errp-no-cache").problem().unwrap();
+        assert!(
+            e.contains("/proc/errp-no-cache") && e.contains("--no-cache"),
+            "{e}"
+        );
+        let unset = TargetCache {
+            dir: None,
+            unset: true,
+        };
+        assert!(unset.problem().unwrap().contains("$HOME"));
+        std::fs::remove_dir_all(&ok).unwrap();
+    }
+}

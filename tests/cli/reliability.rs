@@ -65,18 +65,41 @@ fn sweep_args<'a>(scenario: &'a str, out: &'a str, episodes: &'a str) -> Vec<&'a
     ]
 }
 
-#[test]
-fn a_second_sweep_on_one_directory_is_refused_and_the_first_finishes_intact() {
-    let dir = temp_dir("two-sweeps");
+/// A fresh directory `name` holding the oracle scenario as `s.toml`.
+fn oracle_dir(name: &str) -> (PathBuf, PathBuf) {
+    let dir = temp_dir(name);
     let scenario = dir.join("s.toml");
     std::fs::write(&scenario, ORACLE).unwrap();
+    (dir, scenario)
+}
+
+/// Rows of `out/episodes.csv` (header included; 0 if there is none).
+fn lines_on_disk(out: &Path) -> usize {
+    std::fs::read_to_string(out.join("episodes.csv")).map_or(0, |t| t.lines().count())
+}
+
+/// `out` holds the same `episodes.csv` and `summary.csv` as the sweep of
+/// `scenario` run alone and uninterrupted (into `dir/alone`).
+fn assert_same_as_alone(scenario: &str, dir: &Path, out: &Path, episodes: &str) {
+    let alone = dir.join("alone");
+    let o = errp(&sweep_args(scenario, alone.to_str().unwrap(), episodes));
+    assert!(o.status.success(), "{}", stderr(&o));
+    for f in ["episodes.csv", "summary.csv"] {
+        assert!(
+            std::fs::read(out.join(f)).unwrap() == std::fs::read(alone.join(f)).unwrap(),
+            "{f} differs"
+        );
+    }
+}
+
+#[test]
+fn a_second_sweep_on_one_directory_is_refused_and_the_first_finishes_intact() {
+    let (dir, scenario) = oracle_dir("two-sweeps");
     let s = scenario.to_str().unwrap();
     let out = dir.join("out");
     let o = out.to_str().unwrap();
     let mut first = spawn(&sweep_args(s, o, "40000"));
-    wait_until("the first sweep's rows", || {
-        std::fs::read_to_string(out.join("episodes.csv")).is_ok_and(|t| t.lines().count() > 1)
-    });
+    wait_until("the first sweep's rows", || lines_on_disk(&out) > 1);
     // The same command again, as a resubmitted cluster job would run it.
     let e = refused(&sweep_args(s, o, "40000"));
     assert!(
@@ -89,30 +112,18 @@ fn a_second_sweep_on_one_directory_is_refused_and_the_first_finishes_intact() {
     assert!(status.success(), "the first sweep: {status:?}");
     assert!(!out.join("sweep.lock").exists());
     // Intact: the same bytes as the sweep run alone.
-    let alone = dir.join("alone");
-    let o2 = errp(&sweep_args(s, alone.to_str().unwrap(), "40000"));
-    assert!(o2.status.success(), "{}", stderr(&o2));
-    for f in ["episodes.csv", "summary.csv"] {
-        assert!(
-            std::fs::read(out.join(f)).unwrap() == std::fs::read(alone.join(f)).unwrap(),
-            "{f} differs"
-        );
-    }
+    assert_same_as_alone(s, &dir, &out, "40000");
     let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn sigterm_stops_a_sweep_between_episodes_and_the_same_command_resumes() {
-    let dir = temp_dir("sweep-sigterm");
-    let scenario = dir.join("s.toml");
-    std::fs::write(&scenario, ORACLE).unwrap();
+    let (dir, scenario) = oracle_dir("sweep-sigterm");
     let s = scenario.to_str().unwrap();
     let out = dir.join("out");
     let o = out.to_str().unwrap();
     let mut child = spawn(&sweep_args(s, o, "40000"));
-    wait_until("rows on disk", || {
-        std::fs::read_to_string(out.join("episodes.csv")).is_ok_and(|t| t.lines().count() > 100)
-    });
+    wait_until("rows on disk", || lines_on_disk(&out) > 100);
     signal(&child, "TERM");
     let status = child.wait().unwrap();
     assert_eq!(status.code(), Some(130));
@@ -125,16 +136,7 @@ fn sigterm_stops_a_sweep_between_episodes_and_the_same_command_resumes() {
     );
     let resumed = errp(&sweep_args(s, o, "40000"));
     assert!(resumed.status.success(), "{}", stderr(&resumed));
-    let alone = dir.join("alone");
-    assert!(
-        errp(&sweep_args(s, alone.to_str().unwrap(), "40000"))
-            .status
-            .success()
-    );
-    assert!(
-        std::fs::read(out.join("episodes.csv")).unwrap()
-            == std::fs::read(alone.join("episodes.csv")).unwrap()
-    );
+    assert_same_as_alone(s, &dir, &out, "40000");
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -420,9 +422,7 @@ fn bad_input_is_refused_naming_flag_field_value_and_range_leaving_nothing() {
 /// told, once, why every run searches again.
 #[test]
 fn an_unusable_cache_is_a_warning_not_a_silent_fallback() {
-    let dir = temp_dir("cache-warning");
-    let scenario = dir.join("s.toml");
-    std::fs::write(&scenario, ORACLE).unwrap();
+    let (dir, scenario) = oracle_dir("cache-warning");
     let s = scenario.to_str().unwrap();
     let mut args = sweep_args(s, "", "3");
     args.retain(|a| *a != "--no-cache");

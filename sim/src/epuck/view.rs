@@ -56,36 +56,7 @@ fn cm(x: f64, y: f64) -> [f32; 2] {
 
 /// Polygon outline of an obstacle (cm).
 fn outline(o: &Obstacle) -> Vec<[f32; 2]> {
-    match *o {
-        Obstacle::Circle { x_m, y_m, radius_m } => (0..=48)
-            .map(|k| {
-                let a = k as f64 / 48.0 * std::f64::consts::TAU;
-                cm(x_m + radius_m * a.cos(), y_m + radius_m * a.sin())
-            })
-            .collect(),
-        Obstacle::Box {
-            x_m,
-            y_m,
-            half_width_m,
-            half_height_m,
-            angle_rad,
-        } => {
-            let (s, c) = angle_rad.sin_cos();
-            [
-                (-1.0, -1.0),
-                (1.0, -1.0),
-                (1.0, 1.0),
-                (-1.0, 1.0),
-                (-1.0, -1.0),
-            ]
-            .iter()
-            .map(|(u, v)| {
-                let (lx, ly) = (u * half_width_m, v * half_height_m);
-                cm(x_m + c * lx - s * ly, y_m + s * lx + c * ly)
-            })
-            .collect()
-        }
-    }
+    o.outline().into_iter().map(|(x, y)| cm(x, y)).collect()
 }
 
 /// Belief in [0, 1] as a colour: grey (0) to saturated green (1), on a

@@ -41,14 +41,16 @@ pub enum Obstacle {
 }
 
 impl Obstacle {
-    /// The corners of the axis-aligned rectangle around the obstacle:
-    /// ((x min, y min), (x max, y max)), m.
-    pub fn bounds(&self) -> ((f64, f64), (f64, f64)) {
+    /// The obstacle's outline, m: a box's four corners (the first again at
+    /// the end), or 49 points round a circle.
+    pub fn outline(&self) -> Vec<(f64, f64)> {
         match *self {
-            Obstacle::Circle { x_m, y_m, radius_m } => (
-                (x_m - radius_m, y_m - radius_m),
-                (x_m + radius_m, y_m + radius_m),
-            ),
+            Obstacle::Circle { x_m, y_m, radius_m } => (0..=48)
+                .map(|k| {
+                    let a = k as f64 / 48.0 * std::f64::consts::TAU;
+                    (x_m + radius_m * a.cos(), y_m + radius_m * a.sin())
+                })
+                .collect(),
             Obstacle::Box {
                 x_m,
                 y_m,
@@ -57,11 +59,39 @@ impl Obstacle {
                 angle_rad,
             } => {
                 let (s, c) = angle_rad.sin_cos();
-                let rx = (half_width_m * c).abs() + (half_height_m * s).abs();
-                let ry = (half_width_m * s).abs() + (half_height_m * c).abs();
-                ((x_m - rx, y_m - ry), (x_m + rx, y_m + ry))
+                [
+                    (-1.0, -1.0),
+                    (1.0, -1.0),
+                    (1.0, 1.0),
+                    (-1.0, 1.0),
+                    (-1.0, -1.0),
+                ]
+                .iter()
+                .map(|(u, v)| {
+                    let (lx, ly) = (u * half_width_m, v * half_height_m);
+                    (x_m + c * lx - s * ly, y_m + s * lx + c * ly)
+                })
+                .collect()
             }
         }
+    }
+
+    /// The corners of the axis-aligned rectangle around the obstacle:
+    /// ((x min, y min), (x max, y max)), m.
+    pub fn bounds(&self) -> ((f64, f64), (f64, f64)) {
+        if let Obstacle::Circle { x_m, y_m, radius_m } = *self {
+            return (
+                (x_m - radius_m, y_m - radius_m),
+                (x_m + radius_m, y_m + radius_m),
+            );
+        }
+        self.outline().iter().fold(
+            (
+                (f64::INFINITY, f64::INFINITY),
+                (f64::NEG_INFINITY, f64::NEG_INFINITY),
+            ),
+            |((x0, y0), (x1, y1)), &(x, y)| ((x0.min(x), y0.min(y)), (x1.max(x), y1.max(y))),
+        )
     }
 
     /// Distance from the point to the obstacle's boundary (negative inside).

@@ -232,12 +232,8 @@ accuracy = 0.8
         assert_snapshot("grid_report", &out);
     }
 
-    /// A run that took no action of one class has no mean accuracy; it is
-    /// left out of that column's statistics and of the correlation instead
-    /// of making them NaN (`errp table1 --episodes 3 --seed 5` once printed
-    /// `NaN +- NaN`).
-    #[test]
-    fn a_run_without_errors_does_not_poison_table1() {
+    /// Table 1 with the oracle decoder, one run per pair (seed 1).
+    fn oracle_table1() -> Vec<Table1Cell> {
         let options = Table1Options {
             repeats: 1,
             seed: 1,
@@ -245,7 +241,16 @@ accuracy = 0.8
             eeg: EegMode::Bank,
             params: crate::grid::params::GridTaskParams::default(),
         };
-        let mut cells = run_table1(&options, |_, _| {}).unwrap();
+        run_table1(&options, |_, _| {}).unwrap()
+    }
+
+    /// A run that took no action of one class has no mean accuracy; it is
+    /// left out of that column's statistics and of the correlation instead
+    /// of making them NaN (`errp table1 --episodes 3 --seed 5` once printed
+    /// `NaN +- NaN`).
+    #[test]
+    fn a_run_without_errors_does_not_poison_table1() {
+        let mut cells = oracle_table1();
         let before = cells[0].stat(|r| r.online.mean());
         // A sixth run of S1 on the fixed goals with no erroneous action.
         let mut clean = cells[0].runs[0].clone();
@@ -273,14 +278,7 @@ accuracy = 0.8
 
     #[test]
     fn table1_reads_as_printed() {
-        let options = Table1Options {
-            repeats: 1,
-            seed: 1,
-            decoder: DecoderChoice::Oracle,
-            eeg: EegMode::Bank,
-            params: crate::grid::params::GridTaskParams::default(),
-        };
-        let cells = run_table1(&options, |_, _| {}).unwrap();
+        let cells = oracle_table1();
         assert_snapshot("table1_oracle", &Table1Report(&cells).to_string());
     }
 }
