@@ -10,7 +10,7 @@ use clap::ValueEnum;
 use errp_sweep::{
     DecoderInfo, MAX_EPISODES, Shard, SweepObserver, SweepOptions, SweepOutcome, SweepReport,
     SweepSpec, SweepTask, TargetCache, aliases, merge_sweeps, parse_accuracies, parse_axis,
-    read_task, run_sweep,
+    prepare_sweep, read_task, run_sweep,
 };
 
 use crate::cli::parse_seed;
@@ -63,8 +63,8 @@ pub struct SweepArgs {
     #[arg(long, default_value_t = 1, value_parser = parse_seed, allow_negative_numbers = true)]
     seed: u64,
     /// Output directory (rerunning into it resumes).
-    #[arg(long, value_name = "DIR")]
-    out: PathBuf,
+    #[arg(long, value_name = "DIR", required_unless_present = "prepare_only")]
+    out: Option<PathBuf>,
     /// Grid only: how EEG reaches the decoder.
     #[arg(long, value_enum)]
     eeg: Option<SweepEeg>,
@@ -72,8 +72,8 @@ pub struct SweepArgs {
     /// `errp merge`.
     #[arg(long, value_name = "K/N")]
     shard: Option<String>,
-    /// Worker threads, 1 to 1024 (default: one per core). Results do not
-    /// depend on it.
+    /// Worker threads, 1 to 1024 (default: $SLURM_CPUS_PER_TASK inside a
+    /// Slurm job, else one per core). Results do not depend on it.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
     threads: Option<u64>,
     /// Where targeting results are cached (default: $ERRP_CACHE_DIR, else
@@ -87,6 +87,11 @@ pub struct SweepArgs {
     /// after it) and run them again, instead of stopping at it.
     #[arg(long)]
     repair: bool,
+    /// Only prepare every level's decoder, keeping their accuracy targeting
+    /// in the cache, and run no episode: the first job of a cluster sweep,
+    /// so that its shards do not search the targeting again.
+    #[arg(long, conflicts_with_all = ["shard", "repair", "no_cache", "out"])]
+    prepare_only: bool,
     /// No progress output.
     #[arg(long)]
     quiet: bool,
@@ -278,24 +283,41 @@ pub fn sweep(args: &SweepArgs) -> Result<bool> {
         (Some(dir), false) => TargetCache::new(dir),
         (None, false) => TargetCache::default_location(),
     };
+    // Validate every level before printing anything or starting work
+    // (`run_sweep` checks them again, before it creates the directory).
+    spec.levels()?;
+    // A cache that cannot be used is not an error, but the user is told.
+    if let Some(why) = cache.problem() {
+        if args.prepare_only {
+            bail!("--prepare-only keeps the targeting in the cache, and {why}");
+        }
+        eprintln!("warning: {why}");
+    }
+    let threads = match args.threads {
+        Some(n) => n as usize,
+        None => slurm_cpus().unwrap_or_else(rayon::current_num_threads),
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("cannot start the worker threads")?;
+    let progress = Progress::new(args.quiet);
+    if args.prepare_only {
+        return prepare(&spec, &cache, &pool, &progress).map(|()| true);
+    }
+    let out = args
+        .out
+        .clone()
+        .expect("clap requires --out without --prepare-only");
     let opts = SweepOptions {
-        out: args.out.clone(),
+        out,
         cache,
         shard,
         chunk: 0,
         repair: args.repair,
     };
-    // Validate every level before printing anything or starting work
-    // (`run_sweep` checks them again, before it creates the directory).
-    spec.levels()?;
-    // A cache that cannot be used is not an error, but the user is told.
-    if let Some(why) = opts.cache.problem() {
-        eprintln!("warning: {why}");
-    }
-
-    let progress = Progress::new(args.quiet);
     progress.line(&format!(
-        "Sweeping {} ({}): {} levels x {} episodes{}, seed {}, into {}",
+        "Sweeping {} ({}): {} levels x {} episodes{}, seed {}, into {} on {threads} thread(s)",
         spec.scenario_path.display(),
         spec.task,
         spec.n_levels(),
@@ -309,18 +331,10 @@ pub fn sweep(args: &SweepArgs) -> Result<bool> {
         opts.out.display()
     ));
     let started = wall_clock();
-    let run = || {
+    let outcome = pool.install(|| {
         run_sweep(&spec, &opts, &interrupt::CANCEL, &progress)
             .map_err(|e| name_flag(e, "--out", &opts.out))
-    };
-    let outcome = match args.threads {
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n as usize)
-            .build()
-            .context("cannot start the worker threads")?
-            .install(run),
-        None => run(),
-    };
+    });
     interrupt::graceful(false);
     let outcome = outcome?;
     if let Some(bar) = &progress.bar {
@@ -361,6 +375,65 @@ pub fn sweep(args: &SweepArgs) -> Result<bool> {
             Ok(true)
         }
     }
+}
+
+/// The CPUs Slurm gave this job's task (`$SLURM_CPUS_PER_TASK`), if set.
+fn slurm_cpus() -> Option<usize> {
+    std::env::var("SLURM_CPUS_PER_TASK")
+        .ok()?
+        .trim()
+        .parse::<usize>()
+        .ok()
+        .filter(|n| (1..=1024).contains(n))
+}
+
+/// `errp sweep --prepare-only`: every level's decoder once, the targeting
+/// kept in the cache, a line per decoder printed.
+fn prepare(
+    spec: &SweepSpec,
+    cache: &TargetCache,
+    pool: &rayon::ThreadPool,
+    progress: &Progress,
+) -> Result<()> {
+    let dir = cache.dir().expect("checked: a cache").to_path_buf();
+    progress.line(&format!(
+        "Preparing the decoders of {} ({}): {} levels, seed {}, targeting cached in {} on {} \
+         thread(s)",
+        spec.scenario_path.display(),
+        spec.task,
+        spec.n_levels(),
+        spec.seed,
+        dir.display(),
+        pool.current_num_threads()
+    ));
+    let infos = pool.install(|| prepare_sweep(spec, cache, progress))?;
+    if let Some(bar) = &progress.bar {
+        bar.finish_and_clear();
+    }
+    let searched = infos.iter().filter(|i| !i.cached).count();
+    println!(
+        "Prepared {} decoder(s) ({searched} searched now, {} already cached), their targeting \
+         kept in {}:",
+        infos.len(),
+        infos.len() - searched,
+        dir.display()
+    );
+    for i in &infos {
+        match (i.cv_mean, i.errp_to_noise) {
+            (Some(m), Some(r)) => println!(
+                "  accuracy {} -> {:.2} % cross-validated (ErrP-to-noise {r:.4}){}",
+                i.accuracy,
+                100.0 * m,
+                if i.cached { ", cached" } else { "" }
+            ),
+            _ => println!("  accuracy {}: {} (nothing to target)", i.accuracy, i.kind),
+        }
+    }
+    println!(
+        "Shards of this sweep run with the same cache now find every targeting there \
+         (\"targeting cached\" in their progress)."
+    );
+    Ok(())
 }
 
 fn print_report(report: &SweepReport) {

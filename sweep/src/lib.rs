@@ -40,7 +40,7 @@ pub use merge::merge_sweeps;
 pub use observer::SweepObserver;
 pub use plot::{LevelPoint, PaperPoint, PlotError, Series, SweepPlot};
 pub use rows::{CHECKSUM, episodes_header};
-pub use run::{SweepOptions, SweepOutcome, run_sweep};
+pub use run::{MAX_DECODER_BYTES, SweepOptions, SweepOutcome, prepare_sweep, run_sweep};
 pub use spec::{
     Axis, Level, MAX_EPISODES, MAX_LEVELS, Shard, SweepSpec, SweepTask, aliases, parse_accuracies,
     parse_axis, parse_values, read_task, sweepable,

@@ -9,7 +9,7 @@ use errp_sim::PendingFile;
 use errp_sim::epuck::EpuckTask;
 use errp_sim::grid::GridTask;
 use errp_sim::task::Task;
-use errp_sim::{Result, SimError, create_dir};
+use errp_sim::{Result, SimError, create_dir, forget_if_interrupted, remove_if_interrupted};
 
 use crate::finish::finish_dir;
 use crate::lock::DirLock;
@@ -31,6 +31,13 @@ pub fn merge_sweeps(dirs: &[PathBuf], out: &Path) -> Result<SweepReport> {
     }
     let mut shards: Vec<(Manifest, &Path)> = Vec::with_capacity(dirs.len());
     for d in dirs {
+        if !d.join(MANIFEST).is_file() {
+            return Err(SimError::Sweep(format!(
+                "{} holds no sweep (no {MANIFEST}): has its shard run? Run it (a shard \
+                 resumes where it stopped), then merge",
+                d.display()
+            )));
+        }
         let m = Manifest::read(d)?;
         if m.shard.is_none() {
             return Err(SimError::Sweep(format!(
@@ -108,6 +115,10 @@ pub fn merge_sweeps(dirs: &[PathBuf], out: &Path) -> Result<SweepReport> {
     let levels = spec.levels()?;
     let created = !out.exists();
     create_dir(out)?;
+    if created {
+        // Goes if the merge is interrupted before it is written.
+        remove_if_interrupted(out);
+    }
     let result = DirLock::acquire(out, "--out").and_then(|lock| {
         let report = match spec.task {
             SweepTask::Grid => merge_rows::<GridTask>(&spec, &levels, &inputs, out),
@@ -126,6 +137,7 @@ pub fn merge_sweeps(dirs: &[PathBuf], out: &Path) -> Result<SweepReport> {
     if result.is_err() && created {
         let _ = std::fs::remove_dir_all(out);
     }
+    forget_if_interrupted(out);
     result
 }
 

@@ -10,7 +10,7 @@ use std::sync::atomic::AtomicBool;
 
 use errp_sim::epuck::EpuckTask;
 use errp_sim::grid::GridTask;
-use errp_sim::task::Task;
+use errp_sim::task::{DecoderInfo, Task};
 use errp_sim::{Result, SimError, create_dir, forget_if_interrupted, remove_if_interrupted};
 
 use crate::cache::TargetCache;
@@ -171,6 +171,125 @@ fn foreign_files(dir: &Path) -> Result<Vec<String>> {
     Ok(names)
 }
 
+/// The decoders a sweep's levels need: each distinct one once.
+struct Plan<'a, T: Task> {
+    levels: &'a [Level],
+    /// Every level's scenario.
+    scenarios: Vec<&'a T::Scenario>,
+    /// The first level of each distinct decoder.
+    first: Vec<usize>,
+    /// Each level's distinct decoder.
+    key_of: Vec<usize>,
+}
+
+impl<'a, T: Task> Plan<'a, T> {
+    /// The distinct decoders of `levels`, refused if they would hold more
+    /// memory than a sweep may take.
+    fn new(spec: &SweepSpec, levels: &'a [Level]) -> Result<Self> {
+        let scenarios: Vec<&T::Scenario> = levels
+            .iter()
+            .map(|level| {
+                T::scenario(&level.scenario).ok_or_else(|| {
+                    SimError::Sweep(format!(
+                        "the sweep is of the {} task, but {} is not a scenario of it",
+                        T::INFO.name,
+                        spec.scenario_path.display()
+                    ))
+                })
+            })
+            .collect::<Result<_>>()?;
+        let mut first: Vec<usize> = Vec::new();
+        let mut key_of = Vec::with_capacity(levels.len());
+        let mut index: HashMap<String, usize> = HashMap::new();
+        for (i, s) in scenarios.iter().enumerate() {
+            let d = *index.entry(T::decoder_key(s)).or_insert_with(|| {
+                first.push(i);
+                first.len() - 1
+            });
+            key_of.push(d);
+        }
+        // What the decoders will hold (their shared parts about as much as
+        // the largest), refused before the work if it is more than a sweep
+        // may take.
+        let bytes: Vec<usize> = first
+            .iter()
+            .map(|&i| T::decoder_bytes(scenarios[i]))
+            .collect();
+        let total = bytes.iter().sum::<usize>() + 2 * bytes.iter().max().unwrap_or(&0);
+        if total > MAX_DECODER_BYTES {
+            return Err(SimError::Sweep(format!(
+                "the sweep's {} decoders would hold about {:.1} GiB (their epoch banks), more \
+                 than the {} GiB a sweep may take: sweep fewer levels at once, lower \
+                 bank_per_class, or stream the EEG (--eeg stream)",
+                first.len(),
+                total as f64 / (1u64 << 30) as f64,
+                MAX_DECODER_BYTES >> 30
+            )));
+        }
+        Ok(Self {
+            levels,
+            scenarios,
+            first,
+            key_of,
+        })
+    }
+
+    /// Prepares each distinct decoder (in parallel, with `cache` for the
+    /// targeting), in the order of their first levels.
+    fn prepare(
+        &self,
+        cache: &TargetCache,
+        observer: &dyn SweepObserver,
+    ) -> Result<Vec<(T::Decoder, DecoderInfo)>> {
+        let distinct: Vec<&T::Scenario> = self.first.iter().map(|&i| self.scenarios[i]).collect();
+        let shared = T::shared(&self.scenarios)?;
+        prepare_all::<T>(
+            &distinct,
+            |d| (self.levels[self.first[d]].accuracy - 0.75).abs(),
+            cache,
+            &shared,
+            observer,
+        )
+    }
+}
+
+/// Prepares every distinct decoder of `spec`'s levels, as a sweep would,
+/// and keeps nothing but what `cache` stores: the targeting of each. Run it
+/// once before the shards of a sweep start (`errp sweep --prepare-only`), so
+/// that none of them searches the targeting again. Returns what each decoder
+/// reached.
+pub fn prepare_sweep(
+    spec: &SweepSpec,
+    cache: &TargetCache,
+    observer: &dyn SweepObserver,
+) -> Result<Vec<DecoderInfo>> {
+    if cache.dir().is_none() {
+        return Err(SimError::Sweep(
+            "preparing a sweep keeps its targeting in the cache: give --cache DIR (not \
+             --no-cache)"
+                .into(),
+        ));
+    }
+    let levels = spec.levels()?;
+    fn infos<T: Task>(
+        spec: &SweepSpec,
+        levels: &[Level],
+        cache: &TargetCache,
+        observer: &dyn SweepObserver,
+    ) -> Result<Vec<DecoderInfo>> {
+        let plan = Plan::<T>::new(spec, levels)?;
+        Ok(plan
+            .prepare(cache, observer)?
+            .into_iter()
+            .map(|(_, info)| info)
+            .collect())
+    }
+    match spec.task {
+        SweepTask::Grid => infos::<GridTask>(spec, &levels, cache, observer),
+        SweepTask::Epuck => infos::<EpuckTask>(spec, &levels, cache, observer),
+    }
+}
+
 /// Prepares the levels' decoders (one per distinct calibration, in
 /// parallel), lists them in the manifest, then runs the slice's episodes.
 fn run_levels<T: Task>(
@@ -183,55 +302,8 @@ fn run_levels<T: Task>(
 ) -> Result<SweepOutcome> {
     let out = &opts.out;
     let episodes_path = out.join(EPISODES);
-    let scenarios: Vec<&T::Scenario> = levels
-        .iter()
-        .map(|level| {
-            T::scenario(&level.scenario).ok_or_else(|| {
-                SimError::Sweep(format!(
-                    "the sweep is of the {} task, but {} is not a scenario of it",
-                    T::INFO.name,
-                    spec.scenario_path.display()
-                ))
-            })
-        })
-        .collect::<Result<_>>()?;
-    let mut first: Vec<usize> = Vec::new();
-    let mut key_of = Vec::with_capacity(levels.len());
-    let mut index: HashMap<String, usize> = HashMap::new();
-    for (i, s) in scenarios.iter().enumerate() {
-        let d = *index.entry(T::decoder_key(s)).or_insert_with(|| {
-            first.push(i);
-            first.len() - 1
-        });
-        key_of.push(d);
-    }
-    let distinct: Vec<&T::Scenario> = first.iter().map(|&i| scenarios[i]).collect();
-    // What the decoders will hold (their shared parts about as much as the
-    // largest), refused before the work if it is more than a sweep may take.
-    let largest = distinct
-        .iter()
-        .map(|s| T::decoder_bytes(s))
-        .max()
-        .unwrap_or(0);
-    let bytes = distinct.iter().map(|s| T::decoder_bytes(s)).sum::<usize>() + 2 * largest;
-    if bytes > MAX_DECODER_BYTES {
-        return Err(SimError::Sweep(format!(
-            "the sweep's {} decoders would hold about {:.1} GiB (their epoch banks), more than \
-             the {} GiB a sweep may take: sweep fewer levels at once, lower bank_per_class, \
-             or stream the EEG (--eeg stream)",
-            distinct.len(),
-            bytes as f64 / (1u64 << 30) as f64,
-            MAX_DECODER_BYTES >> 30
-        )));
-    }
-    let shared = T::shared(&scenarios)?;
-    let prepared = prepare_all::<T>(
-        &distinct,
-        |d| (levels[first[d]].accuracy - 0.75).abs(),
-        &opts.cache,
-        &shared,
-        observer,
-    )?;
+    let plan = Plan::<T>::new(spec, levels)?;
+    let prepared = plan.prepare(&opts.cache, observer)?;
     let (decoders, infos): (Vec<_>, Vec<_>) = prepared
         .into_iter()
         .map(|(decoder, info)| (Arc::new(decoder), info))
@@ -241,9 +313,10 @@ fn run_levels<T: Task>(
         ..fresh
     };
     manifest.write(out)?;
-    let runners: Vec<T::Runner> = scenarios
+    let runners: Vec<T::Runner> = plan
+        .scenarios
         .iter()
-        .zip(&key_of)
+        .zip(&plan.key_of)
         .map(|(s, &d)| T::runner(s, decoders[d].clone()))
         .collect::<Result<_>>()?;
 

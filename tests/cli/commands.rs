@@ -383,3 +383,62 @@ fn bad_sweep_input_is_exit_2_with_the_fix_and_no_output() {
     assert!(stderr(&o).contains("sweep.json"), "{}", stderr(&o));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `--prepare-only` fills the targeting cache and runs nothing; a shard
+/// started after it finds every targeting there.
+#[test]
+fn prepare_only_fills_the_cache_so_that_shards_search_nothing() {
+    let dir = temp_dir("prepare-only");
+    let cache = dir.join("cache");
+    let c = cache.to_str().unwrap();
+    let args = [
+        "--task",
+        "epuck",
+        "--accuracy",
+        "0.8,0.9",
+        "--episodes",
+        "2",
+    ];
+    let mut prepare = vec!["sweep", "--prepare-only", "--cache", c];
+    prepare.extend(args);
+    let o = errp(&prepare);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains("Prepared 2 decoder(s) (2 searched now, 0 already cached)"),
+        "{out}"
+    );
+    assert_eq!(files_in(&dir), ["cache"], "no sweep directory");
+    let shard_dir = dir.join("shard-1");
+    let mut shard = vec![
+        "sweep",
+        "--cache",
+        c,
+        "--shard",
+        "1/2",
+        "--out",
+        shard_dir.to_str().unwrap(),
+    ];
+    shard.extend(args);
+    let o = errp(&shard);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let progress = stderr(&o);
+    assert_eq!(
+        progress.matches("(targeting cached)").count(),
+        2,
+        "{progress}"
+    );
+    // Nothing to keep, or an output it would not write: refused.
+    for extra in [
+        vec!["--no-cache"],
+        vec!["--out", "x"],
+        vec!["--shard", "1/2"],
+    ] {
+        let mut bad = vec!["sweep", "--prepare-only"];
+        bad.extend(args);
+        bad.extend(extra.iter());
+        let e = refused(&bad);
+        assert!(e.contains("--prepare-only"), "{extra:?}: {e}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
