@@ -35,7 +35,7 @@ pub use errp_sim::task::DecoderInfo;
 pub use figure::sweep_plot;
 pub use finish::finish_dir;
 pub use lock::{DirLock, HEARTBEAT, Holder, LOCK, STALE_AFTER};
-pub use manifest::{EPISODES, MANIFEST, Manifest};
+pub use manifest::{EPISODES, FORMAT, MANIFEST, MAX_MANIFEST_BYTES, Manifest};
 pub use merge::merge_sweeps;
 pub use observer::SweepObserver;
 pub use plot::{LevelPoint, PaperPoint, PlotError, Series, SweepPlot};
