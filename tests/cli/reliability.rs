@@ -39,6 +39,7 @@ fn wait_until(what: &str, ready: impl Fn() -> bool) {
 }
 
 /// True if `dir` holds a file being written (`.NAME.partial-...`).
+#[cfg(feature = "rerun")]
 fn has_partial(dir: &Path) -> bool {
     files_in(dir).iter().any(|f| f.contains(".partial-"))
 }
