@@ -117,8 +117,9 @@ pub struct PendingFile {
 
 impl PendingFile {
     /// Reserves `dest`: creates the temporary file now, so that an unwritable
-    /// destination is reported before any long computation. Temporaries of
-    /// `dest` left by dead processes of this host are removed first.
+    /// destination is reported before any long computation. Temporaries in
+    /// `dest`'s directory left by dead processes of this host are removed
+    /// first.
     pub fn create(dest: impl AsRef<Path>) -> Result<(Self, File)> {
         let dest = dest.as_ref().to_path_buf();
         let fail = |source| SimError::Output {

@@ -266,11 +266,6 @@ pub fn parse_accuracies(text: &str) -> Result<Vec<f64>> {
         }
         out.push(a);
     }
-    if let Some(twice) = repeated(&out.iter().map(|a| Value::Float(*a)).collect::<Vec<_>>()) {
-        return Err(SimError::Sweep(format!(
-            "--accuracy {text:?} is invalid: {twice} is given twice (each level once)"
-        )));
-    }
     Ok(out)
 }
 
@@ -336,16 +331,12 @@ pub fn parse_axis(task: SweepTask, text: &str) -> Result<Axis> {
             errp_sim::MAX_KEY_PARTS
         )));
     }
-    let values = parse_values(values, &format!("--param {name}"))?;
-    if let Some(twice) = repeated(&values) {
-        return Err(SimError::Sweep(format!(
-            "--param {name}: {twice} is given twice (each value once)"
-        )));
-    }
+    // Values given twice are refused with the other checks of a whole
+    // sweep (`SweepSpec::check`).
     Ok(Axis {
         name: name.to_string(),
         key,
-        values,
+        values: parse_values(values, &format!("--param {name}"))?,
     })
 }
 
