@@ -43,6 +43,7 @@ pub use output::{
 pub use paper::{PAPER, PAPER_EPUCK, PAPER_POOLED};
 pub use scenario::{
     AnyScenario, is_epuck, load_scenario, load_scenario_with, parse_scenario, parse_scenario_table,
+    parse_scenario_with,
 };
 pub use scenario_file::{
     MAX_KEY_PARTS, MAX_SCENARIO_BYTES, parse_toml, read_scenario, set_key, table_into, truncate,

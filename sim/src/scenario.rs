@@ -40,7 +40,20 @@ pub fn load_scenario_with(
     if overrides.is_empty() {
         return load_scenario(path);
     }
-    let mut table: toml::Table = parse_toml(&read_scenario(path)?, path)?;
+    parse_scenario_with(&read_scenario(path)?, path, overrides)
+}
+
+/// [`load_scenario_with`] for a scenario's text (`path` names it in
+/// errors).
+pub fn parse_scenario_with(
+    text: &str,
+    path: &Path,
+    overrides: &[(&str, toml::Value)],
+) -> Result<AnyScenario> {
+    if overrides.is_empty() {
+        return parse_scenario(text, path);
+    }
+    let mut table: toml::Table = parse_toml(text, path)?;
     for (key, value) in overrides {
         if *key == "user.accuracy"
             && let Some(user) = table.get_mut("user").and_then(toml::Value::as_table_mut)

@@ -170,6 +170,34 @@ pub struct EpisodeRow {
     pub online: Accuracy,
 }
 
+impl EpisodeRow {
+    /// The row's fields as `episodes.csv` writes them, from `success` to
+    /// `online_accuracy` (the columns of [`TaskInfo::row_columns`]).
+    pub fn csv_fields(self) -> Vec<String> {
+        let (_, _, acc) = overall(&self.online);
+        let mut f = Vec::with_capacity(self.fields.len() + 4);
+        f.push(u8::from(self.success).to_string());
+        f.extend(self.fields);
+        f.extend([
+            rate_field(self.online.correct),
+            rate_field(self.online.error),
+            rate_field(acc),
+        ]);
+        f
+    }
+}
+
+impl TaskInfo {
+    /// The columns of an episode's row from `success` to `online_accuracy`:
+    /// what [`EpisodeRow::csv_fields`] fills.
+    pub fn row_columns(&self) -> Vec<&'static str> {
+        let mut cols = vec!["success"];
+        cols.extend(self.columns.iter().map(|c| c.name));
+        cols.extend(["acc_correct", "acc_error", "online_accuracy"]);
+        cols
+    }
+}
+
 /// A result the paper reports, drawn beside a sweep's curves.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PaperPoint {

@@ -6,7 +6,7 @@ use std::path::Path;
 use anyhow::{Context, Result, bail};
 use errp_bci::OnlineStep;
 #[cfg(feature = "rerun")]
-use errp_sim::epuck::{ContinuousDecoder, EpuckEpisodeResult, EpuckRecorder, run_epuck_once};
+use errp_sim::epuck::record_epuck_runs;
 use errp_sim::epuck::{
     EpuckRunHeader, EpuckRunRow, EpuckScenario, EpuckSummaryReport,
     prepare_continuous_decoder_with, run_epuck_batch, summarise,
@@ -160,16 +160,7 @@ pub(crate) fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<(
     #[cfg(feature = "rerun")]
     let rrd = open_recording(args, errp_sim::epuck::epuck_recording)?;
     let quiet = args.quiet;
-    let decoder_text = match scenario.online_target {
-        None => format!("decoder accuracy {:.2} %", 100.0 * scenario.accuracy.get()),
-        Some(t) => format!(
-            "decoder calibrated online for {:.1} % hits{}",
-            100.0 * t.hit_rate,
-            t.false_alarms_per_min
-                .map(|f| format!(" at {f} false alarms per minute"))
-                .unwrap_or_default()
-        ),
-    };
+    let decoder_text = scenario.decoder_text();
     let layout = &scenario.layout;
     let start = &scenario.episode.start;
     let goal = &layout.goals()[scenario.episode.goal].name;
@@ -215,7 +206,7 @@ pub(crate) fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<(
     }
     #[cfg(feature = "rerun")]
     let recorded = match &rrd {
-        Some(file) => Some(record_epuck_runs(file, &scenario, &decoder, &decoder_text)?),
+        Some(file) => Some(record_epuck_runs(file, &scenario, &decoder)?),
         None => None,
     };
     #[cfg(not(feature = "rerun"))]
@@ -268,32 +259,4 @@ fn open_recording<T>(
         Some(path) => Ok(Some(open(path).context("--save")?)),
         None => Ok(None),
     }
-}
-
-/// The runs of an e-puck scenario one after another, each recorded.
-#[cfg(feature = "rerun")]
-fn record_epuck_runs(
-    file: &errp_sim::record::RrdFile,
-    scenario: &EpuckScenario,
-    decoder: &ContinuousDecoder,
-    decoder_text: &str,
-) -> Result<Vec<EpuckEpisodeResult>> {
-    let layout = &scenario.layout;
-    let goal = &layout.goals()[scenario.episode.goal].name;
-    let mut recorder = EpuckRecorder::new(
-        file,
-        &scenario.arena,
-        layout,
-        decoder.t_e(scenario.params.control.t_e),
-    )?;
-    let mut out = Vec::with_capacity(scenario.runs);
-    for k in 0..scenario.runs {
-        recorder.next_run(&format!(
-            "run {}: the user wants {goal} ({decoder_text})",
-            k + 1
-        ));
-        out.push(run_epuck_once(scenario, decoder, k, &mut recorder)?);
-    }
-    recorder.finish()?;
-    Ok(out)
 }

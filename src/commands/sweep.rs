@@ -8,9 +8,9 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
 use errp_sweep::{
-    DecoderInfo, MAX_EPISODES, Shard, SweepObserver, SweepOptions, SweepOutcome, SweepReport,
-    SweepSpec, SweepTask, TargetCache, aliases, merge_sweeps, parse_accuracies, parse_axis,
-    prepare_sweep, read_task, run_sweep,
+    DecoderInfo, InputNames, MAX_EPISODES, Shard, SweepObserver, SweepOptions, SweepOutcome,
+    SweepReport, SweepSpec, SweepTask, TargetCache, aliases, merge_sweeps, parse_accuracies,
+    parse_axis, prepare_sweep, run_sweep, sweep_fixed, sweep_scenario,
 };
 
 use crate::cli::parse_seed;
@@ -107,9 +107,6 @@ pub struct MergeArgs {
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
 }
-
-const BUILT_IN_GRID: &str = include_str!("../../scenarios/grid_fixed_goals.toml");
-const BUILT_IN_EPUCK: &str = include_str!("../../scenarios/mexico_to_pisa.toml");
 
 /// Now, for the elapsed times the program prints. Only the command line
 /// reads the clock; nothing it computes depends on it.
@@ -212,54 +209,17 @@ impl SweepObserver for Progress {
 
 /// Runs `errp sweep`. Returns false if interrupted (exit code 130).
 pub fn sweep(args: &SweepArgs) -> Result<bool> {
-    let (task, text, path) = match (&args.scenario, args.task) {
-        (Some(path), task) => {
-            let (t, text) = read_task(path)?;
-            if let Some(want) = task {
-                let want = match want {
-                    TaskArg::Grid => SweepTask::Grid,
-                    TaskArg::Epuck => SweepTask::Epuck,
-                };
-                if want != t {
-                    bail!(
-                        "--task {want} does not match {}, a {t} scenario (its `task` field)",
-                        path.display()
-                    );
-                }
-            }
-            (t, text, path.clone())
-        }
-        (None, Some(TaskArg::Grid)) => (
-            SweepTask::Grid,
-            BUILT_IN_GRID.to_string(),
-            PathBuf::from("scenarios/grid_fixed_goals.toml"),
-        ),
-        (None, Some(TaskArg::Epuck)) => (
-            SweepTask::Epuck,
-            BUILT_IN_EPUCK.to_string(),
-            PathBuf::from("scenarios/mexico_to_pisa.toml"),
-        ),
-        (None, None) => {
-            bail!("give --scenario FILE.toml, or --task grid|epuck for its built-in scenario")
-        }
+    const NAMES: InputNames = InputNames {
+        scenario: "--scenario",
+        task: "--task",
+        eeg: "--eeg",
     };
-    let mut fixed = Vec::new();
-    match (task, args.eeg) {
-        (SweepTask::Grid, eeg) => fixed.push((
-            "eeg".to_string(),
-            toml::Value::String(
-                match eeg.unwrap_or(SweepEeg::Bank) {
-                    SweepEeg::Bank => "bank",
-                    SweepEeg::Stream => "stream",
-                }
-                .into(),
-            ),
-        )),
-        (SweepTask::Epuck, Some(_)) => {
-            bail!("--eeg applies to the grid; the e-puck always streams its EEG")
-        }
-        (SweepTask::Epuck, None) => {}
-    }
+    let want = args.task.map(|t| match t {
+        TaskArg::Grid => SweepTask::Grid,
+        TaskArg::Epuck => SweepTask::Epuck,
+    });
+    let (task, text, path) = sweep_scenario(args.scenario.as_deref(), want, NAMES)?;
+    let fixed = sweep_fixed(task, args.eeg.map(|e| e == SweepEeg::Stream), NAMES)?;
     let spec = SweepSpec {
         task,
         scenario_path: path,

@@ -7,7 +7,7 @@
 //! task knows of it) and the checksum, so a row cut short, edited or
 //! damaged on disk is found, never kept.
 
-use errp_sim::task::{FieldError, Task, overall, rate_field};
+use errp_sim::task::{FieldError, Task};
 use errp_sim::{Result, SimError};
 
 use crate::spec::{Level, SweepSpec, format_number, value_text};
@@ -22,9 +22,9 @@ pub(crate) const MAX_ROW_BYTES: usize = 64 * 1024;
 pub fn episodes_header(spec: &SweepSpec) -> String {
     let mut cols = vec!["level".to_string(), "accuracy".into()];
     cols.extend(spec.axes.iter().map(|a| a.name.clone()));
-    cols.extend(["episode", "seed", "success"].map(String::from));
-    cols.extend(spec.task.info().columns.iter().map(|c| c.name.to_string()));
-    cols.extend(["acc_correct", "acc_error", "online_accuracy", CHECKSUM].map(String::from));
+    cols.extend(["episode", "seed"].map(String::from));
+    cols.extend(spec.task.info().row_columns().into_iter().map(String::from));
+    cols.push(CHECKSUM.to_string());
     cols.join(",")
 }
 
@@ -54,14 +54,7 @@ pub(crate) fn run_row<T: Task>(
             T::INFO.columns.len()
         )));
     }
-    f.push(u8::from(row.success).to_string());
-    f.extend(row.fields);
-    let (_, _, acc) = overall(&row.online);
-    f.extend([
-        rate_field(row.online.correct),
-        rate_field(row.online.error),
-        rate_field(acc),
-    ]);
+    f.extend(row.csv_fields());
     Ok(with_checksum(f.join(",")))
 }
 

@@ -351,6 +351,91 @@ pub fn read_task(path: &Path) -> Result<(SweepTask, String)> {
     Ok((task, text))
 }
 
+/// The built-in grid scenario a sweep runs without a scenario file.
+pub const BUILT_IN_GRID: &str = include_str!("../../scenarios/grid_fixed_goals.toml");
+/// The built-in e-puck scenario.
+pub const BUILT_IN_EPUCK: &str = include_str!("../../scenarios/mexico_to_pisa.toml");
+
+/// How a caller names the inputs of [`sweep_scenario`] and [`sweep_fixed`]
+/// in its errors: `--task` on the command line, `task` in Python.
+#[derive(Debug, Clone, Copy)]
+pub struct InputNames {
+    /// The scenario file.
+    pub scenario: &'static str,
+    /// The task.
+    pub task: &'static str,
+    /// The grid's EEG mode.
+    pub eeg: &'static str,
+}
+
+/// The scenario a sweep runs: the file at `path` (its task checked against
+/// `task` when both are given), or the built-in scenario of `task`, as
+/// (task, text, path).
+pub fn sweep_scenario(
+    path: Option<&Path>,
+    task: Option<SweepTask>,
+    names: InputNames,
+) -> Result<(SweepTask, String, PathBuf)> {
+    match (path, task) {
+        (Some(path), task) => {
+            let (t, text) = read_task(path)?;
+            if let Some(want) = task
+                && want != t
+            {
+                return Err(SimError::Sweep(format!(
+                    "{} {want} does not match {}, a {t} scenario (its `task` field)",
+                    names.task,
+                    path.display()
+                )));
+            }
+            Ok((t, text, path.to_path_buf()))
+        }
+        (None, Some(SweepTask::Grid)) => Ok((
+            SweepTask::Grid,
+            BUILT_IN_GRID.to_string(),
+            PathBuf::from("scenarios/grid_fixed_goals.toml"),
+        )),
+        (None, Some(SweepTask::Epuck)) => Ok((
+            SweepTask::Epuck,
+            BUILT_IN_EPUCK.to_string(),
+            PathBuf::from("scenarios/mexico_to_pisa.toml"),
+        )),
+        (None, None) => Err(SimError::Sweep(format!(
+            "give {} FILE.toml, or {} grid|epuck for its built-in scenario",
+            names.scenario, names.task
+        ))),
+    }
+}
+
+/// The scenario keys a sweep of `task` sets whatever its levels: the grid
+/// reads its epochs from a bank unless `stream` is asked for (`eeg`:
+/// `Some(true)` streams, `Some(false)` or none uses the bank); the e-puck
+/// always streams, so an `eeg` choice is refused.
+pub fn sweep_fixed(
+    task: SweepTask,
+    stream: Option<bool>,
+    names: InputNames,
+) -> Result<Vec<(String, Value)>> {
+    match (task, stream) {
+        (SweepTask::Grid, stream) => Ok(vec![(
+            "eeg".to_string(),
+            Value::String(
+                if stream == Some(true) {
+                    "stream"
+                } else {
+                    "bank"
+                }
+                .into(),
+            ),
+        )]),
+        (SweepTask::Epuck, Some(_)) => Err(SimError::Sweep(format!(
+            "{} applies to the grid; the e-puck always streams its EEG",
+            names.eeg
+        ))),
+        (SweepTask::Epuck, None) => Ok(Vec::new()),
+    }
+}
+
 impl SweepSpec {
     /// Episodes over all levels.
     pub fn total_episodes(&self) -> usize {

@@ -125,6 +125,12 @@ impl SlidingWindow {
         model.p_error(&self.scratch)
     }
 
+    /// The current window: the last 800 ms of preprocessed EEG, `(n_channels,
+    /// n_samples)`, the oldest sample first.
+    pub fn window(&self) -> &EegBlock {
+        &self.window
+    }
+
     /// Rows of FCz and Cz in the blocks [`advance`](Self::advance) returns.
     pub fn fcz_cz(&self) -> [usize; 2] {
         self.fcz_cz

@@ -8,7 +8,7 @@
 //! the controller updates its belief (eq. 6-7) and reacts to a detection.
 
 use errp_bci::{
-    Accuracy, AssessmentKind, Detector, DetectorParams, ResponseSpan,
+    Accuracy, AssessmentKind, Detector, DetectorParams, EegBlock, ResponseSpan,
     rng::{derive_seed, stream},
 };
 use errp_robot::{
@@ -224,6 +224,32 @@ pub fn run_epuck_episode(
     seed: u64,
     observer: &mut impl EpuckObserver,
 ) -> Result<EpuckEpisodeResult> {
+    run_epuck_episode_with(
+        params, arena, layout, episode, decoder, seed, observer, None,
+    )
+}
+
+/// A decoder of the user's own for the e-puck: given the sliding window
+/// every 62.5 ms (the last 800 ms of preprocessed EEG, `(n_channels,
+/// n_samples)`), it returns p(error), a number from 0 to 1.
+pub type WindowDecoder<'a> = &'a mut (dyn FnMut(&EegBlock) -> Result<f64> + Send);
+
+/// [`run_epuck_episode`] with `window_decoder`, if given, in place of the
+/// calibrated SVM: the EEG, its preprocessing and everything else are the
+/// scenario's. Its p(error) goes through the scenario's detector at the
+/// scenario's `control.t_e`, and is scored over the response spans measured
+/// for the built-in decoder.
+#[allow(clippy::too_many_arguments)]
+pub fn run_epuck_episode_with(
+    params: &EpuckTaskParams,
+    arena: &ArenaSpec,
+    layout: &GoalLayout,
+    episode: EpuckEpisode,
+    decoder: &ContinuousDecoder,
+    seed: u64,
+    observer: &mut impl EpuckObserver,
+    mut window_decoder: Option<WindowDecoder<'_>>,
+) -> Result<EpuckEpisodeResult> {
     if episode.goal >= layout.goals().len() {
         return Err(SimError::Scenario(format!(
             "goal index {} is not in the layout of {} goals",
@@ -243,7 +269,10 @@ pub fn run_epuck_episode(
     control.goal_hold_secs = Some(params.goal_hold_secs(&span));
     control.veto_window_secs = Some(params.control.veto_window_secs.unwrap_or(span.to_secs));
     let mut controller = ContinuousController::new(control, layout.clone(), episode.start)?;
-    let t_e = decoder.t_e(params.control.t_e);
+    let t_e = match window_decoder {
+        Some(_) => params.control.t_e,
+        None => decoder.t_e(params.control.t_e),
+    };
     let mut detector = Detector::new(params.detector, t_e)?;
     let mut eeg = decoder.start_stream(derive_seed(seed, "epuck/eeg", 0))?;
     let fcz_cz = eeg.fcz_cz();
@@ -315,7 +344,10 @@ pub fn run_epuck_episode(
         }
 
         let fresh = eeg.advance();
-        let p_error = eeg.p_error(&decoder.model);
+        let p_error = match window_decoder.as_mut() {
+            Some(decode) => crate::grid::check_p_error(decode(eeg.window())?)?,
+            None => eeg.p_error(&decoder.model),
+        };
         let decision = detector.push(p_error, time_secs);
         let obs = controller.observe(decision.detected, &tracked, time_secs)?;
         let used = obs.step != StepKind::Idle;

@@ -3,6 +3,7 @@
 //! decoder, one episode, batches of runs and the recording.
 
 pub(crate) mod decoder;
+pub(crate) mod environment;
 pub(crate) mod episode;
 pub(crate) mod report;
 pub(crate) mod run;
@@ -19,9 +20,11 @@ pub use decoder::{
     ContinuousDecoder, ContinuousReport, ContinuousRequest, OnlineReport, calibrate_continuous_at,
     run_continuous_calibration, run_online_calibration, target_continuous,
 };
+pub use environment::{EpuckAction, EpuckEnvironment, EpuckFeedback, MAX_WINDOWS_PER_ACTION};
 pub use episode::{
     EpuckEpisode, EpuckEpisodeResult, EpuckObserver, EpuckTaskParams, PHYSICS_DT_SECS,
-    PhysicsFrame, WINDOW_STEP_SECS, WindowFrame, run_epuck_episode,
+    PhysicsFrame, WINDOW_STEP_SECS, WindowDecoder, WindowFrame, run_epuck_episode,
+    run_epuck_episode_with,
 };
 pub use errp_robot::AvoidanceParams;
 pub use report::{EpuckRunHeader, EpuckRunRow, EpuckSummaryReport};
@@ -34,9 +37,9 @@ pub use scenario::{
     EpuckScenario, MAX_OBSTACLES, MAX_REACTION_LATENCY_MS, MAX_REELICIT_SECS, MAX_RUN_SECS,
     MAX_RUNS, MAX_TRACKER_HZ,
 };
-pub use task::{EpuckRunner, EpuckTask};
+pub use task::{EpuckRunner, EpuckTask, epuck_row};
 pub use tracker::{CameraTracker, TrackerParams};
 pub use user::{Elicited, Judgement, SeenMotion, SyntheticUser, UserParams};
 #[cfg(feature = "rerun")]
-pub use view::{EpuckRecorder, RUN_GAP_SECS, epuck_recording};
+pub use view::{EpuckRecorder, RUN_GAP_SECS, epuck_recording, record_epuck_runs};
 pub use world::{ArenaSpec, Obstacle, ProximitySensors, World};

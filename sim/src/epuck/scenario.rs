@@ -71,6 +71,21 @@ pub struct EpuckScenario {
 }
 
 impl EpuckScenario {
+    /// The decoder in words, as `errp run` prints it and its recording
+    /// shows it: "decoder accuracy 75.00 %", or the online target.
+    pub fn decoder_text(&self) -> String {
+        match self.online_target {
+            None => format!("decoder accuracy {:.2} %", 100.0 * self.accuracy.get()),
+            Some(t) => format!(
+                "decoder calibrated online for {:.1} % hits{}",
+                100.0 * t.hit_rate,
+                t.false_alarms_per_min
+                    .map(|f| format!(" at {f} false alarms per minute"))
+                    .unwrap_or_default()
+            ),
+        }
+    }
+
     /// Reads and validates an e-puck scenario file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();

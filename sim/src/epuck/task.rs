@@ -4,7 +4,9 @@ use std::sync::Arc;
 
 use crate::calibration::TargetingCache;
 use crate::epuck::decoder::ContinuousDecoder;
-use crate::epuck::episode::run_epuck_episode;
+use errp_robot::GoalLayout;
+
+use crate::epuck::episode::{EpuckEpisodeResult, run_epuck_episode};
 use crate::epuck::run::prepare_epuck_decoder;
 use crate::epuck::scenario::EpuckScenario;
 use crate::error::Result;
@@ -14,6 +16,33 @@ use crate::task::{
     Column, ColumnKind, DecoderInfo, EpisodeRow, FieldError, FigureText, PaperPoint, Task,
     TaskInfo, format_number, rate_field,
 };
+
+/// One e-puck run as the task's row of `episodes.csv`: its
+/// [`TaskInfo::columns`] (cities named from `layout`), success and online
+/// accuracy.
+pub fn epuck_row(layout: &GoalLayout, r: &EpuckEpisodeResult) -> EpisodeRow {
+    let names = layout.names();
+    let fields = vec![
+        names[r.goal].to_string(),
+        r.committed.map_or(String::new(), |c| names[c].to_string()),
+        format_number(r.time_secs),
+        format_number(r.path_m),
+        r.errps.to_string(),
+        r.detected_errors.to_string(),
+        r.false_detections.to_string(),
+        r.missed_errors.to_string(),
+        r.detected_by_phase[0].to_string(),
+        r.detected_by_phase[1].to_string(),
+        r.detected_by_phase[2].to_string(),
+        rate_field(r.hit_rate()),
+        rate_field(r.false_alarms_per_min()),
+    ];
+    EpisodeRow {
+        success: r.reached(),
+        fields,
+        online: r.online,
+    }
+}
 
 /// The continuous e-puck (sec. 5): the cost is seconds to convergence.
 #[derive(Debug, Clone, Copy)]
@@ -141,27 +170,7 @@ impl Task for EpuckTask {
             seed,
             &mut (),
         )?;
-        let names = s.layout.names();
-        let fields = vec![
-            names[r.goal].to_string(),
-            r.committed.map_or(String::new(), |c| names[c].to_string()),
-            format_number(r.time_secs),
-            format_number(r.path_m),
-            r.errps.to_string(),
-            r.detected_errors.to_string(),
-            r.false_detections.to_string(),
-            r.missed_errors.to_string(),
-            r.detected_by_phase[0].to_string(),
-            r.detected_by_phase[1].to_string(),
-            r.detected_by_phase[2].to_string(),
-            rate_field(r.hit_rate()),
-            rate_field(r.false_alarms_per_min()),
-        ];
-        Ok(EpisodeRow {
-            success: r.reached(),
-            fields,
-            online: r.online,
-        })
+        Ok(epuck_row(&s.layout, &r))
     }
 
     /// The goal is the scenario's; success is a commitment to it; the

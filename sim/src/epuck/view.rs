@@ -16,7 +16,10 @@ use rerun::{
     Arrows2D, Color, LineStrips2D, Points2D, RecordingStream, Scalars, SeriesLines, TextLog,
 };
 
-use crate::epuck::episode::{EpuckObserver, PhysicsFrame, WindowFrame};
+use crate::epuck::decoder::ContinuousDecoder;
+use crate::epuck::episode::{EpuckEpisodeResult, EpuckObserver, PhysicsFrame, WindowFrame};
+use crate::epuck::run::run_epuck_once;
+use crate::epuck::scenario::EpuckScenario;
 use crate::epuck::world::{ArenaSpec, Obstacle};
 use crate::error::{Result, SimError};
 use crate::record::{
@@ -319,4 +322,32 @@ impl EpuckObserver for EpuckRecorder<'_> {
         );
         self.keep(r);
     }
+}
+
+/// The runs of `scenario` one after another, each recorded into `file` as
+/// `errp run --save` records them.
+pub fn record_epuck_runs(
+    file: &RrdFile,
+    scenario: &EpuckScenario,
+    decoder: &ContinuousDecoder,
+) -> Result<Vec<EpuckEpisodeResult>> {
+    let layout = &scenario.layout;
+    let goal = &layout.goals()[scenario.episode.goal].name;
+    let decoder_text = scenario.decoder_text();
+    let mut recorder = EpuckRecorder::new(
+        file,
+        &scenario.arena,
+        layout,
+        decoder.t_e(scenario.params.control.t_e),
+    )?;
+    let mut out = Vec::with_capacity(scenario.runs);
+    for k in 0..scenario.runs {
+        recorder.next_run(&format!(
+            "run {}: the user wants {goal} ({decoder_text})",
+            k + 1
+        ));
+        out.push(run_epuck_once(scenario, decoder, k, &mut recorder)?);
+    }
+    recorder.finish()?;
+    Ok(out)
 }

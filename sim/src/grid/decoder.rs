@@ -3,8 +3,8 @@
 //! p(error).
 
 use errp_bci::{
-    Assessment, AssessmentKind, Components, EegGenerator, EpochWindow, ErrorModel, GeneratorParams,
-    LdaModel, Montage, PlattScaling, Preprocessor, rng::derive_seed, rng::stream,
+    Assessment, AssessmentKind, Components, EegBlock, EegGenerator, EpochWindow, ErrorModel,
+    GeneratorParams, LdaModel, Montage, PlattScaling, Preprocessor, rng::derive_seed, rng::stream,
 };
 use rand::Rng;
 use serde::{Deserialize, Serialize};
@@ -166,6 +166,26 @@ fn stream_pools(
     seed: u64,
     components: Components,
 ) -> Result<Pools> {
+    stream_classes(
+        source,
+        params,
+        per_class,
+        seed,
+        components,
+        |eeg, error, interval| eeg.epoch(error, interval, true),
+    )
+}
+
+/// Streams `per_class` epochs of each class in a seeded random order and
+/// keeps what `keep` makes of each.
+fn stream_classes<T>(
+    source: EegSource<'_>,
+    params: &GridTaskParams,
+    per_class: usize,
+    seed: u64,
+    components: Components,
+    mut keep: impl FnMut(&mut OnlineEeg, bool, f64) -> T,
+) -> Result<(Vec<T>, Vec<T>)> {
     if per_class == 0 {
         return Err(SimError::Scenario(
             "an epoch bank needs at least one epoch per class".into(),
@@ -184,7 +204,7 @@ fn stream_pools(
             rng.random_bool(0.5)
         };
         let interval = rng.random_range(params.interval_min_secs..=params.interval_max_secs);
-        let epoch = stream_eeg.epoch(want_error, interval, true);
+        let epoch = keep(&mut stream_eeg, want_error, interval);
         if want_error {
             error.push(epoch);
         } else {
@@ -308,6 +328,41 @@ impl OnlineEeg {
         interval_secs: f64,
         keep_fcz: bool,
     ) -> (Vec<f64>, Vec<f64>) {
+        let clean = self.interval(error, interval_secs);
+        let features = self.window.extract(&clean, 0);
+        let fcz = if keep_fcz {
+            clean.channel(self.fcz_row)[..self.window.span()].to_vec()
+        } else {
+            Vec::new()
+        };
+        (features, fcz)
+    }
+
+    /// Like [`epoch`](Self::epoch), but returns the preprocessed epoch itself,
+    /// `(n_channels, span)` from the onset, and its FCz trace, for a decoder
+    /// of the user's own.
+    pub(crate) fn epoch_block(&mut self, error: bool, interval_secs: f64) -> (EegBlock, Vec<f64>) {
+        let clean = self.interval(error, interval_secs);
+        let span = self.window.span();
+        let mut epoch = EegBlock::zeros(clean.n_channels, span);
+        for ch in 0..clean.n_channels {
+            epoch
+                .channel_mut(ch)
+                .copy_from_slice(&clean.channel(ch)[..span]);
+        }
+        let fcz = epoch.channel(self.fcz_row).to_vec();
+        (epoch, fcz)
+    }
+
+    /// The built-in decoder's features of an epoch from
+    /// [`epoch_block`](Self::epoch_block).
+    pub(crate) fn features(&self, epoch: &EegBlock) -> Vec<f64> {
+        self.window.extract(epoch, 0)
+    }
+
+    /// Schedules an assessment now and streams the preprocessed EEG up to
+    /// the next action.
+    fn interval(&mut self, error: bool, interval_secs: f64) -> EegBlock {
         let fs = self.generator.params().sfreq_hz;
         let onset = self.generator.now_secs();
         self.generator.schedule(Assessment {
@@ -320,14 +375,41 @@ impl OnlineEeg {
         });
         let n = ((interval_secs * fs).round() as usize).max(self.window.span());
         let raw = self.generator.generate(n);
-        let clean = self.preprocessor.process(&raw);
-        let features = self.window.extract(&clean, 0);
-        let fcz = if keep_fcz {
-            clean.channel(self.fcz_row)[..self.window.span()].to_vec()
-        } else {
-            Vec::new()
-        };
-        (features, fcz)
+        self.preprocessor.process(&raw)
+    }
+}
+
+/// Preprocessed epochs of each assessment class for a decoder of the user's
+/// own: streamed as [`EpochBank::build`] streams its epochs (the same
+/// schedule and EEG for the same seed), but kept whole, `(n_channels,
+/// n_samples)` from the onset, instead of as the built-in decoder's
+/// features. [`GridDecoding::Scores`](crate::grid::GridDecoding::Scores)
+/// runs episodes on what a decoder makes of them.
+#[derive(Debug, Clone)]
+pub struct EpochBlocks {
+    /// Error epochs.
+    pub error: Vec<EegBlock>,
+    /// Correct epochs.
+    pub correct: Vec<EegBlock>,
+}
+
+impl EpochBlocks {
+    /// Streams `per_class` epochs of each class from `source`.
+    pub fn build(
+        source: EegSource<'_>,
+        params: &GridTaskParams,
+        per_class: usize,
+        seed: u64,
+    ) -> Result<Self> {
+        let (error, correct) = stream_classes(
+            source,
+            params,
+            per_class,
+            seed,
+            Components::default(),
+            |eeg, error, interval| eeg.epoch_block(error, interval).0,
+        )?;
+        Ok(Self { error, correct })
     }
 }
 

@@ -2,12 +2,13 @@
 //! judges each action, the EEG generator turns the judgement into an epoch,
 //! the decoder gives p(error), the controller updates its belief and acts.
 
-use errp_bci::{Accuracy, Components, rng::derive_seed, rng::stream};
+use errp_bci::{Accuracy, Components, EegBlock, rng::derive_seed, rng::stream};
 use errp_robot::{Cell, Grid, GridAction, GridController, QTable};
 use rand::Rng;
+use rand_chacha::ChaCha8Rng;
 
 use crate::error::{Result, SimError};
-use crate::grid::decoder::{AssessmentDecoder, OnlineEeg, decide};
+use crate::grid::decoder::{AssessmentDecoder, EegSource, OnlineEeg, decide};
 use crate::grid::params::GridTaskParams;
 
 /// One action of an episode, as recorded.
@@ -75,6 +76,82 @@ pub fn run_grid_episode(
     seed: u64,
     record_steps: bool,
 ) -> Result<GridEpisodeResult> {
+    run_grid_episode_with(
+        start,
+        goal,
+        table,
+        params,
+        GridDecoding::Builtin(decoder),
+        seed,
+        record_steps,
+    )
+}
+
+/// A decoder of the user's own: what it is given of each action's EEG and
+/// gives back as p(error).
+pub type EpochDecoder<'a> = &'a mut (dyn FnMut(&EegBlock) -> Result<f64> + Send);
+
+/// What decodes each action of an episode.
+pub enum GridDecoding<'a> {
+    /// One of the testbed's decoders.
+    Builtin(&'a AssessmentDecoder),
+    /// A decoder of the user's own, given each action's preprocessed epoch,
+    /// `(n_channels, n_samples)` from the onset, streamed from `source` as
+    /// [`AssessmentDecoder::Eeg`] streams it; its p(error) must be in [0,
+    /// 1], and p >= 0.5 is its class "error".
+    Epochs {
+        /// The user's EEG model and the calibrated preprocessing.
+        source: EegSource<'a>,
+        /// The decoder.
+        decode: EpochDecoder<'a>,
+    },
+    /// p(error) that a decoder of the user's own gave to a bank of epochs
+    /// of each class ([`EpochBlocks`](crate::grid::EpochBlocks)), drawn at
+    /// random for each action as [`AssessmentDecoder::EegBank`] draws its
+    /// epochs; p >= 0.5 is the class "error".
+    Scores {
+        /// p(error) of the error epochs.
+        error: &'a [f64],
+        /// p(error) of the correct epochs.
+        correct: &'a [f64],
+    },
+}
+
+impl GridDecoding<'_> {
+    /// The same decoding, borrowed again (for the next episode).
+    pub fn reborrow(&mut self) -> GridDecoding<'_> {
+        match self {
+            GridDecoding::Builtin(d) => GridDecoding::Builtin(d),
+            GridDecoding::Epochs { source, decode } => GridDecoding::Epochs {
+                source: *source,
+                decode: &mut **decode,
+            },
+            GridDecoding::Scores { error, correct } => GridDecoding::Scores { error, correct },
+        }
+    }
+}
+
+/// Checks a p(error) that a decoder of the user's own returned.
+pub fn check_p_error(p: f64) -> Result<f64> {
+    if p.is_finite() && (0.0..=1.0).contains(&p) {
+        Ok(p)
+    } else {
+        Err(SimError::Scenario(format!(
+            "decoder: returned p(error) = {p}, expected a number from 0 to 1"
+        )))
+    }
+}
+
+/// [`run_grid_episode`] with any [`GridDecoding`].
+pub fn run_grid_episode_with(
+    start: Cell,
+    goal: Cell,
+    table: &QTable,
+    params: &GridTaskParams,
+    decoding: GridDecoding<'_>,
+    seed: u64,
+    record_steps: bool,
+) -> Result<GridEpisodeResult> {
     let grid: Grid = *table.grid();
     for (name, cell) in [("start", start), ("goal", goal)] {
         if !grid.contains(cell) {
@@ -87,16 +164,8 @@ pub fn run_grid_episode(
     let mut controller = GridController::with_table(table.clone(), params.control);
     let mut rng_user = stream(seed, "grid/user");
     let mut rng_policy = stream(seed, "grid/policy");
-    let mut rng_oracle = stream(seed, "grid/oracle");
-    let mut rng_bank = stream(seed, "grid/bank/draw");
-    let mut online = match decoder {
-        AssessmentDecoder::Eeg(d) => Some(OnlineEeg::start(
-            d.source(),
-            derive_seed(seed, "grid/eeg", 0),
-            Components::default(),
-        )?),
-        _ => None,
-    };
+    let mut decoding = decoding;
+    let mut decoder = ActionDecoder::start(&decoding, seed)?;
 
     let mut cell = start;
     let mut visits = vec![0u32; grid.n_cells()];
@@ -110,38 +179,12 @@ pub fn run_grid_episode(
         let action = controller.choose(cell, &mut rng_policy);
         let error = !grid.is_correct(cell, action, goal);
         let interval = rng_user.random_range(params.interval_min_secs..=params.interval_max_secs);
-        let (p_error, says_error, fcz) = match (decoder, online.as_mut()) {
-            (AssessmentDecoder::Oracle { accuracy }, _) => {
-                let right = rng_oracle.random::<f64>() < *accuracy;
-                let says_error = if right { error } else { !error };
-                let p = if says_error {
-                    *accuracy
-                } else {
-                    1.0 - accuracy
-                };
-                (p, says_error, Vec::new())
-            }
-            (AssessmentDecoder::Eeg(d), Some(eeg)) => {
-                let (x, fcz) = eeg.epoch(error, interval, record_steps);
-                let (p, says) = decide(d, &x);
-                (p, says, fcz)
-            }
-            (AssessmentDecoder::Eeg(_), None) => unreachable!("EEG decoder without a stream"),
-            (AssessmentDecoder::EegBank(bank), _) => {
-                let pool = if error { &bank.error } else { &bank.correct };
-                let (x, fcz) = &pool[rng_bank.random_range(0..pool.len())];
-                let (p, says) = decide(&bank.decoder, x);
-                (
-                    p,
-                    says,
-                    if record_steps {
-                        fcz.clone()
-                    } else {
-                        Vec::new()
-                    },
-                )
-            }
-        };
+        let Decoded {
+            p_error,
+            says_error,
+            fcz,
+            ..
+        } = decoder.decode(&mut decoding, error, interval, record_steps, false)?;
         controller.observe(cell, action, p_error)?;
         let to = grid.step(cell, action);
         labels.push(error);
@@ -179,4 +222,139 @@ pub fn run_grid_episode(
         visits,
         steps,
     })
+}
+
+/// What a decoded action gives: p(error), the decoder's class, the FCz
+/// trace (when asked) and the preprocessed epoch (when asked, and the EEG
+/// is streamed).
+pub(crate) struct Decoded {
+    pub(crate) p_error: f64,
+    pub(crate) says_error: bool,
+    pub(crate) fcz: Vec<f64>,
+    pub(crate) epoch: Option<EegBlock>,
+}
+
+/// A [`GridDecoding`] with its EEG stream and random draws, decoding one
+/// action after another.
+pub(crate) struct ActionDecoder {
+    online: Option<OnlineEeg>,
+    rng_oracle: ChaCha8Rng,
+    rng_bank: ChaCha8Rng,
+}
+
+impl ActionDecoder {
+    /// Checks `decoding` and starts its EEG stream (if it streams), with
+    /// every random draw from `seed`.
+    pub(crate) fn start(decoding: &GridDecoding<'_>, seed: u64) -> Result<Self> {
+        if let GridDecoding::Scores { error, correct } = decoding {
+            if error.is_empty() || correct.is_empty() {
+                return Err(SimError::Scenario(
+                    "decoder: the bank needs at least one scored epoch of each class".into(),
+                ));
+            }
+            for &p in error.iter().chain(correct.iter()) {
+                check_p_error(p)?;
+            }
+        }
+        let source = match decoding {
+            GridDecoding::Builtin(AssessmentDecoder::Eeg(d)) => Some(d.source()),
+            GridDecoding::Epochs { source, .. } => Some(*source),
+            _ => None,
+        };
+        let online = match source {
+            Some(source) => Some(OnlineEeg::start(
+                source,
+                derive_seed(seed, "grid/eeg", 0),
+                Components::default(),
+            )?),
+            None => None,
+        };
+        Ok(Self {
+            online,
+            rng_oracle: stream(seed, "grid/oracle"),
+            rng_bank: stream(seed, "grid/bank/draw"),
+        })
+    }
+
+    /// Decodes with `decoding` (the one it started with) an action the
+    /// user judged erroneous (`error`) or correct, streaming `interval` s of
+    /// EEG when the EEG is streamed.
+    pub(crate) fn decode(
+        &mut self,
+        decoding: &mut GridDecoding<'_>,
+        error: bool,
+        interval: f64,
+        record_steps: bool,
+        keep_epoch: bool,
+    ) -> Result<Decoded> {
+        let mut epoch = None;
+        let (p_error, says_error, fcz) = match (decoding, self.online.as_mut()) {
+            (GridDecoding::Builtin(AssessmentDecoder::Oracle { accuracy }), _) => {
+                let right = self.rng_oracle.random::<f64>() < *accuracy;
+                let says_error = if right { error } else { !error };
+                let p = if says_error {
+                    *accuracy
+                } else {
+                    1.0 - accuracy
+                };
+                (p, says_error, Vec::new())
+            }
+            (GridDecoding::Builtin(AssessmentDecoder::Eeg(d)), Some(eeg)) if keep_epoch => {
+                let (block, fcz) = eeg.epoch_block(error, interval);
+                let (p, says) = decide(d, &eeg.features(&block));
+                epoch = Some(block);
+                (p, says, if record_steps { fcz } else { Vec::new() })
+            }
+            (GridDecoding::Builtin(AssessmentDecoder::Eeg(d)), Some(eeg)) => {
+                let (x, fcz) = eeg.epoch(error, interval, record_steps);
+                let (p, says) = decide(d, &x);
+                (p, says, fcz)
+            }
+            (GridDecoding::Epochs { decode, .. }, Some(eeg)) => {
+                let (block, fcz) = eeg.epoch_block(error, interval);
+                let p = check_p_error(decode(&block)?)?;
+                if keep_epoch {
+                    epoch = Some(block);
+                }
+                (p, p >= 0.5, if record_steps { fcz } else { Vec::new() })
+            }
+            (
+                GridDecoding::Builtin(AssessmentDecoder::Eeg(_)) | GridDecoding::Epochs { .. },
+                None,
+            ) => {
+                unreachable!("EEG decoder without a stream")
+            }
+            (
+                GridDecoding::Scores {
+                    error: e,
+                    correct: c,
+                },
+                _,
+            ) => {
+                let pool = if error { e } else { c };
+                let p = pool[self.rng_bank.random_range(0..pool.len())];
+                (p, p >= 0.5, Vec::new())
+            }
+            (GridDecoding::Builtin(AssessmentDecoder::EegBank(bank)), _) => {
+                let pool = if error { &bank.error } else { &bank.correct };
+                let (x, fcz) = &pool[self.rng_bank.random_range(0..pool.len())];
+                let (p, says) = decide(&bank.decoder, x);
+                (
+                    p,
+                    says,
+                    if record_steps {
+                        fcz.clone()
+                    } else {
+                        Vec::new()
+                    },
+                )
+            }
+        };
+        Ok(Decoded {
+            p_error,
+            says_error,
+            fcz,
+            epoch,
+        })
+    }
 }

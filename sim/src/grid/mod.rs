@@ -2,6 +2,7 @@
 //! episode, a scenario's runs, Table 1 and the recording.
 
 pub(crate) mod decoder;
+pub(crate) mod environment;
 pub(crate) mod episode;
 pub(crate) mod params;
 pub(crate) mod report;
@@ -13,21 +14,25 @@ pub(crate) mod task;
 pub(crate) mod view;
 
 pub use decoder::{
-    AssessmentDecoder, EegDecoder, EegSource, EpochBank, EpochBankParts, PErrorChoice,
+    AssessmentDecoder, EegDecoder, EegSource, EpochBank, EpochBankParts, EpochBlocks, PErrorChoice,
     PErrorMapping,
 };
-pub use episode::{GridEpisodeResult, GridStep, run_grid_episode};
+pub use environment::{GridEnvironment, GridFeedback};
+pub use episode::{
+    EpochDecoder, GridDecoding, GridEpisodeResult, GridStep, check_p_error, run_grid_episode,
+    run_grid_episode_with,
+};
 pub use params::GridTaskParams;
 pub use report::{GridEpisodeHeader, GridEpisodeRow, Table1Report};
 pub use run::{
     GridRunReport, GridShared, PreparedGrid, eeg_decoder, pooled_accuracy, prepare_decoder,
-    prepare_grid_decoder, run_grid_scenario,
+    prepare_grid_decoder, run_grid_scenario, run_grid_scenario_with,
 };
 pub use scenario::{
     DecoderChoice, EegMode, GridScenario, MAX_ACTIONS, MAX_BANK_PER_CLASS, MAX_EPISODES,
     MAX_INTERVAL_SECS, MAX_PAIRS, free_pairs,
 };
 pub use table1::{FIXED_PAIRS, Table1Cell, Table1Options, accuracy_time_correlation, run_table1};
-pub use task::{GridRunner, GridTask};
+pub use task::{GridRunner, GridTask, grid_row};
 #[cfg(feature = "rerun")]
 pub use view::{grid_recording, record_grid_run};

@@ -17,7 +17,7 @@ use crate::error::Result;
 use crate::grid::decoder::{
     AssessmentDecoder, EegDecoder, EegSource, EpochBankParts, PErrorChoice,
 };
-use crate::grid::episode::{GridEpisodeResult, run_grid_episode};
+use crate::grid::episode::{GridDecoding, GridEpisodeResult, run_grid_episode_with};
 use crate::grid::scenario::{DecoderChoice, EegMode, GridScenario};
 
 /// Everything a grid run produced.
@@ -228,18 +228,34 @@ pub fn run_grid_scenario(
     scenario: &GridScenario,
     decoder: &AssessmentDecoder,
     record_steps: bool,
+    on_episode: impl FnMut(usize, &GridEpisodeResult),
+) -> Result<Vec<GridEpisodeResult>> {
+    run_grid_scenario_with(
+        scenario,
+        GridDecoding::Builtin(decoder),
+        record_steps,
+        on_episode,
+    )
+}
+
+/// [`run_grid_scenario`] with any [`GridDecoding`], e.g. a decoder of the
+/// user's own: the same episodes from the same seeds.
+pub fn run_grid_scenario_with(
+    scenario: &GridScenario,
+    mut decoding: GridDecoding<'_>,
+    record_steps: bool,
     mut on_episode: impl FnMut(usize, &GridEpisodeResult),
 ) -> Result<Vec<GridEpisodeResult>> {
     let table = QTable::compute(Grid::paper(), &scenario.params.control.q())?;
     let mut out = Vec::with_capacity(scenario.episodes.len());
     for (k, &(start, goal)) in scenario.episodes.iter().enumerate() {
         let seed = derive_seed(scenario.seed, "grid/episode", k as u64);
-        let r = run_grid_episode(
+        let r = run_grid_episode_with(
             start,
             goal,
             &table,
             &scenario.params,
-            decoder,
+            decoding.reborrow(),
             seed,
             record_steps,
         )?;

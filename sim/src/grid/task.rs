@@ -8,7 +8,7 @@ use errp_robot::{Cell, Grid, QTable};
 use crate::calibration::TargetingCache;
 use crate::error::Result;
 use crate::grid::decoder::AssessmentDecoder;
-use crate::grid::episode::run_grid_episode;
+use crate::grid::episode::{GridEpisodeResult, run_grid_episode};
 use crate::grid::run::{GridShared, prepare_grid_decoder};
 use crate::grid::scenario::{DecoderChoice, EegMode, GridScenario};
 
@@ -21,6 +21,34 @@ use crate::task::{
     Column, ColumnKind, DecoderInfo, EpisodeRow, FieldError, FigureText, PaperPoint, Task,
     TaskInfo, format_number, overall,
 };
+
+/// One grid episode as the task's row of `episodes.csv`: its
+/// [`TaskInfo::columns`], success and online accuracy.
+pub fn grid_row(r: &GridEpisodeResult) -> EpisodeRow {
+    let cell = |c: Option<Cell>| match c {
+        Some(c) => [c.x.to_string(), c.y.to_string()],
+        None => [String::new(), String::new()],
+    };
+    let (detected, hits_correct, _) = overall(&r.online);
+    let mut fields = Vec::with_capacity(GridTask::INFO.columns.len());
+    fields.extend(cell(Some(r.start)));
+    fields.extend(cell(Some(r.goal)));
+    fields.extend(cell(r.committed));
+    fields.extend([
+        r.actions.to_string(),
+        format_number(r.net_secs),
+        format_number(r.total_secs),
+        r.online.n_error.to_string(),
+        detected.to_string(),
+        (r.online.n_correct - hits_correct).to_string(),
+        (r.online.n_error - detected).to_string(),
+    ]);
+    EpisodeRow {
+        success: r.reached(),
+        fields,
+        online: r.online,
+    }
+}
 
 /// The discrete 5x5 grid (sec. 4): the cost is actions to convergence.
 #[derive(Debug, Clone, Copy)]
@@ -155,29 +183,7 @@ impl Task for GridTask {
             seed,
             false,
         )?;
-        let cell = |c: Option<Cell>| match c {
-            Some(c) => [c.x.to_string(), c.y.to_string()],
-            None => [String::new(), String::new()],
-        };
-        let (detected, hits_correct, _) = overall(&r.online);
-        let mut fields = Vec::with_capacity(Self::INFO.columns.len());
-        fields.extend(cell(Some(start)));
-        fields.extend(cell(Some(goal)));
-        fields.extend(cell(r.committed));
-        fields.extend([
-            r.actions.to_string(),
-            format_number(r.net_secs),
-            format_number(r.total_secs),
-            r.online.n_error.to_string(),
-            detected.to_string(),
-            (r.online.n_correct - hits_correct).to_string(),
-            (r.online.n_error - detected).to_string(),
-        ]);
-        Ok(EpisodeRow {
-            success: r.reached(),
-            fields,
-            online: r.online,
-        })
+        Ok(grid_row(&r))
     }
 
     /// The start and goal are the scenario's pair `k`; success is a

@@ -1,0 +1,244 @@
+//! Conversions between Python and the crates' types: errors, scenario
+//! overrides, EEG blocks as numpy arrays, and a decoder of the caller's own
+//! called from inside the Rust loop.
+
+use std::path::{Path, PathBuf};
+
+use errp_bci::{EegBlock, Montage};
+use errp_sim::{AnyScenario, SimError};
+use numpy::ndarray::{Array2, Array3};
+use numpy::{IntoPyArray, PyArray2};
+use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyString};
+
+/// A crate error as a Python exception: files that cannot be read or
+/// written are `OSError`, everything else is a `ValueError` whose message
+/// names the field and what it accepts.
+pub(crate) fn py_err(e: SimError) -> PyErr {
+    let text = chain(&e);
+    match e {
+        SimError::Input { .. } | SimError::Output { .. } | SimError::Record { .. } => {
+            PyOSError::new_err(text)
+        }
+        _ => PyValueError::new_err(text),
+    }
+}
+
+/// An error and its causes, each once.
+fn chain(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut text = e.to_string();
+    let mut source = e.source();
+    while let Some(s) = source {
+        let part = s.to_string();
+        if !text.contains(&part) {
+            text.push_str(": ");
+            text.push_str(&part);
+        }
+        source = s.source();
+    }
+    text
+}
+
+/// A `ValueError` naming `field`.
+pub(crate) fn value_error(field: &str, value: impl std::fmt::Display, expected: &str) -> PyErr {
+    PyValueError::new_err(format!("{field} = {value} is invalid: expected {expected}"))
+}
+
+/// The scenario keyword: a path to a TOML file, or `None` for the built-in
+/// scenario of the task (`grid_fixed_goals.toml`, `mexico_to_pisa.toml`).
+pub(crate) enum ScenarioSource {
+    /// A file.
+    File(PathBuf),
+    /// Built-in text, named by the path it has in the repository.
+    BuiltIn(&'static str, &'static str),
+}
+
+impl ScenarioSource {
+    /// `scenario` as given, or the built-in of `default_epuck`'s task.
+    pub(crate) fn new(scenario: Option<PathBuf>, default_epuck: bool) -> Self {
+        match scenario {
+            Some(p) => ScenarioSource::File(p),
+            None if default_epuck => {
+                ScenarioSource::BuiltIn(errp_sweep::BUILT_IN_EPUCK, "scenarios/mexico_to_pisa.toml")
+            }
+            None => ScenarioSource::BuiltIn(
+                errp_sweep::BUILT_IN_GRID,
+                "scenarios/grid_fixed_goals.toml",
+            ),
+        }
+    }
+
+    /// Loads and validates it with `overrides` set first.
+    pub(crate) fn load(&self, overrides: &[(String, toml::Value)]) -> PyResult<AnyScenario> {
+        let pairs: Vec<(&str, toml::Value)> = overrides
+            .iter()
+            .map(|(k, v)| (k.as_str(), v.clone()))
+            .collect();
+        if let ScenarioSource::File(p) = self
+            && !p.exists()
+        {
+            return Err(PyFileNotFoundError::new_err(format!(
+                "scenario: {} does not exist",
+                p.display()
+            )));
+        }
+        match self {
+            ScenarioSource::File(p) => errp_sim::load_scenario_with(p, &pairs),
+            ScenarioSource::BuiltIn(text, name) => {
+                errp_sim::parse_scenario_with(text, Path::new(name), &pairs)
+            }
+        }
+        .map_err(py_err)
+    }
+}
+
+/// `overrides={"control.tau": 0.5, ...}` as scenario keys and TOML values,
+/// in the dictionary's order; `extra` (from the keyword arguments) first.
+pub(crate) fn overrides(
+    extra: Vec<(String, toml::Value)>,
+    given: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Vec<(String, toml::Value)>> {
+    let mut out = extra;
+    if let Some(d) = given {
+        for (k, v) in d.iter() {
+            let key: String = k.extract().map_err(|_| {
+                PyValueError::new_err(format!(
+                    "overrides: key {k} is not a string; keys are the scenario's dotted \
+                     fields, e.g. \"control.tau\""
+                ))
+            })?;
+            if out.iter().any(|(have, _)| *have == key) {
+                return Err(PyValueError::new_err(format!(
+                    "overrides: `{key}` is set twice (once by a keyword argument)"
+                )));
+            }
+            let value = toml_value(&key, &v)?;
+            out.push((key, value));
+        }
+    }
+    Ok(out)
+}
+
+/// A Python scalar or list as a TOML value.
+pub(crate) fn toml_value(key: &str, v: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
+    if v.is_instance_of::<PyBool>() {
+        return Ok(toml::Value::Boolean(v.extract()?));
+    }
+    if v.is_instance_of::<PyInt>() {
+        let i: i64 = v.extract().map_err(|_| {
+            value_error(
+                &format!("overrides[\"{key}\"]"),
+                v,
+                "an integer that fits 64 bits",
+            )
+        })?;
+        return Ok(toml::Value::Integer(i));
+    }
+    if v.is_instance_of::<PyFloat>() {
+        return Ok(toml::Value::Float(v.extract()?));
+    }
+    if v.is_instance_of::<PyString>() {
+        return Ok(toml::Value::String(v.extract()?));
+    }
+    if let Ok(items) = v.extract::<Vec<Bound<'_, PyAny>>>() {
+        return Ok(toml::Value::Array(
+            items
+                .iter()
+                .map(|x| toml_value(key, x))
+                .collect::<PyResult<_>>()?,
+        ));
+    }
+    Err(value_error(
+        &format!("overrides[\"{key}\"]"),
+        v.repr()?,
+        "a bool, int, float, str or a list of them",
+    ))
+}
+
+/// An EEG block `(n_channels, n_samples)` as a numpy array.
+pub(crate) fn block_to_numpy<'py>(py: Python<'py>, b: &EegBlock) -> Bound<'py, PyArray2<f64>> {
+    Array2::from_shape_vec((b.n_channels, b.n_samples), b.data.clone())
+        .expect("a block's data is n_channels x n_samples")
+        .into_pyarray(py)
+}
+
+/// Blocks of one shape as a `(n_blocks, n_channels, n_samples)` float32
+/// array (half the memory of float64; EEG in uV needs no more).
+pub(crate) fn blocks_to_array3(blocks: &[&EegBlock]) -> Array3<f32> {
+    let (c, s) = blocks
+        .first()
+        .map_or((0, 0), |b| (b.n_channels, b.n_samples));
+    let mut data = Vec::with_capacity(blocks.len() * c * s);
+    for b in blocks {
+        data.extend(b.data.iter().map(|&x| x as f32));
+    }
+    Array3::from_shape_vec((blocks.len(), c, s), data).expect("blocks of one shape")
+}
+
+/// The names of the channels a preprocessor outputs (indices into the
+/// montage).
+pub(crate) fn channel_names(montage: &Montage, outputs: &[usize]) -> Vec<String> {
+    outputs
+        .iter()
+        .map(|&i| montage.channels()[i].name.clone())
+        .collect()
+}
+
+/// Calls a decoder of the caller's own from the Rust loop (the GIL released
+/// around it), remembering the first Python exception so that it reaches
+/// the caller unchanged.
+pub(crate) struct PyDecoder {
+    f: Py<PyAny>,
+    raised: Option<PyErr>,
+    pub(crate) calls: usize,
+}
+
+impl PyDecoder {
+    /// Wraps the callable `f`.
+    pub(crate) fn new(f: Py<PyAny>) -> Self {
+        Self {
+            f,
+            raised: None,
+            calls: 0,
+        }
+    }
+
+    /// p(error) of one window or epoch: `f(x)` for `x` an `(n_channels,
+    /// n_samples)` float64 array.
+    pub(crate) fn call(&mut self, block: &EegBlock) -> errp_sim::Result<f64> {
+        self.calls += 1;
+        let result = Python::attach(|py| -> PyResult<f64> {
+            let x = block_to_numpy(py, block);
+            let out = self.f.bind(py).call1((x,))?;
+            out.extract::<f64>().map_err(|_| {
+                let shown = out.repr().map(|r| r.to_string()).unwrap_or_default();
+                PyValueError::new_err(format!(
+                    "decoder: returned {shown}, expected p(error), a float from 0 to 1"
+                ))
+            })
+        });
+        result.map_err(|e| {
+            let text = Python::attach(|py| e.value(py).to_string());
+            self.raised.get_or_insert(e);
+            SimError::Scenario(format!("decoder raised: {text}"))
+        })
+    }
+
+    /// The Python exception behind `e`, if the decoder raised one; else `e`
+    /// as a Python exception.
+    pub(crate) fn error(&mut self, e: SimError) -> PyErr {
+        self.raised.take().unwrap_or_else(|| py_err(e))
+    }
+}
+
+/// Checks that the argument `name`, if given, can be called.
+pub(crate) fn check_callable(py: Python<'_>, name: &str, f: Option<&Py<PyAny>>) -> PyResult<()> {
+    match f {
+        Some(f) if !f.bind(py).is_callable() => Err(PyValueError::new_err(format!(
+            "{name}: expected a callable returning p(error), got {}",
+            f.bind(py).get_type().name()?
+        ))),
+        _ => Ok(()),
+    }
+}

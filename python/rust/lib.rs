@@ -1,0 +1,35 @@
+//! Python bindings of the ErrP testbed (`errp._core`): a thin layer over
+//! the Rust crates, which stay the one implementation.
+//!
+//! Every function here converts arguments, releases the GIL for the Rust
+//! work, and converts results to numpy arrays, dictionaries or CSV text that
+//! the pure-Python package (`python/src/errp`) turns into pandas frames and
+//! MNE objects. Errors in what the caller gave are `ValueError`s that name
+//! the field and the accepted range (the messages of the scenario loaders);
+//! files that cannot be read or written are `OSError`s; an exception raised
+//! by a decoder of the caller's own propagates unchanged.
+
+mod convert;
+mod env;
+mod run;
+mod session;
+mod tasks;
+
+use pyo3::prelude::*;
+
+/// The compiled core of the `errp` package.
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(session::simulate_session, m)?)?;
+    m.add_function(wrap_pyfunction!(run::run, m)?)?;
+    m.add_function(wrap_pyfunction!(run::sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(run::episode_columns, m)?)?;
+    m.add_class::<session::EegGenerator>()?;
+    m.add_class::<tasks::GridTask>()?;
+    m.add_class::<tasks::EpuckTask>()?;
+    m.add_class::<env::GridEnvCore>()?;
+    m.add_class::<env::EpuckEnvCore>()?;
+    m.add("HAS_RERUN", cfg!(feature = "rerun"))?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

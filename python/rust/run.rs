@@ -1,0 +1,349 @@
+//! `errp.run` and `errp.sweep`: a scenario's runs as `errp run` makes
+//! them, and Monte Carlo sweeps as `errp sweep` writes them.
+
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+
+use errp_bci::rng::derive_seed;
+use errp_sim::AnyScenario;
+use errp_sim::epuck::{EpuckScenario, EpuckTask, epuck_row, epuck_run_seed};
+use errp_sim::grid::{GridScenario, GridTask, grid_row, prepare_decoder, run_grid_scenario};
+use errp_sim::task::{EpisodeRow, Task, TaskInfo, format_number};
+use errp_sweep::{
+    InputNames, Shard, SweepOptions, SweepOutcome, SweepSpec, SweepTask, TargetCache,
+    parse_accuracies, parse_axis, sweep_fixed, sweep_scenario,
+};
+use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::convert::{ScenarioSource, overrides, py_err, value_error};
+
+/// Keyword names in errors.
+const NAMES: InputNames = InputNames {
+    scenario: "scenario=",
+    task: "task=",
+    eeg: "eeg=",
+};
+
+/// The header of the frames `run` and the tasks' `run` return: the columns
+/// of `episodes.csv` without the sweep's swept values and checksum.
+pub(crate) fn header(info: &TaskInfo) -> String {
+    let mut cols = vec!["level", "accuracy", "episode", "seed"];
+    cols.extend(info.row_columns());
+    cols.join(",")
+}
+
+/// One episode's CSV line under [`header`].
+pub(crate) fn line(accuracy: f64, k: usize, seed: u64, row: EpisodeRow) -> String {
+    let mut f = vec![
+        "0".to_string(),
+        format_number(accuracy),
+        k.to_string(),
+        seed.to_string(),
+    ];
+    f.extend(row.csv_fields());
+    f.join(",")
+}
+
+/// The columns of an episode's row of `task` ("grid" or "epuck"), as
+/// `episodes.csv` names them.
+#[pyfunction]
+pub(crate) fn episode_columns(task: &str) -> PyResult<Vec<&'static str>> {
+    let info = match task {
+        "grid" => &GridTask::INFO,
+        "epuck" => &EpuckTask::INFO,
+        other => {
+            return Err(value_error(
+                "task",
+                format!("{other:?}"),
+                "\"grid\" or \"epuck\"",
+            ));
+        }
+    };
+    Ok(info.row_columns())
+}
+
+/// Checks `save=` before any work.
+pub(crate) fn check_save(save: Option<&PathBuf>) -> PyResult<()> {
+    let Some(p) = save else { return Ok(()) };
+    if p.extension().and_then(|e| e.to_str()) != Some("rrd") {
+        return Err(value_error(
+            "save",
+            format!("{:?}", p.display().to_string()),
+            "a file name ending in .rrd",
+        ));
+    }
+    if !cfg!(feature = "rerun") {
+        return Err(PyValueError::new_err(
+            "save: this errp was built without Rerun; reinstall it with the default features \
+             (pip install ./python) to write recordings",
+        ));
+    }
+    Ok(())
+}
+
+/// Loads the scenario of `run` with its keyword overrides.
+pub(crate) fn load(
+    scenario: Option<PathBuf>,
+    accuracy: Option<f64>,
+    given: Option<&Bound<'_, PyDict>>,
+) -> PyResult<AnyScenario> {
+    let source = ScenarioSource::new(scenario, true);
+    let mut extra = Vec::new();
+    if let Some(a) = accuracy {
+        extra.push(("user.accuracy".to_string(), toml::Value::Float(a)));
+    }
+    source.load(&overrides(extra, given)?)
+}
+
+/// Runs a scenario as `errp run` does (the same decoder, seeds and
+/// results) and returns its episodes as CSV text, one row per episode, and
+/// what was calibrated.
+#[pyfunction]
+#[pyo3(signature = (scenario=None, *, seed=None, runs=None, accuracy=None, overrides=None, save=None))]
+pub(crate) fn run<'py>(
+    py: Python<'py>,
+    scenario: Option<PathBuf>,
+    seed: Option<u64>,
+    runs: Option<usize>,
+    accuracy: Option<f64>,
+    overrides: Option<&Bound<'py, PyDict>>,
+    save: Option<PathBuf>,
+) -> PyResult<Bound<'py, PyDict>> {
+    check_save(save.as_ref())?;
+    let any = load(scenario, accuracy, overrides)?;
+    let out = PyDict::new(py);
+    match any {
+        AnyScenario::Grid(mut s) => {
+            if runs.is_some() {
+                return Err(PyValueError::new_err(
+                    "runs: applies to e-puck scenarios; a grid scenario lists its episodes \
+                     (set `repeats`, or give overrides)",
+                ));
+            }
+            if let Some(seed) = seed {
+                s.seed = seed;
+            }
+            let (csv, info) = py.detach(|| run_grid(&s, save.as_ref())).map_err(py_err)?;
+            out.set_item("task", "grid")?;
+            out.set_item("csv", csv)?;
+            out.set_item("decoder", info)?;
+        }
+        AnyScenario::Epuck(mut s) => {
+            if let Some(seed) = seed {
+                s.seed = seed;
+            }
+            if let Some(r) = runs {
+                if !(1..=errp_sim::epuck::MAX_RUNS as usize).contains(&r) {
+                    return Err(value_error(
+                        "runs",
+                        r,
+                        &format!("a whole number from 1 to {}", errp_sim::epuck::MAX_RUNS),
+                    ));
+                }
+                s.runs = r;
+            }
+            if save.is_some() && s.runs > 100 {
+                return Err(value_error(
+                    "runs",
+                    s.runs,
+                    "at most 100 with save= (each run adds about 2.5 MB to the recording)",
+                ));
+            }
+            let (csv, info) = py.detach(|| run_epuck(&s, save.as_ref())).map_err(py_err)?;
+            out.set_item("task", "epuck")?;
+            out.set_item("csv", csv)?;
+            out.set_item("decoder", info)?;
+        }
+    }
+    Ok(out)
+}
+
+/// What a calibration found, for Python.
+pub(crate) type DecoderSummary = Vec<(&'static str, f64)>;
+
+fn run_grid(
+    s: &GridScenario,
+    save: Option<&PathBuf>,
+) -> errp_sim::Result<(String, DecoderSummary)> {
+    #[cfg(feature = "rerun")]
+    let rrd = match save {
+        Some(p) => Some(errp_sim::grid::grid_recording(p)?),
+        None => None,
+    };
+    #[cfg(not(feature = "rerun"))]
+    let _ = save;
+    let (decoder, calibration) = prepare_decoder(s, |_| {})?;
+    let episodes = run_grid_scenario(s, &decoder, save.is_some(), |_, _| {})?;
+    let mut lines = vec![header(&GridTask::INFO)];
+    for (k, r) in episodes.iter().enumerate() {
+        let seed = derive_seed(s.seed, "grid/episode", k as u64);
+        lines.push(line(s.accuracy, k, seed, grid_row(r)));
+    }
+    let mut info = vec![("accuracy", s.accuracy)];
+    if let Some(c) = &calibration {
+        let a = c.calibrated.accuracy;
+        info.extend([
+            ("errp_to_noise", c.targeting.ratio),
+            ("cv_correct", a.correct),
+            ("cv_error", a.error),
+            ("cv_mean", a.mean()),
+        ]);
+    }
+    #[cfg(feature = "rerun")]
+    if let Some(file) = rrd {
+        let report = errp_sim::grid::GridRunReport {
+            scenario: s.clone(),
+            calibration,
+            episodes,
+        };
+        errp_sim::grid::record_grid_run(file, &report)?;
+    }
+    Ok((lines.join("\n") + "\n", info))
+}
+
+fn run_epuck(
+    s: &EpuckScenario,
+    save: Option<&PathBuf>,
+) -> errp_sim::Result<(String, DecoderSummary)> {
+    #[cfg(feature = "rerun")]
+    let rrd = match save {
+        Some(p) => Some(errp_sim::epuck::epuck_recording(p)?),
+        None => None,
+    };
+    #[cfg(not(feature = "rerun"))]
+    let _ = save;
+    let (decoder, report) = errp_sim::epuck::prepare_continuous_decoder(s, |_| {})?;
+    #[cfg(feature = "rerun")]
+    let results = match &rrd {
+        Some(file) => errp_sim::epuck::record_epuck_runs(file, s, &decoder)?,
+        None => errp_sim::epuck::run_epuck_batch(s, &decoder, s.runs)?,
+    };
+    #[cfg(not(feature = "rerun"))]
+    let results = errp_sim::epuck::run_epuck_batch(s, &decoder, s.runs)?;
+    let mut lines = vec![header(&EpuckTask::INFO)];
+    for (k, r) in results.iter().enumerate() {
+        let seed = epuck_run_seed(s.seed, k);
+        lines.push(line(s.accuracy.get(), k, seed, epuck_row(&s.layout, r)));
+    }
+    let a = report.calibrated.accuracy;
+    let mut info = vec![
+        ("accuracy", s.accuracy.get()),
+        ("errp_to_noise", report.generator.errp_to_noise),
+        ("cv_correct", a.correct),
+        ("cv_error", a.error),
+        ("cv_mean", a.mean()),
+        ("t_e", decoder.t_e(s.params.control.t_e)),
+    ];
+    if let Some(o) = &decoder.online {
+        info.extend([
+            ("online_hit_rate", o.point.hit_rate),
+            ("online_false_alarms_per_min", o.point.false_alarms_per_min),
+        ]);
+    }
+    #[cfg(feature = "rerun")]
+    if let Some(file) = rrd {
+        file.finish()?;
+    }
+    Ok((lines.join("\n") + "\n", info))
+}
+
+/// Runs a Monte Carlo sweep as `errp sweep` does, into `out`, and returns
+/// the paths of its files. A rerun of the same sweep into the same
+/// directory resumes it.
+#[pyfunction]
+#[pyo3(signature = (out, *, accuracy, task=None, scenario=None, episodes=100, seed=1, params=None, stream=None, cache=None, threads=None))]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn sweep<'py>(
+    py: Python<'py>,
+    out: PathBuf,
+    accuracy: &str,
+    task: Option<&str>,
+    scenario: Option<PathBuf>,
+    episodes: usize,
+    seed: u64,
+    params: Option<Vec<String>>,
+    stream: Option<bool>,
+    cache: Option<PathBuf>,
+    threads: Option<usize>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let want = match task {
+        None => None,
+        Some("grid") => Some(SweepTask::Grid),
+        Some("epuck") => Some(SweepTask::Epuck),
+        Some(other) => {
+            return Err(value_error(
+                "task",
+                format!("{other:?}"),
+                "\"grid\" or \"epuck\"",
+            ));
+        }
+    };
+    if !(1..=errp_sweep::MAX_EPISODES).contains(&episodes) {
+        return Err(value_error(
+            "episodes",
+            episodes,
+            &format!("a whole number from 1 to {}", errp_sweep::MAX_EPISODES),
+        ));
+    }
+    let threads = match threads {
+        Some(n) if !(1..=1024).contains(&n) => {
+            return Err(value_error("threads", n, "a whole number from 1 to 1024"));
+        }
+        Some(n) => n,
+        None => rayon::current_num_threads(),
+    };
+    let (task, text, path) = sweep_scenario(scenario.as_deref(), want, NAMES).map_err(py_err)?;
+    let spec = SweepSpec {
+        task,
+        scenario_path: path,
+        scenario_toml: text,
+        accuracies: parse_accuracies(accuracy)
+            .map_err(|e| PyValueError::new_err(format!("accuracy: {}", e)))?,
+        axes: params
+            .unwrap_or_default()
+            .iter()
+            .map(|p| parse_axis(task, p))
+            .collect::<errp_sim::Result<_>>()
+            .map_err(|e| PyValueError::new_err(format!("params: {e}")))?,
+        fixed: sweep_fixed(task, stream, NAMES).map_err(py_err)?,
+        episodes,
+        seed,
+    };
+    spec.levels().map_err(py_err)?;
+    let opts = SweepOptions {
+        out: out.clone(),
+        cache: match cache {
+            Some(dir) => TargetCache::new(dir),
+            None => TargetCache::disabled(),
+        },
+        shard: Shard::ALL,
+        chunk: 0,
+        repair: false,
+    };
+    let cancel = AtomicBool::new(false);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| PyValueError::new_err(format!("threads: cannot start them: {e}")))?;
+    let outcome = py
+        .detach(|| pool.install(|| errp_sweep::run_sweep(&spec, &opts, &cancel, &())))
+        .map_err(py_err)?;
+    match outcome {
+        SweepOutcome::Interrupted { .. } => {
+            Err(PyKeyboardInterrupt::new_err("the sweep was interrupted"))
+        }
+        SweepOutcome::Complete { ran, total, .. } => {
+            let d = PyDict::new(py);
+            d.set_item("out", out.clone())?;
+            d.set_item("episodes_csv", out.join(errp_sweep::EPISODES))?;
+            d.set_item("summary_csv", out.join("summary.csv"))?;
+            d.set_item("manifest", out.join(errp_sweep::MANIFEST))?;
+            d.set_item("ran", ran)?;
+            d.set_item("total", total)?;
+            d.set_item("task", task.to_string())?;
+            Ok(d)
+        }
+    }
+}

@@ -1,0 +1,443 @@
+//! `errp.GridTask` and `errp.EpuckTask`: a scenario with its decoder
+//! calibrated once, run with the testbed's decoder or with a decoder of the
+//! caller's own in the closed loop.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use errp_bci::EegBlock;
+use errp_bci::rng::derive_seed;
+use errp_sim::AnyScenario;
+use errp_sim::epuck::{
+    ContinuousDecoder, EpuckScenario, EpuckTask as EpuckInfo, epuck_row, epuck_run_seed,
+    run_epuck_batch, run_epuck_episode_with,
+};
+use errp_sim::grid::{
+    AssessmentDecoder, EegDecoder, EpochBlocks, GridDecoding, GridScenario, GridTask as GridInfo,
+    grid_row, prepare_decoder, run_grid_scenario_with,
+};
+use errp_sim::task::Task;
+use numpy::{IntoPyArray, PyReadonlyArray1, PyUntypedArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::convert::{
+    PyDecoder, blocks_to_array3, channel_names, check_callable, py_err, value_error,
+};
+use crate::run::{header, line, load};
+
+/// The EEG pipeline behind a grid decoder, if it reads EEG.
+fn eeg_of(d: &AssessmentDecoder) -> Option<&EegDecoder> {
+    match d {
+        AssessmentDecoder::Eeg(e) => Some(e),
+        AssessmentDecoder::EegBank(b) => Some(&b.decoder),
+        AssessmentDecoder::Oracle { .. } => None,
+    }
+}
+
+/// The grid task of a scenario (Table 1's protocol): its decoder calibrated
+/// once at the scenario's accuracy, then episodes decoded by it or by a
+/// decoder of the caller's own.
+#[pyclass(module = "errp._core")]
+pub(crate) struct GridTask {
+    scenario: GridScenario,
+    builtin: Arc<AssessmentDecoder>,
+    decoder: Option<Py<PyAny>>,
+    scores: Option<(Vec<f64>, Vec<f64>)>,
+    calibration: Vec<(&'static str, f64)>,
+    calls: AtomicUsize,
+}
+
+#[pymethods]
+impl GridTask {
+    /// Calibrates the scenario's decoder; with `decoder` (called with each
+    /// action's epoch) or `batch_decoder` (called once with a bank of
+    /// epochs), a decoder of the caller's own replaces it in the loop.
+    #[new]
+    #[pyo3(signature = (scenario=None, *, decoder=None, batch_decoder=None, seed=None, accuracy=None, overrides=None))]
+    fn new(
+        py: Python<'_>,
+        scenario: Option<PathBuf>,
+        decoder: Option<Py<PyAny>>,
+        batch_decoder: Option<Py<PyAny>>,
+        seed: Option<u64>,
+        accuracy: Option<f64>,
+        overrides: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Self> {
+        let given = scenario.clone();
+        let mut s = match grid_default(scenario, accuracy, overrides)? {
+            AnyScenario::Grid(s) => *s,
+            AnyScenario::Epuck(_) => {
+                return Err(PyValueError::new_err(format!(
+                    "scenario: {} is an e-puck scenario; use errp.EpuckTask",
+                    given.map(|p| p.display().to_string()).unwrap_or_default()
+                )));
+            }
+        };
+        if let Some(seed) = seed {
+            s.seed = seed;
+        }
+        check_callable(py, "decoder", decoder.as_ref())?;
+        check_callable(py, "batch_decoder", batch_decoder.as_ref())?;
+        if decoder.is_some() && batch_decoder.is_some() {
+            return Err(PyValueError::new_err(
+                "decoder and batch_decoder: give one of them, not both",
+            ));
+        }
+        let (builtin, calibration) = py.detach(|| prepare_decoder(&s, |_| {})).map_err(py_err)?;
+        let mut info = vec![("accuracy", s.accuracy)];
+        if let Some(c) = &calibration {
+            let a = c.calibrated.accuracy;
+            info.extend([
+                ("errp_to_noise", c.targeting.ratio),
+                ("cv_correct", a.correct),
+                ("cv_error", a.error),
+                ("cv_mean", a.mean()),
+            ]);
+        }
+        if (decoder.is_some() || batch_decoder.is_some()) && eeg_of(&builtin).is_none() {
+            return Err(PyValueError::new_err(
+                "decoder: the scenario's decoder is the oracle (no EEG); a decoder of your own \
+                 reads EEG: set decoder = \"eeg\" in the scenario (overrides={\"decoder\": \"eeg\"})",
+            ));
+        }
+        let mut task = Self {
+            scenario: s,
+            builtin: Arc::new(builtin),
+            decoder,
+            scores: None,
+            calibration: info,
+            calls: AtomicUsize::new(0),
+        };
+        if let Some(f) = batch_decoder {
+            task.score_bank(py, f)?;
+        }
+        Ok(task)
+    }
+
+    /// Runs every episode of the scenario (episode k from the seed `errp
+    /// run` gives it) and returns the rows as CSV text.
+    fn run(&self, py: Python<'_>) -> PyResult<String> {
+        let s = &self.scenario;
+        let builtin = &self.builtin;
+        let mut lines = vec![header(&GridInfo::INFO)];
+        let mut push = |k: usize, r: &errp_sim::grid::GridEpisodeResult| {
+            let seed = derive_seed(s.seed, "grid/episode", k as u64);
+            lines.push(line(s.accuracy, k, seed, grid_row(r)));
+        };
+        match (&self.decoder, &self.scores) {
+            (Some(f), _) => {
+                let mut dec = PyDecoder::new(f.clone_ref(py));
+                let eeg = eeg_of(builtin).expect("checked: an EEG decoder");
+                let result = py.detach(|| {
+                    let mut call = |b: &EegBlock| dec.call(b);
+                    let decoding = GridDecoding::Epochs {
+                        source: eeg.source(),
+                        decode: &mut call,
+                    };
+                    run_grid_scenario_with(s, decoding, false, &mut push)
+                });
+                self.calls.fetch_add(dec.calls, Ordering::Relaxed);
+                result.map_err(|e| dec.error(e))?;
+            }
+            (None, Some((error, correct))) => {
+                let decoding = GridDecoding::Scores { error, correct };
+                py.detach(|| run_grid_scenario_with(s, decoding, false, &mut push))
+                    .map_err(py_err)?;
+            }
+            (None, None) => {
+                let decoding = GridDecoding::Builtin(builtin);
+                py.detach(|| run_grid_scenario_with(s, decoding, false, &mut push))
+                    .map_err(py_err)?;
+            }
+        }
+        Ok(lines.join("\n") + "\n")
+    }
+
+    /// What the calibration found: the requested accuracy, the ErrP-to-noise
+    /// ratio and the cross-validated accuracies of the testbed's decoder.
+    #[getter]
+    fn calibration<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (k, v) in &self.calibration {
+            d.set_item(k, v)?;
+        }
+        Ok(d)
+    }
+
+    /// Names of the channels of each epoch (the preprocessed EEG channels).
+    #[getter]
+    fn ch_names(&self) -> Vec<String> {
+        eeg_of(&self.builtin).map_or_else(Vec::new, |e| {
+            channel_names(&e.montage, e.preprocessor.outputs())
+        })
+    }
+
+    /// Sampling rate of the epochs (Hz).
+    #[getter]
+    fn sfreq(&self) -> f64 {
+        eeg_of(&self.builtin).map_or(256.0, |e| e.generator.sfreq_hz)
+    }
+
+    /// Samples per epoch, from the action's onset: the span of the paper's
+    /// feature window ([200, 800] ms at 64 Hz).
+    #[getter]
+    fn n_samples(&self) -> usize {
+        errp_bci::EpochWindow::paper(self.sfreq()).span()
+    }
+
+    /// Times the per-epoch decoder was called so far.
+    #[getter]
+    fn decoder_calls(&self) -> usize {
+        self.calls.load(Ordering::Relaxed)
+    }
+
+    /// The scenario's name.
+    #[getter]
+    fn name(&self) -> String {
+        self.scenario.name.clone()
+    }
+
+    /// The scenario's seed.
+    #[getter]
+    fn seed(&self) -> u64 {
+        self.scenario.seed
+    }
+}
+
+impl GridTask {
+    /// Streams the scenario's bank of epochs (`bank_per_class` of each
+    /// class), has `f` score them in one call, and keeps the scores.
+    fn score_bank(&mut self, py: Python<'_>, f: Py<PyAny>) -> PyResult<()> {
+        let eeg = eeg_of(&self.builtin).expect("checked: an EEG decoder");
+        let s = &self.scenario;
+        let blocks = py
+            .detach(|| EpochBlocks::build(eeg.source(), &s.params, s.bank_per_class, s.seed))
+            .map_err(py_err)?;
+        let all: Vec<&EegBlock> = blocks.error.iter().chain(&blocks.correct).collect();
+        let x = blocks_to_array3(&all).into_pyarray(py);
+        let out = f.bind(py).call1((x,))?;
+        let np = py.import("numpy")?;
+        let p = np.call_method1("asarray", (out, "float64"))?;
+        let p: PyReadonlyArray1<'_, f64> = p.extract().map_err(|_| {
+            PyValueError::new_err(format!(
+                "batch_decoder: expected a 1-D array of {} p(error) values, one per epoch",
+                all.len()
+            ))
+        })?;
+        if p.len() != all.len() {
+            return Err(value_error(
+                "batch_decoder",
+                format!("an array of {} values", p.len()),
+                &format!("{} p(error) values, one per epoch", all.len()),
+            ));
+        }
+        let p = p.as_slice()?.to_vec();
+        for (i, &v) in p.iter().enumerate() {
+            if !(v.is_finite() && (0.0..=1.0).contains(&v)) {
+                return Err(value_error(
+                    &format!("batch_decoder: p(error) of epoch {i}"),
+                    v,
+                    "a number from 0 to 1",
+                ));
+            }
+        }
+        let n_error = blocks.error.len();
+        self.scores = Some((p[..n_error].to_vec(), p[n_error..].to_vec()));
+        Ok(())
+    }
+}
+
+/// A grid scenario, the built-in one by default.
+fn grid_default(
+    scenario: Option<PathBuf>,
+    accuracy: Option<f64>,
+    overrides: Option<&Bound<'_, PyDict>>,
+) -> PyResult<AnyScenario> {
+    match scenario {
+        Some(p) => load(Some(p), accuracy, overrides),
+        None => {
+            let mut extra = Vec::new();
+            if let Some(a) = accuracy {
+                extra.push(("user.accuracy".to_string(), toml::Value::Float(a)));
+            }
+            crate::convert::ScenarioSource::new(None, false)
+                .load(&crate::convert::overrides(extra, overrides)?)
+        }
+    }
+}
+
+/// The e-puck task of a scenario (sec. 5): its continuous decoder
+/// calibrated once, then runs decoded by it or by a decoder of the caller's
+/// own, called with every 62.5 ms window.
+#[pyclass(module = "errp._core")]
+pub(crate) struct EpuckTask {
+    scenario: EpuckScenario,
+    builtin: Arc<ContinuousDecoder>,
+    decoder: Option<Py<PyAny>>,
+    calibration: Vec<(&'static str, f64)>,
+    calls: AtomicUsize,
+}
+
+#[pymethods]
+impl EpuckTask {
+    /// Calibrates the scenario's continuous decoder; with `decoder`, a
+    /// decoder of the caller's own replaces it in the loop.
+    #[new]
+    #[pyo3(signature = (scenario=None, *, decoder=None, seed=None, accuracy=None, overrides=None))]
+    fn new(
+        py: Python<'_>,
+        scenario: Option<PathBuf>,
+        decoder: Option<Py<PyAny>>,
+        seed: Option<u64>,
+        accuracy: Option<f64>,
+        overrides: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Self> {
+        let given = scenario.clone();
+        let mut s = match load(scenario, accuracy, overrides)? {
+            AnyScenario::Epuck(s) => *s,
+            AnyScenario::Grid(_) => {
+                return Err(PyValueError::new_err(format!(
+                    "scenario: {} is a grid scenario; use errp.GridTask",
+                    given.map(|p| p.display().to_string()).unwrap_or_default()
+                )));
+            }
+        };
+        if let Some(seed) = seed {
+            s.seed = seed;
+        }
+        check_callable(py, "decoder", decoder.as_ref())?;
+        let (builtin, report) = py
+            .detach(|| errp_sim::epuck::prepare_continuous_decoder(&s, |_| {}))
+            .map_err(py_err)?;
+        let a = report.calibrated.accuracy;
+        let mut info = vec![
+            ("accuracy", s.accuracy.get()),
+            ("errp_to_noise", report.generator.errp_to_noise),
+            ("cv_correct", a.correct),
+            ("cv_error", a.error),
+            ("cv_mean", a.mean()),
+            ("t_e", builtin.t_e(s.params.control.t_e)),
+        ];
+        if let Some(o) = &builtin.online {
+            info.extend([
+                ("online_hit_rate", o.point.hit_rate),
+                ("online_false_alarms_per_min", o.point.false_alarms_per_min),
+            ]);
+        }
+        Ok(Self {
+            scenario: s,
+            builtin: Arc::new(builtin),
+            decoder,
+            calibration: info,
+            calls: AtomicUsize::new(0),
+        })
+    }
+
+    /// Runs `runs` runs (the scenario's by default; run k from the seed
+    /// `errp run` gives it) and returns the rows as CSV text. With the
+    /// testbed's decoder they run in parallel; a decoder of the caller's own
+    /// runs them one after another.
+    #[pyo3(signature = (runs=None))]
+    fn run(&self, py: Python<'_>, runs: Option<usize>) -> PyResult<String> {
+        let max = errp_sim::epuck::MAX_RUNS as usize;
+        let runs = runs.unwrap_or(self.scenario.runs);
+        if !(1..=max).contains(&runs) {
+            return Err(value_error(
+                "runs",
+                runs,
+                &format!("a whole number from 1 to {max}"),
+            ));
+        }
+        let s = &self.scenario;
+        let d = &self.builtin;
+        let results = match &self.decoder {
+            None => py.detach(|| run_epuck_batch(s, d, runs)).map_err(py_err)?,
+            Some(f) => {
+                let mut dec = PyDecoder::new(f.clone_ref(py));
+                let result = py.detach(|| {
+                    (0..runs)
+                        .map(|k| {
+                            let mut call = |b: &EegBlock| dec.call(b);
+                            run_epuck_episode_with(
+                                &s.params,
+                                &s.arena,
+                                &s.layout,
+                                s.episode,
+                                d,
+                                epuck_run_seed(s.seed, k),
+                                &mut (),
+                                Some(&mut call),
+                            )
+                        })
+                        .collect::<errp_sim::Result<Vec<_>>>()
+                });
+                self.calls.fetch_add(dec.calls, Ordering::Relaxed);
+                result.map_err(|e| dec.error(e))?
+            }
+        };
+        let mut lines = vec![header(&EpuckInfo::INFO)];
+        for (k, r) in results.iter().enumerate() {
+            let seed = epuck_run_seed(s.seed, k);
+            lines.push(line(s.accuracy.get(), k, seed, epuck_row(&s.layout, r)));
+        }
+        Ok(lines.join("\n") + "\n")
+    }
+
+    /// What the calibration found (accuracy, ErrP-to-noise ratio,
+    /// cross-validated accuracies, the detector's T_e and its operating
+    /// point on a held-out recording).
+    #[getter]
+    fn calibration<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (k, v) in &self.calibration {
+            d.set_item(k, v)?;
+        }
+        Ok(d)
+    }
+
+    /// Names of the channels of each window (the preprocessed EEG channels).
+    #[getter]
+    fn ch_names(&self) -> Vec<String> {
+        channel_names(&self.builtin.montage, self.builtin.preprocessor.outputs())
+    }
+
+    /// Sampling rate of the windows (Hz).
+    #[getter]
+    fn sfreq(&self) -> f64 {
+        self.builtin.generator.sfreq_hz
+    }
+
+    /// Samples per window (800 ms).
+    #[getter]
+    fn n_samples(&self) -> usize {
+        self.builtin.features.span()
+    }
+
+    /// The detection threshold a decoder of the caller's own runs at: the
+    /// scenario's `control.t_e`.
+    #[getter]
+    fn t_e(&self) -> f64 {
+        self.scenario.params.control.t_e
+    }
+
+    /// Times the decoder was called so far.
+    #[getter]
+    fn decoder_calls(&self) -> usize {
+        self.calls.load(Ordering::Relaxed)
+    }
+
+    /// The scenario's name.
+    #[getter]
+    fn name(&self) -> String {
+        self.scenario.name.clone()
+    }
+
+    /// The scenario's seed.
+    #[getter]
+    fn seed(&self) -> u64 {
+        self.scenario.seed
+    }
+}

@@ -1,0 +1,518 @@
+"""The ErrP testbed from Python.
+
+A synthetic user watches a simulated device (a cursor on a 5x5 grid, or an
+e-puck robot in a 200 x 200 cm arena with 25 city goals), a synthetic EEG
+generator turns each of the user's judgements into 34 EEG + 6 EOG channels,
+a decoder turns that EEG into p(error), and shared control infers the
+user's goal from it (Iturrate et al., MLIS'13). Everything runs in the Rust
+crates of the testbed; this package is a thin binding over them.
+
+Three uses:
+
+- **Synthetic EEG** for MNE-Python: :func:`simulate_session` (a calibration
+  session as an ``mne.io.RawArray`` with annotations) and the streaming
+  :class:`EegGenerator`.
+- **Your own decoder in the closed loop**: :class:`GridTask` and
+  :class:`EpuckTask` call your callable with each epoch or window of
+  preprocessed EEG; :func:`run` and :func:`sweep` give the testbed's own
+  results as pandas DataFrames with the columns of ``episodes.csv``.
+- **Your own agent**: Gymnasium environments in :mod:`errp.gym`
+  (``errp/Grid-v0``), whose feedback is the decoded ErrP.
+
+Units: EEG in microvolts (MNE objects in volts), time in seconds, sampling
+rate in Hz. Seeds are explicit everywhere; the same seed gives the same
+numbers as the ``errp`` program.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import shutil
+import tempfile
+from dataclasses import dataclass, field
+from typing import Any, Callable, Dict, Mapping, Optional, Sequence, Union
+
+import numpy as np
+
+from . import _core
+from ._core import HAS_RERUN, EegGenerator, __version__
+
+__all__ = [
+    "EegGenerator",
+    "EpuckTask",
+    "GridTask",
+    "HAS_RERUN",
+    "Session",
+    "SweepResult",
+    "episode_columns",
+    "run",
+    "simulate_session",
+    "sweep",
+    "__version__",
+]
+
+PathLike = Union[str, "os.PathLike[str]"]
+Scalar = Union[bool, int, float, str]
+
+
+def _frame(csv: str):
+    """Rows as the testbed writes them, read as ``episodes.csv`` is read."""
+    import pandas as pd
+
+    return pd.read_csv(io.StringIO(csv))
+
+
+def _path(p: Optional[PathLike]) -> Optional[str]:
+    return None if p is None else os.fspath(p)
+
+
+def episode_columns(task: str) -> list:
+    """The columns of one episode's row of ``task`` ("grid" or "epuck"),
+    from ``success`` to ``online_accuracy``, as ``episodes.csv`` names
+    them."""
+    return list(_core.episode_columns(task))
+
+
+@dataclass(frozen=True)
+class Session:
+    """A simulated calibration session (the one ``errp calibrate`` makes).
+
+    Attributes
+    ----------
+    data : ndarray, shape (n_channels, n_samples), float64
+        The raw recording in uV: 34 EEG channels, then 6 EOG channels.
+    ch_names, ch_types : list of str
+        Channel names and MNE types ("eeg", "eog").
+    sfreq : float
+        Sampling rate (Hz): 256.
+    onsets : ndarray, shape (n_actions,)
+        Action onsets (s from the first sample).
+    labels : ndarray of str, shape (n_actions,)
+        "error" or "correct": the user's judgement of each action.
+    epochs : ndarray, shape (n_actions, 8, n_epoch_samples), float32
+        Each action's EEG from its onset (204 samples, 0-797 ms: the span
+        of the paper's [200, 800] ms feature window), preprocessed as the
+        closed loop preprocesses it (50 Hz notch, [1, 10] Hz band-pass,
+        common average reference, EOG regression fitted on the session's
+        EOG recording) on the paper's eight decoding channels: the arrays
+        :class:`GridTask` gives a decoder of your own.
+    epoch_ch_names : list of str
+        The channels of ``epochs``: Fz, FC1, FCz, FC2, C1, Cz, C2, CPz.
+    errp_to_noise : float
+        The ErrP-to-noise ratio that the targeting found.
+    accuracy : float
+        The requested mean accuracy.
+    cv_correct, cv_error, cv_mean : float
+        The testbed's decoder's cross-validated accuracy on this session
+        (correct class, error class, their mean).
+    seed : int
+    """
+
+    data: np.ndarray
+    ch_names: list
+    ch_types: list
+    sfreq: float
+    onsets: np.ndarray
+    labels: np.ndarray
+    epochs: np.ndarray
+    epoch_ch_names: list
+    errp_to_noise: float
+    accuracy: float
+    cv_correct: float
+    cv_error: float
+    cv_mean: float
+    seed: int
+
+    @property
+    def y(self) -> np.ndarray:
+        """``True`` where the action was an error, shape (n_actions,)."""
+        return self.labels[: len(self.epochs)] == "error"
+
+    @property
+    def epoch_times(self) -> np.ndarray:
+        """Time of each sample of an epoch from the onset (s)."""
+        return np.arange(self.epochs.shape[-1]) / self.sfreq
+
+    def to_mne(self):
+        """The raw recording as an ``mne.io.RawArray`` (in volts) with one
+        annotation per action ("error" or "correct"). Needs MNE-Python."""
+        try:
+            import mne
+        except ImportError as e:  # pragma: no cover - depends on the environment
+            raise ImportError(
+                "Session.to_mne needs MNE-Python: pip install mne "
+                "(the arrays are in Session.data without it)"
+            ) from e
+        info = mne.create_info(list(self.ch_names), self.sfreq, list(self.ch_types))
+        raw = mne.io.RawArray(self.data * 1e-6, info, verbose="error")
+        raw.set_annotations(
+            mne.Annotations(
+                onset=self.onsets,
+                duration=np.zeros(len(self.onsets)),
+                description=list(self.labels),
+            )
+        )
+        return raw
+
+    @property
+    def raw(self):
+        """Same as :meth:`to_mne`."""
+        return self.to_mne()
+
+
+def simulate_session(accuracy: float = 0.7438, seed: int = 1) -> Session:
+    """Simulates the discrete calibration session of ``errp calibrate
+    --accuracy ACCURACY --seed SEED``: the ErrP-to-noise ratio is targeted
+    so that the paper's decoder reaches ``accuracy`` (mean of the two
+    classes, cross-validated), then 400 actions, 20 % of them erroneous, are
+    simulated at that ratio.
+
+    Parameters
+    ----------
+    accuracy : float
+        Requested mean accuracy, strictly between 0.5 and 1 (Table 1:
+        0.7438 fixed goals, 0.7767 free goals).
+    seed : int
+        Seed of the synthetic user and the session (>= 0).
+
+    Returns
+    -------
+    Session
+        The recording, its events, the preprocessed epochs and the
+        targeting; ``session.to_mne()`` gives an ``mne.io.RawArray``.
+    """
+    d = _core.simulate_session(accuracy, seed)
+    d["labels"] = np.asarray(d["labels"])
+    return Session(**d)
+
+
+def run(
+    scenario: Optional[PathLike] = None,
+    *,
+    seed: Optional[int] = None,
+    runs: Optional[int] = None,
+    accuracy: Optional[float] = None,
+    overrides: Optional[Mapping[str, Any]] = None,
+    save: Optional[PathLike] = None,
+):
+    """Runs a scenario as ``errp run`` does and returns one row per episode.
+
+    Parameters
+    ----------
+    scenario : path, optional
+        A scenario file (``scenarios/*.toml``); by default the built-in
+        Mexico-to-Pisa e-puck run.
+    seed : int, optional
+        Replaces the scenario's seed.
+    runs : int, optional
+        E-puck runs (1 to 100 000); a grid scenario lists its episodes.
+    accuracy : float, optional
+        Replaces ``user.accuracy`` (as ``errp run --accuracy``).
+    overrides : dict, optional
+        Scenario fields by dotted key, e.g. ``{"control.tau": 0.5}``; they
+        are checked as the file's own.
+    save : path, optional
+        Records the run to this ``.rrd`` file, as ``errp run --save``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The columns of ``episodes.csv`` (``level``, ``accuracy``,
+        ``episode``, ``seed``, ``success``, the task's columns and the
+        online accuracy); ``df.attrs["decoder"]`` holds the calibration.
+    """
+    d = _core.run(
+        _path(scenario),
+        seed=seed,
+        runs=runs,
+        accuracy=accuracy,
+        overrides=None if overrides is None else dict(overrides),
+        save=_path(save),
+    )
+    df = _frame(d["csv"])
+    df.attrs["task"] = d["task"]
+    df.attrs["decoder"] = dict(d["decoder"])
+    return df
+
+
+@dataclass
+class SweepResult:
+    """A finished sweep: its episodes and per-level summary as DataFrames
+    (the columns of ``episodes.csv`` and ``summary.csv``), and where its
+    files are (``None`` when it ran in a temporary directory)."""
+
+    episodes: Any
+    summary: Any
+    out: Optional[str]
+    task: str
+    ran: int = 0
+    files: Dict[str, str] = field(default_factory=dict)
+
+
+def sweep(
+    out: Optional[PathLike] = None,
+    *,
+    accuracy: Union[str, float, Sequence[float]],
+    task: Optional[str] = None,
+    scenario: Optional[PathLike] = None,
+    episodes: int = 100,
+    seed: int = 1,
+    params: Optional[Mapping[str, Sequence[Scalar]]] = None,
+    stream: Optional[bool] = None,
+    cache: Optional[PathLike] = None,
+    threads: Optional[int] = None,
+) -> SweepResult:
+    """Runs a Monte Carlo sweep as ``errp sweep`` does.
+
+    Parameters
+    ----------
+    out : path, optional
+        The sweep directory (``episodes.csv``, ``summary.csv``, plots,
+        ``sweep.json``); running the same sweep into it again resumes it.
+        By default a temporary directory, removed once read.
+    accuracy : str, float or list of float
+        Decoder accuracies: ``"0.6:0.9:0.05"`` (a range), ``[0.7, 0.8]``.
+    task : {"grid", "epuck"}, optional
+        The task, for its built-in scenario when ``scenario`` is not given.
+    scenario : path, optional
+        A scenario file.
+    episodes : int
+        Episodes per level (1 to 1 000 000).
+    seed : int
+        The sweep's seed; episode seeds derive from it.
+    params : dict, optional
+        Swept parameters: ``{"strategy": ["greedy", "info_gain"]}``, by the
+        short names of ``errp sweep --param`` or dotted scenario keys.
+    stream : bool, optional
+        Grid: stream the EEG of every action instead of drawing epochs from
+        a bank (the sweep's default).
+    cache : path, optional
+        A directory for the accuracy targeting, shared across sweeps.
+    threads : int, optional
+        Worker threads (all cores by default); results do not depend on it.
+    """
+    if isinstance(accuracy, str):
+        acc = accuracy
+    elif isinstance(accuracy, (int, float)):
+        acc = repr(float(accuracy))
+    else:
+        acc = ",".join(repr(float(a)) for a in accuracy)
+    axes = None
+    if params is not None:
+        axes = []
+        for name, values in params.items():
+            if isinstance(values, (str, bytes)) or not hasattr(values, "__iter__"):
+                values = [values]
+            axes.append(f"{name}=" + ",".join(_value_text(v) for v in values))
+    tmp = None
+    if out is None:
+        tmp = tempfile.mkdtemp(prefix="errp-sweep-")
+        target = os.path.join(tmp, "sweep")
+    else:
+        target = os.fspath(out)
+    try:
+        d = _core.sweep(
+            target,
+            accuracy=acc,
+            task=task,
+            scenario=_path(scenario),
+            episodes=episodes,
+            seed=seed,
+            params=axes,
+            stream=stream,
+            cache=_path(cache),
+            threads=threads,
+        )
+        import pandas as pd
+
+        result = SweepResult(
+            episodes=pd.read_csv(d["episodes_csv"]),
+            summary=pd.read_csv(d["summary_csv"]),
+            out=None if tmp else target,
+            task=d["task"],
+            ran=d["ran"],
+            files={} if tmp else {
+                "episodes": d["episodes_csv"],
+                "summary": d["summary_csv"],
+                "manifest": d["manifest"],
+            },
+        )
+    finally:
+        if tmp is not None:
+            shutil.rmtree(tmp, ignore_errors=True)
+    return result
+
+
+def _value_text(v: Scalar) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    return str(v)
+
+
+Decoder = Callable[[np.ndarray], float]
+BatchDecoder = Callable[[np.ndarray], np.ndarray]
+
+
+class GridTask:
+    """The grid task of a scenario with its decoder calibrated once.
+
+    Without ``decoder``, episodes are decoded by the testbed's decoder (the
+    paper's shrinkage LDA). With ``decoder``, your callable decodes every
+    action: it is called with the action's epoch of preprocessed EEG, an
+    ndarray ``(n_channels, n_samples)`` float64 in uV (channels
+    :attr:`ch_names`, :attr:`sfreq` Hz, :attr:`n_samples` samples from the
+    onset), and returns p(error) in [0, 1]; p >= 0.5 counts as its
+    "error" class. Everything else (the user, the EEG, the shared control)
+    is the scenario's. With ``batch_decoder``, your callable is called once
+    with a bank of epochs, ``(n_epochs, n_channels, n_samples)`` float32,
+    ``bank_per_class`` of each class in a shuffled order it is not told, and
+    returns their p(error), shape ``(n_epochs,)``; each action then draws
+    one of them, as the testbed's sweeps draw from their epoch bank. The
+    same user at the same seed is behind all three, so their results
+    compare at the same accuracy.
+
+    Parameters
+    ----------
+    scenario : path, optional
+        A grid scenario file; by default the built-in fixed-goals one
+        (``scenarios/grid_fixed_goals.toml``, 74.38 %).
+    decoder, batch_decoder : callable, optional
+    seed, accuracy, overrides :
+        As for :func:`run`.
+    """
+
+    def __init__(
+        self,
+        scenario: Optional[PathLike] = None,
+        *,
+        decoder: Optional[Decoder] = None,
+        batch_decoder: Optional[BatchDecoder] = None,
+        seed: Optional[int] = None,
+        accuracy: Optional[float] = None,
+        overrides: Optional[Mapping[str, Any]] = None,
+    ) -> None:
+        self._core = _core.GridTask(
+            _path(scenario),
+            decoder=decoder,
+            batch_decoder=batch_decoder,
+            seed=seed,
+            accuracy=accuracy,
+            overrides=None if overrides is None else dict(overrides),
+        )
+
+    def run(self):
+        """Runs every episode of the scenario and returns one row per
+        episode (the columns of :func:`run`)."""
+        df = _frame(self._core.run())
+        df.attrs["task"] = "grid"
+        df.attrs["decoder"] = self.calibration
+        return df
+
+    @property
+    def calibration(self) -> dict:
+        """What the calibration of the testbed's decoder found."""
+        return dict(self._core.calibration)
+
+    @property
+    def ch_names(self) -> list:
+        """Channels of each epoch."""
+        return list(self._core.ch_names)
+
+    @property
+    def sfreq(self) -> float:
+        """Sampling rate of the epochs (Hz)."""
+        return self._core.sfreq
+
+    @property
+    def n_samples(self) -> int:
+        """Samples per epoch, from the onset."""
+        return self._core.n_samples
+
+    @property
+    def decoder_calls(self) -> int:
+        """How often the per-epoch decoder has been called."""
+        return self._core.decoder_calls
+
+    def __repr__(self) -> str:
+        return f"GridTask({self._core.name!r}, seed={self._core.seed})"
+
+
+class EpuckTask:
+    """The e-puck task of a scenario with its continuous decoder calibrated
+    once.
+
+    With ``decoder``, your callable replaces the testbed's sliding-window
+    SVM: every 62.5 ms it is called with the last 800 ms of preprocessed
+    EEG, an ndarray ``(n_channels, n_samples)`` float64 in uV (channels
+    :attr:`ch_names`, :attr:`sfreq` Hz), and returns p(error) in [0, 1].
+    Its output goes through the scenario's detector at the scenario's
+    ``control.t_e`` (:attr:`t_e`), and is scored over the response spans
+    measured for the testbed's decoder.
+
+    Parameters
+    ----------
+    scenario : path, optional
+        An e-puck scenario; by default the built-in Mexico-to-Pisa run.
+    decoder : callable, optional
+    seed, accuracy, overrides :
+        As for :func:`run`.
+    """
+
+    def __init__(
+        self,
+        scenario: Optional[PathLike] = None,
+        *,
+        decoder: Optional[Decoder] = None,
+        seed: Optional[int] = None,
+        accuracy: Optional[float] = None,
+        overrides: Optional[Mapping[str, Any]] = None,
+    ) -> None:
+        self._core = _core.EpuckTask(
+            _path(scenario),
+            decoder=decoder,
+            seed=seed,
+            accuracy=accuracy,
+            overrides=None if overrides is None else dict(overrides),
+        )
+
+    def run(self, runs: Optional[int] = None):
+        """Runs ``runs`` runs (the scenario's by default) and returns one row
+        per run (the columns of :func:`run`)."""
+        df = _frame(self._core.run(runs))
+        df.attrs["task"] = "epuck"
+        df.attrs["decoder"] = self.calibration
+        return df
+
+    @property
+    def calibration(self) -> dict:
+        """What the calibration of the testbed's decoder found."""
+        return dict(self._core.calibration)
+
+    @property
+    def ch_names(self) -> list:
+        """Channels of each window."""
+        return list(self._core.ch_names)
+
+    @property
+    def sfreq(self) -> float:
+        """Sampling rate (Hz)."""
+        return self._core.sfreq
+
+    @property
+    def n_samples(self) -> int:
+        """Samples per window (800 ms)."""
+        return self._core.n_samples
+
+    @property
+    def t_e(self) -> float:
+        """The detection threshold your decoder's p(error) is compared with."""
+        return self._core.t_e
+
+    @property
+    def decoder_calls(self) -> int:
+        """How often the decoder has been called."""
+        return self._core.decoder_calls
+
+    def __repr__(self) -> str:
+        return f"EpuckTask({self._core.name!r}, seed={self._core.seed})"

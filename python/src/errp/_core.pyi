@@ -1,0 +1,171 @@
+"""Type stubs of the compiled core (``errp._core``). The documented API is
+the package's (``errp``, ``errp.gym``); these are what it calls."""
+
+from typing import Any, Callable, Dict, List, Optional, Tuple
+
+import numpy as np
+import numpy.typing as npt
+
+HAS_RERUN: bool
+__version__: str
+
+def simulate_session(accuracy: float = 0.7438, seed: int = 1) -> Dict[str, Any]:
+    """The calibration session of ``errp calibrate``: ``data`` (n_channels,
+    n_samples) uV, ``ch_names``, ``ch_types``, ``sfreq``, ``onsets`` (s),
+    ``labels``, ``epochs`` (n_actions, n_eeg, n_samples) float32,
+    ``epoch_ch_names``, ``errp_to_noise``, ``accuracy``, ``cv_correct``,
+    ``cv_error``, ``cv_mean``, ``seed``."""
+
+def run(
+    scenario: Optional[str] = None,
+    *,
+    seed: Optional[int] = None,
+    runs: Optional[int] = None,
+    accuracy: Optional[float] = None,
+    overrides: Optional[Dict[str, Any]] = None,
+    save: Optional[str] = None,
+) -> Dict[str, Any]:
+    """``task``, ``csv`` (one row per episode) and ``decoder``."""
+
+def sweep(
+    out: str,
+    *,
+    accuracy: str,
+    task: Optional[str] = None,
+    scenario: Optional[str] = None,
+    episodes: int = 100,
+    seed: int = 1,
+    params: Optional[List[str]] = None,
+    stream: Optional[bool] = None,
+    cache: Optional[str] = None,
+    threads: Optional[int] = None,
+) -> Dict[str, Any]:
+    """Paths of the sweep's files, ``ran``, ``total`` and ``task``."""
+
+def episode_columns(task: str) -> List[str]: ...
+
+class EegGenerator:
+    """Streaming synthetic EEG, 34 EEG + 6 EOG channels, 256 Hz, uV."""
+
+    def __init__(
+        self, seed: int = 0, errp_to_noise: float = 1.0, params: Optional[Dict[str, Any]] = None
+    ) -> None: ...
+    def schedule(self, onset_secs: float, kind: str) -> None:
+        """Schedules the potential of an assessment ("error" or "correct")
+        with its time zero at ``onset_secs`` on the generator's clock."""
+    def generate(self, n_samples: int) -> npt.NDArray[np.float64]:
+        """The next samples, (n_channels, n_samples) in uV."""
+    @property
+    def ch_names(self) -> List[str]: ...
+    @property
+    def ch_types(self) -> List[str]: ...
+    @property
+    def sfreq(self) -> float: ...
+    @property
+    def now_secs(self) -> float: ...
+    @property
+    def errp_to_noise(self) -> float: ...
+
+class GridTask:
+    def __init__(
+        self,
+        scenario: Optional[str] = None,
+        *,
+        decoder: Optional[Callable[[npt.NDArray[np.float64]], float]] = None,
+        batch_decoder: Optional[Callable[[npt.NDArray[np.float32]], Any]] = None,
+        seed: Optional[int] = None,
+        accuracy: Optional[float] = None,
+        overrides: Optional[Dict[str, Any]] = None,
+    ) -> None: ...
+    def run(self) -> str: ...
+    @property
+    def calibration(self) -> Dict[str, float]: ...
+    @property
+    def ch_names(self) -> List[str]: ...
+    @property
+    def sfreq(self) -> float: ...
+    @property
+    def n_samples(self) -> int: ...
+    @property
+    def decoder_calls(self) -> int: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def seed(self) -> int: ...
+
+class EpuckTask:
+    def __init__(
+        self,
+        scenario: Optional[str] = None,
+        *,
+        decoder: Optional[Callable[[npt.NDArray[np.float64]], float]] = None,
+        seed: Optional[int] = None,
+        accuracy: Optional[float] = None,
+        overrides: Optional[Dict[str, Any]] = None,
+    ) -> None: ...
+    def run(self, runs: Optional[int] = None) -> str: ...
+    @property
+    def calibration(self) -> Dict[str, float]: ...
+    @property
+    def ch_names(self) -> List[str]: ...
+    @property
+    def sfreq(self) -> float: ...
+    @property
+    def n_samples(self) -> int: ...
+    @property
+    def t_e(self) -> float: ...
+    @property
+    def decoder_calls(self) -> int: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def seed(self) -> int: ...
+
+class GridEnvCore:
+    def __init__(
+        self,
+        scenario: Optional[str] = None,
+        *,
+        accuracy: Optional[float] = None,
+        overrides: Optional[Dict[str, Any]] = None,
+    ) -> None: ...
+    def reset(
+        self,
+        seed: int,
+        start: Optional[Tuple[int, int]] = None,
+        goal: Optional[Tuple[int, int]] = None,
+    ) -> Tuple[Tuple[int, int], Tuple[int, int]]: ...
+    def step(self, action: int, keep_epoch: bool = False) -> Dict[str, Any]: ...
+    @property
+    def streams(self) -> bool: ...
+    @property
+    def epoch_shape(self) -> Tuple[List[str], int, float]: ...
+    @property
+    def max_actions(self) -> int: ...
+    @property
+    def name(self) -> str: ...
+
+class EpuckEnvCore:
+    def __init__(
+        self,
+        scenario: Optional[str] = None,
+        *,
+        accuracy: Optional[float] = None,
+        overrides: Optional[Dict[str, Any]] = None,
+    ) -> None: ...
+    def reset(
+        self, seed: int, goal: Optional[int] = None
+    ) -> Tuple[Tuple[float, float, float], int]: ...
+    def step(self, action: int, windows: int, keep_window: bool = False) -> Dict[str, Any]: ...
+    @property
+    def window_shape(self) -> Tuple[List[str], int, float]: ...
+    @property
+    def goal_names(self) -> List[str]: ...
+    @property
+    def arena_size_m(self) -> float: ...
+    @property
+    def max_secs(self) -> float: ...
+    @property
+    def scenario_goal(self) -> int: ...
+    @property
+    def name(self) -> str: ...

@@ -1,0 +1,447 @@
+"""Gymnasium environments for learning from ErrP feedback.
+
+Importing this module registers:
+
+- ``errp/Epuck-v0``: the e-puck of sec. 5, driven by motion primitives
+  (see :class:`EpuckEnv`); its feedback is the p(error) of the
+  sliding-window decoder every 62.5 ms.
+- ``errp/Grid-v0``: the 5x5 grid of the paper's sec. 4. The agent moves the
+  cursor (0 up, 1 down, 2 left, 3 right, 4 "goal reached"); the synthetic
+  user judges each action against a goal the agent is not told (correct
+  when it brings the cursor closer, or says "goal reached" on the goal);
+  the EEG of that judgement is decoded by the testbed's calibrated decoder,
+  and the agent observes the cursor and the decoded p(error). The reward is
+  the feedback in [-1, 1], ``1 - 2 p(error)``: the agent learns from what
+  the user's brain said, never from the goal. The episode ends when the
+  agent says "goal reached" (``info["success"]`` says whether it was the
+  goal) or after ``max_episode_steps`` actions (100).
+
+With ``observe_epoch=True`` the observation also holds the action's epoch of
+preprocessed EEG, ``(n_channels, n_samples)`` float32 in uV, for agents that
+decode the EEG themselves (the scenario's EEG must be streamed: the default
+here).
+
+    import gymnasium as gym
+    import errp.gym  # registers the environments
+
+    env = gym.make("errp/Grid-v0", goal=(3, 1))
+    obs, info = env.reset(seed=0)
+    obs, reward, terminated, truncated, info = env.step(3)
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Optional, Tuple
+
+import numpy as np
+
+try:
+    import gymnasium as gym
+    from gymnasium import spaces
+except ImportError as e:  # pragma: no cover - depends on the environment
+    raise ImportError(
+        "errp.gym needs Gymnasium: pip install gymnasium (or pip install './python[gym]')"
+    ) from e
+
+from . import _core
+
+__all__ = ["ACTIONS", "EPUCK_ACTIONS", "EpuckEnv", "GridEnv"]
+
+#: The grid's actions, by index.
+ACTIONS = ("up", "down", "left", "right", "goal reached")
+#: The e-puck's motion primitives, by index.
+EPUCK_ACTIONS = ("forward", "turn left", "turn right", "stop")
+
+
+class GridEnv(gym.Env):
+    """The grid task with the device's actions chosen by an agent.
+
+    Parameters
+    ----------
+    scenario : path, optional
+        A grid scenario; by default the built-in fixed-goals one, with its
+        EEG streamed (each action's EEG synthesised and decoded live).
+    accuracy : float, optional
+        The decoder's mean accuracy (the scenario's, 74.38 %, by default).
+    overrides : dict, optional
+        Scenario fields by dotted key.
+    goal, start : (x, y), optional
+        The user's goal and the cursor's start; drawn from the reset seed
+        when not given (``reset(options={"goal": ..., "start": ...})`` sets
+        them for one episode).
+    observe_epoch : bool
+        Add the action's preprocessed EEG epoch to the observation.
+    render_mode : {"ansi"}, optional
+        ``render()`` returns the grid as text.
+    """
+
+    metadata = {"render_modes": ["ansi"]}
+
+    def __init__(
+        self,
+        scenario: Optional[str] = None,
+        *,
+        accuracy: Optional[float] = None,
+        overrides: Optional[dict] = None,
+        goal: Optional[Tuple[int, int]] = None,
+        start: Optional[Tuple[int, int]] = None,
+        observe_epoch: bool = False,
+        render_mode: Optional[str] = None,
+    ) -> None:
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(
+                f"render_mode = {render_mode!r} is invalid: expected None or 'ansi'"
+            )
+        fields = {"eeg": "stream"}
+        if overrides:
+            fields.update(overrides)
+        self._core = _core.GridEnvCore(
+            None if scenario is None else os.fspath(scenario),
+            accuracy=accuracy,
+            overrides=fields,
+        )
+        self.goal = _cell("goal", goal)
+        self.start = _cell("start", start)
+        self.observe_epoch = bool(observe_epoch)
+        self.render_mode = render_mode
+        self.action_space = spaces.Discrete(5)
+        obs = {
+            "cursor": spaces.MultiDiscrete([5, 5]),
+            "p_error": spaces.Box(0.0, 1.0, shape=(1,), dtype=np.float32),
+        }
+        if self.observe_epoch:
+            if not self._core.streams:
+                raise ValueError(
+                    "observe_epoch: the scenario's decoder does not stream EEG; "
+                    "set eeg = \"stream\" and decoder = \"eeg\""
+                )
+            names, n_samples, _ = self._core.epoch_shape
+            obs["epoch"] = spaces.Box(
+                -np.inf, np.inf, shape=(len(names), n_samples), dtype=np.float32
+            )
+        self.observation_space = spaces.Dict(obs)
+        self._cursor = (0, 0)
+        self._goal = (0, 0)
+        self._last: dict = {}
+
+    @property
+    def ch_names(self) -> list:
+        """Channels of an epoch."""
+        return list(self._core.epoch_shape[0])
+
+    @property
+    def sfreq(self) -> float:
+        """Sampling rate of an epoch (Hz)."""
+        return self._core.epoch_shape[2]
+
+    def _obs(self, p_error: float, epoch: Optional[np.ndarray]) -> dict:
+        obs = {
+            "cursor": np.array(self._cursor, dtype=np.int64),
+            "p_error": np.array([p_error], dtype=np.float32),
+        }
+        if self.observe_epoch:
+            shape = self.observation_space["epoch"].shape
+            obs["epoch"] = (
+                np.zeros(shape, dtype=np.float32)
+                if epoch is None
+                else np.asarray(epoch, dtype=np.float32)
+            )
+        return obs
+
+    def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None):
+        """Starts an episode. The observation's p_error is 0.5 (no feedback
+        yet) and its epoch zeros; ``info["goal"]`` is the user's goal, for
+        evaluation only."""
+        super().reset(seed=seed)
+        options = options or {}
+        unknown = set(options) - {"goal", "start"}
+        if unknown:
+            raise ValueError(
+                f"options: unknown key(s) {sorted(unknown)}; accepted: 'goal', 'start'"
+            )
+        goal = _cell("goal", options.get("goal", self.goal))
+        start = _cell("start", options.get("start", self.start))
+        core_seed = int(self.np_random.integers(0, 2**63 - 1))
+        self._cursor, self._goal = self._core.reset(core_seed, start, goal)
+        self._last = {}
+        return self._obs(0.5, None), {"goal": self._goal, "actions": 0}
+
+    def step(self, action: Any):
+        """Takes an action (0-4) and returns the observation, the reward
+        ``1 - 2 p(error)``, whether the agent said "goal reached", False
+        (the time limit is the wrapper's), and info: ``success``, the
+        user's true judgement ``error``, the decoder's ``decoded_error``,
+        ``p_error``, ``interval_secs`` and the goal."""
+        a = int(action)
+        if not self.action_space.contains(a):
+            raise ValueError(
+                f"action = {action!r} is invalid: expected 0 (up), 1 (down), "
+                "2 (left), 3 (right) or 4 (goal reached)"
+            )
+        d = self._core.step(a, self.observe_epoch)
+        self._cursor = tuple(d["cursor"])
+        p = float(d["p_error"])
+        self._last = d
+        terminated = a == 4
+        info = {
+            "success": bool(d["reached"]),
+            "error": bool(d["error"]),
+            "decoded_error": bool(d["decoded_error"]),
+            "p_error": p,
+            "interval_secs": float(d["interval_secs"]),
+            "goal": self._goal,
+        }
+        return self._obs(p, d.get("epoch")), 1.0 - 2.0 * p, terminated, False, info
+
+    def render(self) -> Optional[str]:
+        """The grid as text (row 4 on top): C the cursor, G the goal."""
+        if self.render_mode != "ansi":
+            return None
+        rows = []
+        for y in reversed(range(5)):
+            row = ""
+            for x in range(5):
+                c = "C" if (x, y) == tuple(self._cursor) else "."
+                if (x, y) == tuple(self._goal):
+                    c = "*" if c == "C" else "G"
+                row += c
+            rows.append(row)
+        p = self._last.get("p_error")
+        tail = "" if p is None else f"\np(error) = {p:.2f}"
+        return "\n".join(rows) + tail
+
+
+class EpuckEnv(gym.Env):
+    """The e-puck task with the robot driven by an agent.
+
+    Every action is a motion primitive held for ``windows_per_action``
+    decoder windows of 62.5 ms (0.25 s by default): 0 forward (the
+    scenario's drive speed), 1 turn left, 2 turn right (in place, the
+    scenario's turn speed), 3 stop. The synthetic user watches the robot
+    through the ceiling camera and judges its motion against a goal the
+    agent is not told; the testbed's sliding-window SVM turns the EEG into
+    p(error) every window. The observation is the pose the camera sees
+    ``(x_m, y_m, heading_rad)``, the p(error) of each window of the action
+    and whether the scenario's detector reported an error; the reward is
+    the mean of ``1 - 2 p(error)`` over the action's windows. Stopping on
+    a goal (within the scenario's goal radius) commits to it and ends the
+    episode (``info["success"]``: it was the user's); the time limit is
+    ``max_episode_steps`` actions (1200: 5 minutes at 0.25 s).
+
+    Parameters
+    ----------
+    scenario : path, optional
+        An e-puck scenario; by default the built-in Mexico-to-Pisa run.
+    accuracy, overrides :
+        As for :class:`GridEnv`.
+    goal : int or str, optional
+        The user's goal: an index into :attr:`goal_names` or a city name
+        (the scenario's by default; ``reset(options={"goal": ...})`` sets
+        it for one episode).
+    windows_per_action : int
+        Windows of 62.5 ms each action lasts, 1 to 64.
+    observe_window : bool
+        Add the last window of preprocessed EEG, ``(n_channels,
+        n_samples)`` float32 in uV, to the observation.
+    """
+
+    metadata = {"render_modes": ["ansi"]}
+
+    def __init__(
+        self,
+        scenario: Optional[str] = None,
+        *,
+        accuracy: Optional[float] = None,
+        overrides: Optional[dict] = None,
+        goal: Any = None,
+        windows_per_action: int = 4,
+        observe_window: bool = False,
+        render_mode: Optional[str] = None,
+    ) -> None:
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(
+                f"render_mode = {render_mode!r} is invalid: expected None or 'ansi'"
+            )
+        if not (isinstance(windows_per_action, int) and 1 <= windows_per_action <= 64):
+            raise ValueError(
+                f"windows_per_action = {windows_per_action!r} is invalid: expected a "
+                "whole number from 1 to 64 (windows of 62.5 ms)"
+            )
+        self._core = _core.EpuckEnvCore(
+            None if scenario is None else os.fspath(scenario),
+            accuracy=accuracy,
+            overrides=None if overrides is None else dict(overrides),
+        )
+        self.goal_names = list(self._core.goal_names)
+        #: The goals as (name, x_m, y_m): where the cities are is no secret;
+        #: which one the user wants is.
+        self.goals = [tuple(g) for g in self._core.goals]
+        #: How near a goal's centre the robot must stop to commit to it (m).
+        self.goal_radius_m = float(self._core.goal_radius_m)
+        self.goal = self._goal_index(goal)
+        self.windows_per_action = windows_per_action
+        self.observe_window = bool(observe_window)
+        self.render_mode = render_mode
+        size = float(self._core.arena_size_m)
+        self.action_space = spaces.Discrete(4)
+        obs = {
+            "pose": spaces.Box(
+                np.array([0.0, 0.0, -np.pi], dtype=np.float32),
+                np.array([size, size, np.pi], dtype=np.float32),
+                dtype=np.float32,
+            ),
+            "p_error": spaces.Box(0.0, 1.0, shape=(windows_per_action,), dtype=np.float32),
+            "detected": spaces.Discrete(2),
+        }
+        if self.observe_window:
+            names, n_samples, _ = self._core.window_shape
+            obs["window"] = spaces.Box(
+                -np.inf, np.inf, shape=(len(names), n_samples), dtype=np.float32
+            )
+        self.observation_space = spaces.Dict(obs)
+        self._size = size
+        self._pose = (0.0, 0.0, 0.0)
+        self._goal = 0
+        self._time = 0.0
+
+    @property
+    def ch_names(self) -> list:
+        """Channels of a window."""
+        return list(self._core.window_shape[0])
+
+    @property
+    def sfreq(self) -> float:
+        """Sampling rate (Hz)."""
+        return self._core.window_shape[2]
+
+    def _goal_index(self, goal: Any) -> Optional[int]:
+        if goal is None:
+            return None
+        if isinstance(goal, str):
+            if goal not in self.goal_names:
+                raise ValueError(
+                    f"goal = {goal!r} is invalid: expected one of the 25 cities "
+                    f"({', '.join(self.goal_names)}) or an index 0-24"
+                )
+            return self.goal_names.index(goal)
+        g = int(goal)
+        if not 0 <= g < len(self.goal_names):
+            raise ValueError(
+                f"goal = {goal!r} is invalid: expected an index from 0 to "
+                f"{len(self.goal_names) - 1} or a city name"
+            )
+        return g
+
+    def _obs(self, p_error, detected: bool, window) -> dict:
+        x, y, h = self._pose
+        obs = {
+            "pose": np.array(
+                [
+                    min(max(x, 0.0), self._size),
+                    min(max(y, 0.0), self._size),
+                    np.arctan2(np.sin(h), np.cos(h)),
+                ],
+                dtype=np.float32,
+            ),
+            "p_error": np.asarray(p_error, dtype=np.float32),
+            "detected": int(detected),
+        }
+        if self.observe_window:
+            shape = self.observation_space["window"].shape
+            obs["window"] = (
+                np.zeros(shape, dtype=np.float32)
+                if window is None
+                else np.asarray(window, dtype=np.float32)
+            )
+        return obs
+
+    def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None):
+        """Starts an episode at the scenario's start pose; p_error is 0.5 (no
+        feedback yet). ``info["goal"]`` names the user's goal, for
+        evaluation only."""
+        super().reset(seed=seed)
+        options = options or {}
+        unknown = set(options) - {"goal"}
+        if unknown:
+            raise ValueError(f"options: unknown key(s) {sorted(unknown)}; accepted: 'goal'")
+        goal = self._goal_index(options.get("goal", self.goal))
+        core_seed = int(self.np_random.integers(0, 2**63 - 1))
+        self._pose, self._goal = self._core.reset(core_seed, goal)
+        self._time = 0.0
+        p = np.full(self.windows_per_action, 0.5, dtype=np.float32)
+        return self._obs(p, False, None), {"goal": self.goal_names[self._goal], "time_secs": 0.0}
+
+    def step(self, action: Any):
+        """Runs a motion primitive (0-3) and returns the observation, the
+        mean of ``1 - 2 p(error)``, whether the robot stopped on a goal,
+        False, and info: ``success``, ``committed`` (the city stopped on),
+        ``errps`` (the user's ErrPs during the action, for scoring),
+        ``time_secs`` and the goal."""
+        a = int(action)
+        if not self.action_space.contains(a):
+            raise ValueError(
+                f"action = {action!r} is invalid: expected 0 (forward), 1 (turn left), "
+                "2 (turn right) or 3 (stop)"
+            )
+        d = self._core.step(a, self.windows_per_action, self.observe_window)
+        self._pose = tuple(d["pose"])
+        self._time = float(d["time_secs"])
+        p = np.asarray(d["p_error"], dtype=np.float64)
+        on_goal = d["on_goal"]
+        terminated = a == 3 and on_goal is not None
+        info = {
+            "success": terminated and on_goal == self._goal,
+            "committed": self.goal_names[on_goal] if terminated else None,
+            "errps": int(d["errps"]),
+            "time_secs": self._time,
+            "goal": self.goal_names[self._goal],
+        }
+        reward = float(np.mean(1.0 - 2.0 * p))
+        return self._obs(p, d["detected"], d.get("window")), reward, terminated, False, info
+
+    def render(self) -> Optional[str]:
+        """The pose and time as text."""
+        if self.render_mode != "ansi":
+            return None
+        x, y, h = self._pose
+        return (
+            f"t = {self._time:.2f} s: e-puck at ({100 * x:.1f}, {100 * y:.1f}) cm, "
+            f"heading {np.degrees(h):.0f} deg; the user wants {self.goal_names[self._goal]}"
+        )
+
+
+def _cell(name: str, c) -> Optional[Tuple[int, int]]:
+    if c is None:
+        return None
+    try:
+        x, y = (int(v) for v in c)
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"{name} = {c!r} is invalid: expected a cell (x, y) of the 5x5 grid, "
+            "x and y from 0 to 4"
+        ) from None
+    if not (0 <= x < 5 and 0 <= y < 5):
+        raise ValueError(
+            f"{name} = ({x}, {y}) is invalid: expected a cell (x, y) of the 5x5 grid, "
+            "x and y from 0 to 4"
+        )
+    return (x, y)
+
+
+def _register() -> None:
+    if "errp/Grid-v0" not in gym.registry:
+        gym.register(
+            id="errp/Grid-v0",
+            entry_point="errp.gym:GridEnv",
+            max_episode_steps=100,
+        )
+    if "errp/Epuck-v0" not in gym.registry:
+        gym.register(
+            id="errp/Epuck-v0",
+            entry_point="errp.gym:EpuckEnv",
+            max_episode_steps=1200,
+        )
+
+
+_register()
