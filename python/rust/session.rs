@@ -35,13 +35,10 @@ pub(crate) fn simulate_session<'py>(
     let (report, raw, events) = py
         .detach(|| {
             let request = CalibrationRequest::new(accuracy, seed);
-            let mut raw: Option<EegBlock> = None;
+            let mut blocks: Vec<EegBlock> = Vec::new();
             let mut events: Vec<Assessment> = Vec::new();
             let mut sink = |block: &EegBlock, now: &[Assessment]| -> errp_bci::Result<()> {
-                match raw.as_mut() {
-                    Some(r) => r.append(block),
-                    None => raw = Some(block.clone()),
-                }
+                blocks.push(block.clone());
                 events.extend_from_slice(now);
                 Ok(())
             };
@@ -50,7 +47,7 @@ pub(crate) fn simulate_session<'py>(
                 ..SessionOptions::default()
             };
             let report = run_calibration(&request, |_| {}, options)?;
-            Ok::<_, errp_sim::SimError>((report, raw.unwrap_or(EegBlock::zeros(0, 0)), events))
+            Ok::<_, errp_sim::SimError>((report, EegBlock::concat(&blocks), events))
         })
         .map_err(py_err)?;
 

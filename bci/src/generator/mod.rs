@@ -170,6 +170,31 @@ impl EegBlock {
         &mut self.data[ch * self.n_samples..(ch + 1) * self.n_samples]
     }
 
+    /// The blocks one after another (all with the same channel count), in
+    /// one allocation: for many blocks, where repeated [`append`]s would
+    /// copy the growing block each time.
+    ///
+    /// [`append`]: Self::append
+    pub fn concat(blocks: &[EegBlock]) -> EegBlock {
+        let n_channels = blocks.first().map_or(0, |b| b.n_channels);
+        assert!(
+            blocks.iter().all(|b| b.n_channels == n_channels),
+            "channel counts differ"
+        );
+        let n_samples = blocks.iter().map(|b| b.n_samples).sum();
+        let mut data = Vec::with_capacity(n_channels * n_samples);
+        for ch in 0..n_channels {
+            for b in blocks {
+                data.extend_from_slice(b.channel(ch));
+            }
+        }
+        EegBlock {
+            n_channels,
+            n_samples,
+            data,
+        }
+    }
+
     /// Appends `other` (same channel count) after this block's samples.
     pub fn append(&mut self, other: &EegBlock) {
         assert_eq!(self.n_channels, other.n_channels, "channel counts differ");
@@ -214,6 +239,18 @@ mod tests {
 
     fn generator(seed: u64) -> EegGenerator {
         EegGenerator::new(GeneratorParams::default(), &Montage::standard(), seed).unwrap()
+    }
+
+    #[test]
+    fn concat_equals_appending_block_by_block() {
+        let mut g = generator(2);
+        let blocks: Vec<EegBlock> = (1..5).map(|k| g.generate(37 * k)).collect();
+        let mut appended = blocks[0].clone();
+        for b in &blocks[1..] {
+            appended.append(b);
+        }
+        assert_eq!(EegBlock::concat(&blocks), appended);
+        assert_eq!(EegBlock::concat(&[]).n_samples, 0);
     }
 
     #[test]
