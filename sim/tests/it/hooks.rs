@@ -1,0 +1,191 @@
+//! The hooks through which decoders and agents of the user's own enter the
+//! loop (the Python package's): a decoder given the epochs or windows reads
+//! exactly the EEG the testbed's own decoder reads, pre-scored banks and the
+//! step-by-step environments are seeded, and bad p(error) is refused.
+
+use std::sync::Arc;
+
+use errp_bci::{EegBlock, EpochWindow, ErrorModel};
+use errp_robot::{Cell, GridAction};
+use errp_sim::epuck::{
+    EpuckAction, EpuckEnvironment, prepare_continuous_decoder, run_epuck_episode,
+    run_epuck_episode_with,
+};
+use errp_sim::grid::{
+    AssessmentDecoder, EpochBlocks, GridDecoding, GridEnvironment, GridTaskParams, PErrorMapping,
+    run_grid_episode, run_grid_episode_with,
+};
+
+use crate::{epuck, grid};
+
+/// The streamed EEG decoder at 80 % (seed 3), with the paper's sigmoid, so
+/// that its class (y >= 0) is p >= 0.5.
+fn sigmoid_decoder() -> AssessmentDecoder {
+    match grid::eeg_decoder(0.8, 3) {
+        AssessmentDecoder::Eeg(mut d) => {
+            d.p_error = PErrorMapping::Sigmoid;
+            AssessmentDecoder::Eeg(d)
+        }
+        _ => unreachable!("eeg_decoder streams"),
+    }
+}
+
+#[test]
+fn an_epoch_decoder_reads_the_eeg_the_builtin_decoder_reads() {
+    let builtin = sigmoid_decoder();
+    let AssessmentDecoder::Eeg(d) = &builtin else {
+        unreachable!()
+    };
+    let params = GridTaskParams::default();
+    let t = grid::table(&params);
+    let (start, goal) = (Cell::new(0, 0), Cell::new(3, 4));
+    let want = run_grid_episode(start, goal, &t, &params, &builtin, 9, true).unwrap();
+    let window = EpochWindow::paper(256.0);
+    let mut calls = 0;
+    let mut decode = |epoch: &EegBlock| {
+        calls += 1;
+        assert_eq!((epoch.n_channels, epoch.n_samples), (8, window.span()));
+        Ok(errp_bci::sigmoid(
+            d.model.decision(&window.extract(epoch, 0)),
+        ))
+    };
+    let decoding = GridDecoding::Epochs {
+        source: d.source(),
+        decode: &mut decode,
+    };
+    let got = run_grid_episode_with(start, goal, &t, &params, decoding, 9, true).unwrap();
+    assert_eq!(got, want);
+    assert_eq!(calls, want.actions);
+}
+
+#[test]
+fn a_perfect_scored_bank_walks_straight_to_the_goal() {
+    let params = GridTaskParams::default();
+    let t = grid::table(&params);
+    let (start, goal) = (Cell::new(0, 0), Cell::new(3, 4));
+    let (error, correct) = ([0.95; 3], [0.05; 3]);
+    let run = |seed| {
+        let decoding = GridDecoding::Scores {
+            error: &error,
+            correct: &correct,
+        };
+        run_grid_episode_with(start, goal, &t, &params, decoding, seed, false).unwrap()
+    };
+    let r = run(1);
+    assert!(r.reached(), "{r:?}");
+    assert_eq!((r.online.correct, r.online.error), (1.0, 1.0));
+    assert!(r.actions < 40, "{} actions", r.actions);
+    assert_eq!(run(1), r);
+
+    // Out of [0, 1]: refused by name, before any action.
+    let bad = [1.5];
+    let decoding = GridDecoding::Scores {
+        error: &bad,
+        correct: &correct,
+    };
+    let e = run_grid_episode_with(start, goal, &t, &params, decoding, 1, false).unwrap_err();
+    assert!(
+        e.to_string().contains("decoder: returned p(error) = 1.5"),
+        "{e}"
+    );
+}
+
+#[test]
+fn epoch_blocks_hold_both_classes_from_one_seed() {
+    let AssessmentDecoder::Eeg(d) = sigmoid_decoder() else {
+        unreachable!()
+    };
+    let params = GridTaskParams::default();
+    let a = EpochBlocks::build(d.source(), &params, 6, 2).unwrap();
+    let b = EpochBlocks::build(d.source(), &params, 6, 2).unwrap();
+    assert_eq!((a.error.len(), a.correct.len()), (6, 6));
+    assert_eq!(a.error, b.error);
+    assert_ne!(a.error[0], a.correct[0]);
+}
+
+#[test]
+fn the_grid_environment_judges_and_decodes_each_action() {
+    let decoder = Arc::new(sigmoid_decoder());
+    let params = GridTaskParams::default();
+    let start = Some(Cell::new(0, 0));
+    let goal = Some(Cell::new(2, 0));
+    let mut env = GridEnvironment::new(decoder.clone(), params, start, goal, 4).unwrap();
+    let mut again = GridEnvironment::new(decoder.clone(), params, start, goal, 4).unwrap();
+    let right = env.step(GridAction::Right, true).unwrap();
+    assert!(!right.error && right.cell == Cell::new(1, 0));
+    assert_eq!(right.epoch.as_ref().map(|e| e.n_channels), Some(8));
+    assert_eq!(again.step(GridAction::Right, true).unwrap(), right);
+    let left = env.step(GridAction::Left, false).unwrap();
+    assert!(left.error && left.epoch.is_none());
+    env.step(GridAction::Right, false).unwrap();
+    let stop = env.step(GridAction::Right, false).unwrap();
+    assert!(!stop.error && stop.cell == Cell::new(2, 0));
+    let done = env.step(GridAction::GoalReached, false).unwrap();
+    assert!(done.reached && !done.error && env.actions() == 5);
+
+    // Cells drawn from the seed, and bad cells refused by name.
+    let drawn = GridEnvironment::new(decoder.clone(), params, None, None, 7).unwrap();
+    let same = GridEnvironment::new(decoder.clone(), params, None, None, 7).unwrap();
+    assert_eq!((drawn.cell(), drawn.goal()), (same.cell(), same.goal()));
+    let e = GridEnvironment::new(decoder, params, Some(Cell::new(5, 0)), None, 7)
+        .err()
+        .unwrap();
+    assert!(
+        e.to_string().contains("start: cell (5, 0) is outside"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_window_decoder_reads_the_windows_the_svm_reads() {
+    let mut s = epuck::scenario("mexico_to_pisa.toml");
+    s.params.max_secs = 20.0;
+    let (decoder, _) = prepare_continuous_decoder(&s, |_| {}).unwrap();
+    let want = run_epuck_episode(
+        &s.params,
+        &s.arena,
+        &s.layout,
+        s.episode,
+        &decoder,
+        5,
+        &mut (),
+    )
+    .unwrap();
+    let mut scratch = Vec::new();
+    let mut calls = 0;
+    let mut decode = |w: &EegBlock| {
+        calls += 1;
+        scratch.clear();
+        decoder.features.extract_into(w, 0, &mut scratch);
+        Ok(decoder.model.p_error(&scratch))
+    };
+    let got = run_epuck_episode_with(
+        &s.params,
+        &s.arena,
+        &s.layout,
+        s.episode,
+        &decoder,
+        5,
+        &mut (),
+        Some(&mut decode),
+    )
+    .unwrap();
+    assert_eq!(got, want);
+    assert_eq!(calls as f64, (want.time_secs / 0.0625).round());
+
+    // The environment: seeded, and the motion is the agent's.
+    let decoder = Arc::new(decoder);
+    let mut env = EpuckEnvironment::new(decoder.clone(), &s, None, 5).unwrap();
+    let mut twin = EpuckEnvironment::new(decoder.clone(), &s, None, 5).unwrap();
+    let h0 = env.tracked().heading_rad;
+    let turned = env.step(EpuckAction::TurnLeft, 8, true).unwrap();
+    assert_eq!(twin.step(EpuckAction::TurnLeft, 8, true).unwrap(), turned);
+    assert!(turned.tracked.heading_rad - h0 > 0.3, "{turned:?}");
+    assert_eq!(turned.p_error.len(), 8);
+    assert!(turned.window.is_some() && turned.time_secs == 0.5);
+    let y0 = env.tracked().y_m;
+    env.step(EpuckAction::TurnRight, 8, false).unwrap();
+    let ahead = env.step(EpuckAction::Forward, 16, false).unwrap();
+    assert!(ahead.tracked.y_m - y0 > 0.03, "{ahead:?}");
+    assert!(env.step(EpuckAction::Stop, 0, false).is_err());
+}
