@@ -5,6 +5,8 @@
 use std::path::{Path, PathBuf};
 
 use errp_bci::{EegBlock, Montage};
+use errp_sim::epuck::EpuckScenario;
+use errp_sim::grid::GridScenario;
 use errp_sim::{AnyScenario, SimError};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray2};
@@ -241,4 +243,59 @@ pub(crate) fn check_callable(py: Python<'_>, name: &str, f: Option<&Py<PyAny>>) 
         ))),
         _ => Ok(()),
     }
+}
+
+/// The scenario keyword with `accuracy=` and `overrides=` set: the file
+/// given, or the built-in scenario of the e-puck (`default_epuck`) or of the
+/// grid.
+pub(crate) fn load_any(
+    scenario: Option<PathBuf>,
+    default_epuck: bool,
+    accuracy: Option<f64>,
+    given: Option<&Bound<'_, PyDict>>,
+) -> PyResult<AnyScenario> {
+    let mut extra = Vec::new();
+    if let Some(a) = accuracy {
+        extra.push(("user.accuracy".to_string(), toml::Value::Float(a)));
+    }
+    ScenarioSource::new(scenario, default_epuck).load(&overrides(extra, given)?)
+}
+
+/// A grid scenario (the built-in one by default); `who` names what needs
+/// it in the error for an e-puck scenario.
+pub(crate) fn load_grid(
+    scenario: Option<PathBuf>,
+    accuracy: Option<f64>,
+    given: Option<&Bound<'_, PyDict>>,
+    who: &str,
+) -> PyResult<GridScenario> {
+    let shown = shown(&scenario);
+    match load_any(scenario, false, accuracy, given)? {
+        AnyScenario::Grid(s) => Ok(*s),
+        AnyScenario::Epuck(_) => Err(PyValueError::new_err(format!(
+            "scenario: {shown} is an e-puck scenario; {who} needs a grid scenario"
+        ))),
+    }
+}
+
+/// An e-puck scenario (the built-in Mexico-to-Pisa one by default).
+pub(crate) fn load_epuck(
+    scenario: Option<PathBuf>,
+    accuracy: Option<f64>,
+    given: Option<&Bound<'_, PyDict>>,
+    who: &str,
+) -> PyResult<EpuckScenario> {
+    let shown = shown(&scenario);
+    match load_any(scenario, true, accuracy, given)? {
+        AnyScenario::Epuck(s) => Ok(*s),
+        AnyScenario::Grid(_) => Err(PyValueError::new_err(format!(
+            "scenario: {shown} is a grid scenario; {who} needs an e-puck scenario"
+        ))),
+    }
+}
+
+fn shown(scenario: &Option<PathBuf>) -> String {
+    scenario
+        .as_ref()
+        .map_or_else(String::new, |p| p.display().to_string())
 }

@@ -5,7 +5,6 @@ use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
 use errp_robot::{Cell, GridAction};
-use errp_sim::AnyScenario;
 use errp_sim::epuck::{
     ContinuousDecoder, EpuckAction, EpuckEnvironment, EpuckScenario, EpuckTask as EpuckInfo,
     prepare_continuous_decoder,
@@ -15,11 +14,11 @@ use errp_sim::grid::{
 };
 use errp_sim::task::Task;
 use numpy::PyArray2;
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{ScenarioSource, block_to_numpy, overrides, py_err, value_error};
+use crate::convert::{block_to_numpy, load_epuck, load_grid, py_err, value_error};
 
 /// How many calibrated decoders of each task a process keeps, so that
 /// environments of one scenario (made again by `gym.make`, vectorised
@@ -84,16 +83,7 @@ impl GridEnvCore {
         accuracy: Option<f64>,
         overrides: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
-        let mut extra = Vec::new();
-        if let Some(a) = accuracy {
-            extra.push(("user.accuracy".to_string(), toml::Value::Float(a)));
-        }
-        let any = ScenarioSource::new(scenario, false).load(&self::overrides(extra, overrides)?)?;
-        let AnyScenario::Grid(s) = any else {
-            return Err(PyValueError::new_err(
-                "scenario: an e-puck scenario; the grid environment needs a grid scenario",
-            ));
-        };
+        let s = load_grid(scenario, accuracy, overrides, "the grid environment")?;
         let key = GridInfo::decoder_key(&s);
         let decoder = match cached(&GRID_DECODERS, &key) {
             Some(d) => d,
@@ -103,7 +93,7 @@ impl GridEnvCore {
             }
         };
         Ok(Self {
-            scenario: *s,
+            scenario: s,
             decoder,
             episode: None,
         })
@@ -226,16 +216,7 @@ impl EpuckEnvCore {
         accuracy: Option<f64>,
         overrides: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
-        let mut extra = Vec::new();
-        if let Some(a) = accuracy {
-            extra.push(("user.accuracy".to_string(), toml::Value::Float(a)));
-        }
-        let any = ScenarioSource::new(scenario, true).load(&self::overrides(extra, overrides)?)?;
-        let AnyScenario::Epuck(s) = any else {
-            return Err(PyValueError::new_err(
-                "scenario: a grid scenario; the e-puck environment needs an e-puck scenario",
-            ));
-        };
+        let s = load_epuck(scenario, accuracy, overrides, "the e-puck environment")?;
         let key = EpuckInfo::decoder_key(&s);
         let decoder = match cached(&EPUCK_DECODERS, &key) {
             Some(d) => d,
@@ -247,7 +228,7 @@ impl EpuckEnvCore {
             }
         };
         Ok(Self {
-            scenario: *s,
+            scenario: s,
             decoder,
             episode: None,
         })

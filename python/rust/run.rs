@@ -6,7 +6,10 @@ use std::sync::atomic::AtomicBool;
 
 use errp_bci::rng::derive_seed;
 use errp_sim::AnyScenario;
-use errp_sim::epuck::{EpuckScenario, EpuckTask, epuck_row, epuck_run_seed};
+use errp_sim::calibration::CalibrationReport;
+use errp_sim::epuck::{
+    ContinuousDecoder, ContinuousReport, EpuckScenario, EpuckTask, epuck_row, epuck_run_seed,
+};
 use errp_sim::grid::{GridScenario, GridTask, grid_row, prepare_decoder, run_grid_scenario};
 use errp_sim::task::{EpisodeRow, Task, TaskInfo, format_number};
 use errp_sweep::{
@@ -17,7 +20,7 @@ use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{ScenarioSource, overrides, py_err, value_error};
+use crate::convert::{load_any, py_err, value_error};
 
 /// Keyword names in errors.
 const NAMES: InputNames = InputNames {
@@ -83,20 +86,6 @@ pub(crate) fn check_save(save: Option<&PathBuf>) -> PyResult<()> {
     Ok(())
 }
 
-/// Loads the scenario of `run` with its keyword overrides.
-pub(crate) fn load(
-    scenario: Option<PathBuf>,
-    accuracy: Option<f64>,
-    given: Option<&Bound<'_, PyDict>>,
-) -> PyResult<AnyScenario> {
-    let source = ScenarioSource::new(scenario, true);
-    let mut extra = Vec::new();
-    if let Some(a) = accuracy {
-        extra.push(("user.accuracy".to_string(), toml::Value::Float(a)));
-    }
-    source.load(&overrides(extra, given)?)
-}
-
 /// Runs a scenario as `errp run` does (the same decoder, seeds and
 /// results) and returns its episodes as CSV text, one row per episode, and
 /// what was calibrated.
@@ -112,7 +101,7 @@ pub(crate) fn run<'py>(
     save: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyDict>> {
     check_save(save.as_ref())?;
-    let any = load(scenario, accuracy, overrides)?;
+    let any = load_any(scenario, true, accuracy, overrides)?;
     let out = PyDict::new(py);
     match any {
         AnyScenario::Grid(mut s) => {
@@ -163,6 +152,49 @@ pub(crate) fn run<'py>(
 /// What a calibration found, for Python.
 pub(crate) type DecoderSummary = Vec<(&'static str, f64)>;
 
+/// What the grid decoder's calibration found (none for the oracle).
+pub(crate) fn grid_summary(
+    s: &GridScenario,
+    calibration: Option<&CalibrationReport>,
+) -> DecoderSummary {
+    let mut info = vec![("accuracy", s.accuracy)];
+    if let Some(c) = calibration {
+        let a = c.calibrated.accuracy;
+        info.extend([
+            ("errp_to_noise", c.targeting.ratio),
+            ("cv_correct", a.correct),
+            ("cv_error", a.error),
+            ("cv_mean", a.mean()),
+        ]);
+    }
+    info
+}
+
+/// What the continuous decoder's calibration found, with its T_e and its
+/// operating point on the held-out recording.
+pub(crate) fn epuck_summary(
+    s: &EpuckScenario,
+    decoder: &ContinuousDecoder,
+    report: &ContinuousReport,
+) -> DecoderSummary {
+    let a = report.calibrated.accuracy;
+    let mut info = vec![
+        ("accuracy", s.accuracy.get()),
+        ("errp_to_noise", report.generator.errp_to_noise),
+        ("cv_correct", a.correct),
+        ("cv_error", a.error),
+        ("cv_mean", a.mean()),
+        ("t_e", decoder.t_e(s.params.control.t_e)),
+    ];
+    if let Some(o) = &decoder.online {
+        info.extend([
+            ("online_hit_rate", o.point.hit_rate),
+            ("online_false_alarms_per_min", o.point.false_alarms_per_min),
+        ]);
+    }
+    info
+}
+
 fn run_grid(
     s: &GridScenario,
     save: Option<&PathBuf>,
@@ -181,16 +213,7 @@ fn run_grid(
         let seed = derive_seed(s.seed, "grid/episode", k as u64);
         lines.push(line(s.accuracy, k, seed, grid_row(r)));
     }
-    let mut info = vec![("accuracy", s.accuracy)];
-    if let Some(c) = &calibration {
-        let a = c.calibrated.accuracy;
-        info.extend([
-            ("errp_to_noise", c.targeting.ratio),
-            ("cv_correct", a.correct),
-            ("cv_error", a.error),
-            ("cv_mean", a.mean()),
-        ]);
-    }
+    let info = grid_summary(s, calibration.as_ref());
     #[cfg(feature = "rerun")]
     if let Some(file) = rrd {
         let report = errp_sim::grid::GridRunReport {
@@ -227,21 +250,7 @@ fn run_epuck(
         let seed = epuck_run_seed(s.seed, k);
         lines.push(line(s.accuracy.get(), k, seed, epuck_row(&s.layout, r)));
     }
-    let a = report.calibrated.accuracy;
-    let mut info = vec![
-        ("accuracy", s.accuracy.get()),
-        ("errp_to_noise", report.generator.errp_to_noise),
-        ("cv_correct", a.correct),
-        ("cv_error", a.error),
-        ("cv_mean", a.mean()),
-        ("t_e", decoder.t_e(s.params.control.t_e)),
-    ];
-    if let Some(o) = &decoder.online {
-        info.extend([
-            ("online_hit_rate", o.point.hit_rate),
-            ("online_false_alarms_per_min", o.point.false_alarms_per_min),
-        ]);
-    }
+    let info = epuck_summary(s, &decoder, &report);
     #[cfg(feature = "rerun")]
     if let Some(file) = rrd {
         file.finish()?;

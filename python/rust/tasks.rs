@@ -8,7 +8,6 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use errp_bci::EegBlock;
 use errp_bci::rng::derive_seed;
-use errp_sim::AnyScenario;
 use errp_sim::epuck::{
     ContinuousDecoder, EpuckScenario, EpuckTask as EpuckInfo, epuck_row, epuck_run_seed,
     run_epuck_batch, run_epuck_episode_with,
@@ -24,9 +23,10 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::{
-    PyDecoder, blocks_to_array3, channel_names, check_callable, py_err, value_error,
+    PyDecoder, blocks_to_array3, channel_names, check_callable, load_epuck, load_grid, py_err,
+    value_error,
 };
-use crate::run::{header, line, load};
+use crate::run::{epuck_summary, grid_summary, header, line};
 
 /// The EEG pipeline behind a grid decoder, if it reads EEG.
 fn eeg_of(d: &AssessmentDecoder) -> Option<&EegDecoder> {
@@ -66,16 +66,7 @@ impl GridTask {
         accuracy: Option<f64>,
         overrides: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
-        let given = scenario.clone();
-        let mut s = match grid_default(scenario, accuracy, overrides)? {
-            AnyScenario::Grid(s) => *s,
-            AnyScenario::Epuck(_) => {
-                return Err(PyValueError::new_err(format!(
-                    "scenario: {} is an e-puck scenario; use errp.EpuckTask",
-                    given.map(|p| p.display().to_string()).unwrap_or_default()
-                )));
-            }
-        };
+        let mut s = load_grid(scenario, accuracy, overrides, "errp.GridTask")?;
         if let Some(seed) = seed {
             s.seed = seed;
         }
@@ -87,16 +78,7 @@ impl GridTask {
             ));
         }
         let (builtin, calibration) = py.detach(|| prepare_decoder(&s, |_| {})).map_err(py_err)?;
-        let mut info = vec![("accuracy", s.accuracy)];
-        if let Some(c) = &calibration {
-            let a = c.calibrated.accuracy;
-            info.extend([
-                ("errp_to_noise", c.targeting.ratio),
-                ("cv_correct", a.correct),
-                ("cv_error", a.error),
-                ("cv_mean", a.mean()),
-            ]);
-        }
+        let info = grid_summary(&s, calibration.as_ref());
         if (decoder.is_some() || batch_decoder.is_some()) && eeg_of(&builtin).is_none() {
             return Err(PyValueError::new_err(
                 "decoder: the scenario's decoder is the oracle (no EEG); a decoder of your own \
@@ -250,25 +232,6 @@ impl GridTask {
     }
 }
 
-/// A grid scenario, the built-in one by default.
-fn grid_default(
-    scenario: Option<PathBuf>,
-    accuracy: Option<f64>,
-    overrides: Option<&Bound<'_, PyDict>>,
-) -> PyResult<AnyScenario> {
-    match scenario {
-        Some(p) => load(Some(p), accuracy, overrides),
-        None => {
-            let mut extra = Vec::new();
-            if let Some(a) = accuracy {
-                extra.push(("user.accuracy".to_string(), toml::Value::Float(a)));
-            }
-            crate::convert::ScenarioSource::new(None, false)
-                .load(&crate::convert::overrides(extra, overrides)?)
-        }
-    }
-}
-
 /// The e-puck task of a scenario (sec. 5): its continuous decoder
 /// calibrated once, then runs decoded by it or by a decoder of the caller's
 /// own, called with every 62.5 ms window.
@@ -295,16 +258,7 @@ impl EpuckTask {
         accuracy: Option<f64>,
         overrides: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
-        let given = scenario.clone();
-        let mut s = match load(scenario, accuracy, overrides)? {
-            AnyScenario::Epuck(s) => *s,
-            AnyScenario::Grid(_) => {
-                return Err(PyValueError::new_err(format!(
-                    "scenario: {} is a grid scenario; use errp.GridTask",
-                    given.map(|p| p.display().to_string()).unwrap_or_default()
-                )));
-            }
-        };
+        let mut s = load_epuck(scenario, accuracy, overrides, "errp.EpuckTask")?;
         if let Some(seed) = seed {
             s.seed = seed;
         }
@@ -312,21 +266,7 @@ impl EpuckTask {
         let (builtin, report) = py
             .detach(|| errp_sim::epuck::prepare_continuous_decoder(&s, |_| {}))
             .map_err(py_err)?;
-        let a = report.calibrated.accuracy;
-        let mut info = vec![
-            ("accuracy", s.accuracy.get()),
-            ("errp_to_noise", report.generator.errp_to_noise),
-            ("cv_correct", a.correct),
-            ("cv_error", a.error),
-            ("cv_mean", a.mean()),
-            ("t_e", builtin.t_e(s.params.control.t_e)),
-        ];
-        if let Some(o) = &builtin.online {
-            info.extend([
-                ("online_hit_rate", o.point.hit_rate),
-                ("online_false_alarms_per_min", o.point.false_alarms_per_min),
-            ]);
-        }
+        let info = epuck_summary(&s, &builtin, &report);
         Ok(Self {
             scenario: s,
             builtin: Arc::new(builtin),

@@ -141,7 +141,7 @@ def test_decoder_mistakes_are_reported(root):
         errp.GridTask(scenario, decoder=3)
     with pytest.raises(ValueError, match="oracle"):
         errp.GridTask(scenario, decoder=lambda x: 0.5, overrides={"decoder": "oracle"})
-    with pytest.raises(ValueError, match="e-puck scenario; use errp.EpuckTask"):
+    with pytest.raises(ValueError, match="e-puck scenario; errp.GridTask needs a grid scenario"):
         errp.GridTask(root / "scenarios/mexico_to_pisa.toml")
 
 

@@ -354,7 +354,42 @@ Decoder = Callable[[np.ndarray], float]
 BatchDecoder = Callable[[np.ndarray], np.ndarray]
 
 
-class GridTask:
+class _Task:
+    """What both tasks' wrappers share: the calibration and the shape of
+    what a decoder of your own is given."""
+
+    _core: Any
+
+    @property
+    def calibration(self) -> dict:
+        """What the calibration of the testbed's decoder found."""
+        return dict(self._core.calibration)
+
+    @property
+    def ch_names(self) -> list:
+        """Channels of each epoch or window given to your decoder."""
+        return list(self._core.ch_names)
+
+    @property
+    def sfreq(self) -> float:
+        """Sampling rate (Hz)."""
+        return self._core.sfreq
+
+    @property
+    def n_samples(self) -> int:
+        """Samples per epoch (from the onset) or window (800 ms)."""
+        return self._core.n_samples
+
+    @property
+    def decoder_calls(self) -> int:
+        """How often your per-epoch or per-window decoder has been called."""
+        return self._core.decoder_calls
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self._core.name!r}, seed={self._core.seed})"
+
+
+class GridTask(_Task):
     """The grid task of a scenario with its decoder calibrated once.
 
     Without ``decoder``, episodes are decoded by the testbed's decoder (the
@@ -409,36 +444,8 @@ class GridTask:
         df.attrs["decoder"] = self.calibration
         return df
 
-    @property
-    def calibration(self) -> dict:
-        """What the calibration of the testbed's decoder found."""
-        return dict(self._core.calibration)
 
-    @property
-    def ch_names(self) -> list:
-        """Channels of each epoch."""
-        return list(self._core.ch_names)
-
-    @property
-    def sfreq(self) -> float:
-        """Sampling rate of the epochs (Hz)."""
-        return self._core.sfreq
-
-    @property
-    def n_samples(self) -> int:
-        """Samples per epoch, from the onset."""
-        return self._core.n_samples
-
-    @property
-    def decoder_calls(self) -> int:
-        """How often the per-epoch decoder has been called."""
-        return self._core.decoder_calls
-
-    def __repr__(self) -> str:
-        return f"GridTask({self._core.name!r}, seed={self._core.seed})"
-
-
-class EpuckTask:
+class EpuckTask(_Task):
     """The e-puck task of a scenario with its continuous decoder calibrated
     once.
 
@@ -485,34 +492,6 @@ class EpuckTask:
         return df
 
     @property
-    def calibration(self) -> dict:
-        """What the calibration of the testbed's decoder found."""
-        return dict(self._core.calibration)
-
-    @property
-    def ch_names(self) -> list:
-        """Channels of each window."""
-        return list(self._core.ch_names)
-
-    @property
-    def sfreq(self) -> float:
-        """Sampling rate (Hz)."""
-        return self._core.sfreq
-
-    @property
-    def n_samples(self) -> int:
-        """Samples per window (800 ms)."""
-        return self._core.n_samples
-
-    @property
     def t_e(self) -> float:
         """The detection threshold your decoder's p(error) is compared with."""
         return self._core.t_e
-
-    @property
-    def decoder_calls(self) -> int:
-        """How often the decoder has been called."""
-        return self._core.decoder_calls
-
-    def __repr__(self) -> str:
-        return f"EpuckTask({self._core.name!r}, seed={self._core.seed})"
