@@ -152,6 +152,18 @@ pub(crate) fn run<'py>(
 /// What a calibration found, for Python.
 pub(crate) type DecoderSummary = Vec<(&'static str, f64)>;
 
+/// A summary as a Python dict.
+pub(crate) fn summary_dict<'py>(
+    py: Python<'py>,
+    s: &DecoderSummary,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    for (k, v) in s {
+        d.set_item(k, v)?;
+    }
+    Ok(d)
+}
+
 /// What the grid decoder's calibration found (none for the oracle).
 pub(crate) fn grid_summary(
     s: &GridScenario,

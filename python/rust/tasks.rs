@@ -26,7 +26,7 @@ use crate::convert::{
     PyDecoder, blocks_to_array3, channel_names, check_callable, load_epuck, load_grid, py_err,
     value_error,
 };
-use crate::run::{epuck_summary, grid_summary, header, line};
+use crate::run::{DecoderSummary, epuck_summary, grid_summary, header, line, summary_dict};
 
 /// The EEG pipeline behind a grid decoder, if it reads EEG.
 fn eeg_of(d: &AssessmentDecoder) -> Option<&EegDecoder> {
@@ -46,7 +46,7 @@ pub(crate) struct GridTask {
     builtin: Arc<AssessmentDecoder>,
     decoder: Option<Py<PyAny>>,
     scores: Option<(Vec<f64>, Vec<f64>)>,
-    calibration: Vec<(&'static str, f64)>,
+    calibration: DecoderSummary,
     calls: AtomicUsize,
 }
 
@@ -142,11 +142,7 @@ impl GridTask {
     /// ratio and the cross-validated accuracies of the testbed's decoder.
     #[getter]
     fn calibration<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        for (k, v) in &self.calibration {
-            d.set_item(k, v)?;
-        }
-        Ok(d)
+        summary_dict(py, &self.calibration)
     }
 
     /// Names of the channels of each epoch (the preprocessed EEG channels).
@@ -240,7 +236,7 @@ pub(crate) struct EpuckTask {
     scenario: EpuckScenario,
     builtin: Arc<ContinuousDecoder>,
     decoder: Option<Py<PyAny>>,
-    calibration: Vec<(&'static str, f64)>,
+    calibration: DecoderSummary,
     calls: AtomicUsize,
 }
 
@@ -331,11 +327,7 @@ impl EpuckTask {
     /// point on a held-out recording).
     #[getter]
     fn calibration<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        for (k, v) in &self.calibration {
-            d.set_item(k, v)?;
-        }
-        Ok(d)
+        summary_dict(py, &self.calibration)
     }
 
     /// Names of the channels of each window (the preprocessed EEG channels).
