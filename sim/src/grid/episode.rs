@@ -148,7 +148,7 @@ pub fn run_grid_episode_with(
     goal: Cell,
     table: &QTable,
     params: &GridTaskParams,
-    decoding: GridDecoding<'_>,
+    mut decoding: GridDecoding<'_>,
     seed: u64,
     record_steps: bool,
 ) -> Result<GridEpisodeResult> {
@@ -164,7 +164,6 @@ pub fn run_grid_episode_with(
     let mut controller = GridController::with_table(table.clone(), params.control);
     let mut rng_user = stream(seed, "grid/user");
     let mut rng_policy = stream(seed, "grid/policy");
-    let mut decoding = decoding;
     let mut decoder = ActionDecoder::start(&decoding, seed)?;
 
     let mut cell = start;
