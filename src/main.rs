@@ -12,7 +12,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use crate::cli::{CalibrateArgs, RunArgs, Table1Args};
-use crate::commands::{calibrate, run, sweep, table1};
+use crate::commands::{calibrate, fit, run, sweep, table1};
 
 /// Simulated shared control of a robot from EEG error potentials.
 #[derive(Parser)]
@@ -49,6 +49,11 @@ enum Command {
     /// Merge the directories of a sharded sweep (`errp sweep --shard K/N`)
     /// into the files one unsharded run writes.
     Merge(sweep::MergeArgs),
+    /// Estimate a parameter the paper does not state from the paper's own
+    /// numbers, by maximum likelihood over a grid with Monte Carlo
+    /// likelihoods.
+    #[command(subcommand)]
+    Fit(fit::FitCommand),
 }
 
 fn main() -> ExitCode {
@@ -63,6 +68,11 @@ fn main() -> ExitCode {
             Ok(())
         }
         Command::Merge(args) => sweep::merge(&args),
+        Command::Fit(cmd) => match fit::fit(&cmd) {
+            Ok(true) => Ok(()),
+            Ok(false) => return ExitCode::from(interrupt::EXIT_INTERRUPTED),
+            Err(e) => Err(e),
+        },
         Command::Sweep(args) => match sweep::sweep(&args) {
             Ok(true) => Ok(()),
             Ok(false) => return ExitCode::from(interrupt::EXIT_INTERRUPTED),

@@ -70,9 +70,9 @@ pub use montage::{Channel, ChannelKind, DECODING_CHANNELS, Montage};
 pub use noise::{PinkNoise, Resonator};
 pub use online::{
     Decision, Detector, DetectorMode, DetectorParams, OnlineRecording, OnlineRecordingParams,
-    OnlineStep, OnlineTarget, OnlineTargeting, OperatingPoint, ResponseSpan, SPAN_FRACTION,
-    SlidingWindow, WARM_UP_SECS, WINDOW_STEP_SECS, operating_point, record_online, response_span,
-    target_online, threshold_for_false_alarms,
+    OnlineStep, OnlineTarget, OnlineTargeting, OperatingPoint, ResponseSpan, SPAN_ALPHA,
+    SlidingWindow, WARM_UP_SECS, WINDOW_STEP_SECS, binomial_upper_tail, detector_span, firings,
+    operating_point, record_online, response_span, target_online, threshold_for_false_alarms,
 };
 pub use platt::PlattScaling;
 pub use preprocess::{PreprocessParams, Preprocessor};

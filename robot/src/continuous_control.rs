@@ -37,9 +37,16 @@
 //!   has no defined bearing; it gets likelihood 1 in turn and linear steps.
 //! - **Goal choice** is greedy ([`Strategy::Greedy`]): the most probable
 //!   goal, ties broken by the goal nearest the robot, then by the lowest
-//!   index. With the uniform belief of the start, a robot placed on a goal
-//!   therefore starts "stopped on" it; the user judges that stop as wrong,
-//!   which is how the start goal gets rejected.
+//!   index.
+//! - **The run starts with the movement** (sec. 5.3 times "from the start
+//!   of the movement"): the user placed the robot on its start, so the goal
+//!   under it is not a target until the robot has left it, and the robot
+//!   turns or drives at once. (Otherwise a detection during the first turn,
+//!   which penalises the goals on one side and never the one under the
+//!   robot, would make the start the most probable goal, and the robot
+//!   would stop on it without having moved, a stop the user does not judge.)
+//!   The start goal keeps its prior; the belief can bring the robot back to
+//!   it later, like any other goal.
 //! - **Goal choice by information gain** ([`Strategy::InfoGain`], not in the
 //!   paper) heads for the goal whose heading the user's next assessment is
 //!   expected to say most about; see
@@ -145,12 +152,16 @@ pub struct ContinuousController {
     converged: Option<usize>,
     /// The goal the robot last left, and until when a detection vetoes it.
     left_goal: Option<(usize, f64)>,
+    /// The goal the robot started on, until it has left it: not a target.
+    start_goal: Option<usize>,
 }
 
 impl ContinuousController {
     /// A controller with a uniform belief, the robot at `start` at time 0.
-    /// The first target is the nearest goal; if the robot is on it, it starts
-    /// stopped on it until `stop_secs`.
+    /// The first target is the strategy's choice among the goals the robot
+    /// is not on (with the uniform belief, greedy takes the nearest): the
+    /// robot moves at once, and the goal it starts on is no target until it
+    /// has left it.
     pub fn new(params: ContinuousControlParams, layout: GoalLayout, start: Pose) -> Result<Self> {
         params.validate()?;
         let goals = layout.goals();
@@ -180,7 +191,9 @@ impl ContinuousController {
             last_heading_rad: start.heading_rad,
             converged: None,
             left_goal: None,
+            start_goal: None,
         };
+        c.start_goal = (0..c.layout.len()).find(|&i| c.on_goal(&start, i));
         c.choose_next(&start, 0.0);
         Ok(c)
     }
@@ -270,18 +283,28 @@ impl ContinuousController {
     /// [`Strategy::Thompson`] never gets here (the parameters' validation
     /// rejects it); it would be greedy.
     pub fn next_target(&self, pose: &Pose) -> usize {
-        let greedy = self.most_probable_goal(pose);
-        if self.params.strategy != Strategy::InfoGain
-            || self.belief.probability(greedy) >= self.params.p_c
-        {
+        self.target_among(pose, |_| true)
+    }
+
+    /// [`next_target`](Self::next_target) among the goals that `candidate`
+    /// accepts.
+    fn target_among(&self, pose: &Pose, candidate: impl Fn(usize) -> bool) -> usize {
+        let p = self.belief.probabilities();
+        let greedy = self.most_probable_of(pose, &p, &candidate);
+        if self.params.strategy != Strategy::InfoGain || p[greedy] >= self.params.p_c {
             return greedy;
         }
-        let p = self.belief.probabilities();
         let gains: Vec<f64> = (0..self.layout.len())
-            .map(|g| self.gain(&p, pose, g))
+            .map(|g| {
+                if candidate(g) {
+                    self.gain(&p, pose, g)
+                } else {
+                    f64::NEG_INFINITY
+                }
+            })
             .collect();
         let best = gains.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        self.most_probable_of(pose, &p, |g| gains[g] >= best - 1e-12)
+        self.most_probable_of(pose, &p, |g| candidate(g) && gains[g] >= best - 1e-12)
     }
 
     /// The expected information gain, nats, of one decoder window spent
@@ -352,9 +375,11 @@ impl ContinuousController {
         )
     }
 
-    /// Picks the next target and starts towards it (or stays stopped on it).
+    /// Picks the next target (never the start goal before the robot has
+    /// left it) and starts towards it (or stays stopped on it).
     fn choose_next(&mut self, pose: &Pose, time_secs: f64) {
-        self.target = self.next_target(pose);
+        let start = self.start_goal;
+        self.target = self.target_among(pose, |i| Some(i) != start);
         self.phase = if self.on_goal(pose, self.target) {
             self.stop(time_secs, StopReason::OnGoal(self.target))
         } else {
@@ -381,6 +406,11 @@ impl ContinuousController {
     /// tracked pose; also ends stops and switches between turning and
     /// driving. Zero while stopped. Never above the top speed.
     pub fn command(&mut self, pose: &Pose, time_secs: f64) -> WheelSpeeds {
+        if let Some(s) = self.start_goal
+            && !self.on_goal(pose, s)
+        {
+            self.start_goal = None;
+        }
         let epuck = self.params.epuck;
         let top = epuck.max_speed_m_per_s();
         let align = self.params.align_tolerance_deg.to_radians();
@@ -544,43 +574,54 @@ mod tests {
     }
 
     #[test]
-    fn starting_on_a_goal_is_a_stop_on_it() {
+    fn the_robot_leaves_its_start_city_at_once() {
         let l = GoalLayout::cities();
         let start = on(&l, "Mexico", 0.0);
         let mut c = ContinuousController::new(params(), l, start).unwrap();
         let mexico = 0;
-        assert_eq!(c.target(), mexico);
-        assert_eq!(
-            c.phase(),
-            Phase::Stopped {
-                until_secs: 1.0,
-                reason: StopReason::OnGoal(mexico)
-            }
-        );
-        assert_eq!(c.command(&start, 0.5), WheelSpeeds::ZERO);
-        // Judged wrong: only Mexico is penalised.
-        let o = c.observe(true, &start, 0.5).unwrap();
-        assert_eq!(o.step, StepKind::StopOnGoal(mexico));
-        assert!(!o.detected && o.converged.is_none(), "no stop to report");
-        assert!((o.likelihoods[mexico] - (1.0 - 0.7 * c.params().pdf_peak())).abs() < 1e-12);
-        assert!(o.likelihoods[1..].iter().all(|&v| v == 1.0));
-        assert_eq!(
-            c.phase(),
-            Phase::Stopped {
-                until_secs: 1.0,
-                reason: StopReason::OnGoal(mexico)
-            }
-        );
-        // The stop ends: the nearest of the now most probable goals, Havana
-        // and Bogota tie at 0.4 m, the lower index (Havana) wins.
-        let w = c.command(&start, 1.0);
+        // The nearest goals other than Mexico, Havana and Bogota, tie at
+        // 0.4 m; the lower index (Havana) wins. No stop on Mexico first.
         assert_eq!(c.target(), 1);
+        assert_eq!(c.phase(), Phase::Turning);
+        let w = c.command(&start, 0.0);
         assert_eq!(
             c.phase(),
             Phase::Driving,
             "Havana is straight ahead: no turn"
         );
         assert!(w.left_m_per_s > 0.0 && (w.left_m_per_s - w.right_m_per_s).abs() < 1e-12);
+        // A window while driving off Mexico is a linear step; Mexico, under
+        // the robot, has no bearing and keeps its probability.
+        let o = c.observe(false, &start, 0.0625).unwrap();
+        assert_eq!(o.step, StepKind::Linear);
+        assert_eq!(o.likelihoods[mexico], 1.0);
+        // A detection while still on Mexico penalises the goals ahead and
+        // never Mexico; after the stop the robot still does not choose the
+        // goal it has not left.
+        let o = c.observe(true, &start, 0.125).unwrap();
+        assert!(o.detected);
+        assert_eq!(c.command(&start, 0.5), WheelSpeeds::ZERO);
+        let mut c2 = c.clone();
+        c.command(&start, 1.2);
+        assert_ne!(c.target(), mexico);
+        assert!(matches!(c.phase(), Phase::Turning | Phase::Driving));
+        // Once it has left Mexico, Mexico is a goal like any other.
+        let away = Pose::new(start.x_m, start.y_m + 0.2, 0.0);
+        c2.command(&away, 1.2);
+        assert!(c2.start_goal.is_none());
+    }
+
+    #[test]
+    fn the_start_goal_is_avoided_by_info_gain_too() {
+        let l = GoalLayout::cities();
+        let start = on(&l, "Mexico", 0.0);
+        let p = ContinuousControlParams {
+            strategy: Strategy::InfoGain,
+            ..params()
+        };
+        let c = ContinuousController::new(p, l, start).unwrap();
+        assert_ne!(c.target(), 0);
+        assert_eq!(c.phase(), Phase::Turning);
     }
 
     #[test]
@@ -621,38 +662,45 @@ mod tests {
     #[test]
     fn a_stop_on_a_goal_holds_for_the_verdict_and_a_late_veto_is_charged_to_it() {
         let l = GoalLayout::cities();
-        let start = on(&l, "Mexico", 0.0);
+        // Just below Athens, facing it: the robot drives there first.
+        let athens = l.index_of("Athens").unwrap();
+        let start = Pose::new(1.0, 0.9, PI / 2.0);
         let held = ContinuousControlParams {
             goal_hold_secs: Some(1.8),
             veto_window_secs: Some(1.2),
             ..params()
         };
         let mut c = ContinuousController::new(held, l, start).unwrap();
-        let mexico = 0;
+        assert_eq!(c.target(), athens);
+        let on_athens = on(c.layout(), "Athens", PI / 2.0);
+        assert_eq!(c.command(&on_athens, 0.5), WheelSpeeds::ZERO, "arrived");
         assert_eq!(
             c.phase(),
             Phase::Stopped {
-                until_secs: 1.8,
-                reason: StopReason::OnGoal(mexico)
+                until_secs: 2.3,
+                reason: StopReason::OnGoal(athens)
             }
         );
-        assert_eq!(c.command(&start, 1.5), WheelSpeeds::ZERO, "still held");
-        // The user's verdict on the start city arrives within the hold.
-        let o = c.observe(true, &start, 1.2).unwrap();
-        assert_eq!(o.step, StepKind::StopOnGoal(mexico));
-        c.command(&start, 1.8);
-        assert_eq!(c.phase(), Phase::Driving, "off to Havana");
-        let before = c.belief().probability(mexico);
-        // A detection 0.5 s after leaving is the verdict on Mexico: it does
-        // not stop the robot and only Mexico is penalised.
-        let o = c.observe(true, &start, 2.3).unwrap();
-        assert_eq!(o.step, StepKind::StopOnGoal(mexico));
+        assert_eq!(c.command(&on_athens, 2.0), WheelSpeeds::ZERO, "still held");
+        // The user's verdict on Athens arrives within the hold.
+        let o = c.observe(true, &on_athens, 1.7).unwrap();
+        assert_eq!(o.step, StepKind::StopOnGoal(athens));
+        c.command(&on_athens, 2.3);
+        assert!(
+            matches!(c.phase(), Phase::Turning | Phase::Driving),
+            "off to another goal"
+        );
+        let before = c.belief().probability(athens);
+        // A detection 0.5 s after leaving is the verdict on Athens: it does
+        // not stop the robot and only Athens is penalised.
+        let o = c.observe(true, &on_athens, 2.8).unwrap();
+        assert_eq!(o.step, StepKind::StopOnGoal(athens));
         assert!(!o.detected);
-        assert_eq!(c.phase(), Phase::Driving);
-        assert!(c.belief().probability(mexico) < 0.3 * before);
+        assert!(matches!(c.phase(), Phase::Turning | Phase::Driving));
+        assert!(c.belief().probability(athens) < 0.3 * before);
         // After the veto window, a detection stops the robot as usual.
-        let o = c.observe(true, &start, 3.1).unwrap();
-        assert_eq!(o.step, StepKind::Linear);
+        let o = c.observe(true, &on_athens, 3.6).unwrap();
+        assert!(matches!(o.step, StepKind::Linear | StepKind::Turn { .. }));
         assert!(o.detected);
     }
 

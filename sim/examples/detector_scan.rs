@@ -7,8 +7,8 @@
 //! (defaults 0.95 and 1; 30 minutes of held-out EEG).
 
 use errp_bci::{
-    Detector, DetectorMode, DetectorParams, OnlineRecordingParams, SPAN_FRACTION, operating_point,
-    record_online, response_span,
+    Detector, DetectorMode, DetectorParams, OnlineRecordingParams, detector_span, operating_point,
+    record_online,
 };
 use errp_sim::epuck::{ContinuousDecoder, ContinuousRequest, run_continuous_calibration};
 
@@ -35,14 +35,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     )?;
     println!("t_e  windows  span (s)    hit rate  false alarms/min  median latency (s)");
     for t_e in [0.5, 0.6, 0.7, 0.8, 0.9] {
-        let span = response_span(&rec, t_e, SPAN_FRACTION);
         for n in [1usize, 2, 3, 4, 6, 8] {
             let p = DetectorParams {
                 mode: DetectorMode::Smoothed,
                 smooth_windows: n,
                 ..DetectorParams::default()
             };
-            let op = operating_point(&rec, Detector::new(p, t_e)?, span.delayed(p.delay_secs()));
+            let span = detector_span(&rec, p, t_e)?;
+            let op = operating_point(&rec, Detector::new(p, t_e)?, span);
             println!(
                 "{t_e:.1}  {n:>7}  {:.2}-{:.2}  {:>7.1} %  {:>16.2}  {:>18.2}",
                 op.span.from_secs,

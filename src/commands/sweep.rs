@@ -3,6 +3,7 @@
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
@@ -111,19 +112,22 @@ pub struct MergeArgs {
 /// Now, for the elapsed times the program prints. Only the command line
 /// reads the clock; nothing it computes depends on it.
 #[allow(clippy::disallowed_methods)]
-fn wall_clock() -> Instant {
+pub(crate) fn wall_clock() -> Instant {
     Instant::now()
 }
 
 /// Progress on a terminal (a bar), plain lines in logs, or nothing.
-struct Progress {
-    bar: Option<ProgressBar>,
+pub(crate) struct Progress {
+    pub(crate) bar: Option<ProgressBar>,
     plain: bool,
     started: Instant,
+    /// Plain progress: the last tenth of the episodes reported (a line per
+    /// tenth in logs, where there is no bar).
+    tenths: AtomicUsize,
 }
 
 impl Progress {
-    fn new(quiet: bool) -> Self {
+    pub(crate) fn new(quiet: bool) -> Self {
         let ci = std::env::var_os("CI").is_some_and(|v| !v.is_empty() && v != "false");
         let terminal = std::io::stderr().is_terminal();
         if quiet {
@@ -131,6 +135,7 @@ impl Progress {
                 bar: None,
                 plain: false,
                 started: wall_clock(),
+                tenths: AtomicUsize::new(0),
             };
         }
         if !terminal || ci {
@@ -138,6 +143,7 @@ impl Progress {
                 bar: None,
                 plain: true,
                 started: wall_clock(),
+                tenths: AtomicUsize::new(0),
             };
         }
         let bar = ProgressBar::with_draw_target(Some(0), ProgressDrawTarget::stderr());
@@ -152,10 +158,11 @@ impl Progress {
             bar: Some(bar),
             plain: false,
             started: wall_clock(),
+            tenths: AtomicUsize::new(0),
         }
     }
 
-    fn line(&self, text: &str) {
+    pub(crate) fn line(&self, text: &str) {
         match &self.bar {
             Some(bar) => bar.println(text),
             None if self.plain => eprintln!("{text}"),
@@ -189,6 +196,16 @@ impl SweepObserver for Progress {
     fn episodes_done(&self, done: usize, total: usize) {
         // Rows are on disk from now on: a signal stops between episodes.
         interrupt::graceful(true);
+        if self.plain && total > 0 {
+            let tenth = 10 * done / total;
+            let before = self.tenths.swap(tenth, Ordering::Relaxed);
+            if tenth != before && tenth > 0 {
+                eprintln!(
+                    "  episodes {done}/{total} [{:.1} s]",
+                    self.started.elapsed().as_secs_f64()
+                );
+            }
+        }
         if let Some(bar) = &self.bar {
             if bar.message() != "episodes" {
                 bar.set_message("episodes");
@@ -338,7 +355,7 @@ pub fn sweep(args: &SweepArgs) -> Result<bool> {
 }
 
 /// The CPUs Slurm gave this job's task (`$SLURM_CPUS_PER_TASK`), if set.
-fn slurm_cpus() -> Option<usize> {
+pub(crate) fn slurm_cpus() -> Option<usize> {
     std::env::var("SLURM_CPUS_PER_TASK")
         .ok()?
         .trim()

@@ -17,6 +17,7 @@
 mod cache;
 mod figure;
 mod finish;
+pub mod fit;
 mod lock;
 mod manifest;
 mod merge;
@@ -38,7 +39,10 @@ pub use lock::{DirLock, HEARTBEAT, Holder, LOCK, STALE_AFTER};
 pub use manifest::{EPISODES, FORMAT, MANIFEST, MAX_MANIFEST_BYTES, Manifest};
 pub use merge::merge_sweeps;
 pub use observer::SweepObserver;
-pub use plot::{LevelPoint, PaperPoint, PlotError, Series, SweepPlot};
+pub use plot::{
+    Curve, CurvePoint, FitPanel, FitPlot, LevelPoint, PaperPoint, PlotError, Series, SweepPlot,
+    fit_png, fit_svg,
+};
 pub use rows::{CHECKSUM, episodes_header};
 pub use run::{MAX_DECODER_BYTES, SweepOptions, SweepOutcome, prepare_sweep, run_sweep};
 pub use spec::{

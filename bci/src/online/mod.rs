@@ -260,27 +260,90 @@ mod tests {
         assert!(bad.contains("hit_rate") && bad.contains("(0, 1)"), "{bad}");
     }
 
-    #[test]
-    fn the_response_span_is_where_windows_respond() {
-        // Windows respond (p = 0.9) from 0.6 to 1.0 s after each ErrP, with
-        // a few background false positives.
+    /// 50 ErrPs 5 s apart over 300 s; windows respond with probability
+    /// `early` from 0.25 to 0.5 s after each (windows that hold only the
+    /// start of the ErrP) and always from 0.5625 to 1.0 s; background
+    /// windows fire now and then.
+    fn synthetic_recording(early: f64) -> OnlineRecording {
+        let mut rng = stream(7, "test");
         let n = (300.0 / WINDOW_STEP_SECS) as usize;
         let errps: Vec<f64> = (0..50).map(|k| 3.0 + 5.0 * k as f64).collect();
-        let mut p = vec![0.1; n];
+        let mut p: Vec<f64> = (0..n)
+            .map(|_| if rng.random_bool(0.01) { 0.95 } else { 0.1 })
+            .collect();
         for &o in &errps {
-            for k in 0..n {
+            for (k, v) in p.iter_mut().enumerate() {
                 let lag = OnlineRecording::window_end_secs(k) - o;
-                if (0.6 - 1e-9..=1.0 + 1e-9).contains(&lag) {
-                    p[k] = 0.9;
+                if (0.5625 - 1e-9..=1.0 + 1e-9).contains(&lag)
+                    || ((0.25 - 1e-9..=0.5 + 1e-9).contains(&lag) && rng.random_bool(early))
+                {
+                    *v = 0.9;
                 }
             }
         }
-        for k in (7..n).step_by(97) {
-            p[k] = 0.95;
-        }
-        let rec = OnlineRecording { p_error: p, errps };
-        let s = response_span(&rec, 0.8, 0.25);
-        assert!((s.from_secs - 0.625).abs() < 0.07, "{s:?}");
+        OnlineRecording { p_error: p, errps }
+    }
+
+    #[test]
+    fn binomial_tails() {
+        assert_eq!(binomial_upper_tail(0, 10, 0.3), 1.0);
+        assert_eq!(binomial_upper_tail(11, 10, 0.3), 0.0);
+        // P(X >= 1) = 1 - 0.7^10; P(X >= 10) = 0.3^10.
+        assert!((binomial_upper_tail(1, 10, 0.3) - (1.0 - 0.7f64.powi(10))).abs() < 1e-12);
+        assert!((binomial_upper_tail(10, 10, 0.3) - 0.3f64.powi(10)).abs() < 1e-15);
+        // Two of 100 at a rate of 1e-4: about (0.01)^2 / 2.
+        let t = binomial_upper_tail(2, 100, 1e-4);
+        assert!((t / 4.95e-5 - 1.0).abs() < 0.01, "{t}");
+    }
+
+    #[test]
+    fn the_response_span_is_where_windows_respond() {
+        let rec = synthetic_recording(0.0);
+        let s = detector_span(&rec, DetectorParams::literal(), 0.8).unwrap();
+        assert!((s.from_secs - 0.5625).abs() < 0.07, "{s:?}");
         assert!((s.to_secs - 1.0).abs() < 0.07, "{s:?}");
+    }
+
+    #[test]
+    fn early_responses_are_part_of_the_span_not_false_alarms() {
+        // A third of the windows that hold only the start of an ErrP fire:
+        // far above the 1 % background, though a third of the peak.
+        let rec = synthetic_recording(0.3);
+        for (detector, late) in [
+            (DetectorParams::literal(), 1.0),
+            (
+                DetectorParams::default(),
+                1.0 + DetectorParams::default().delay_secs(),
+            ),
+        ] {
+            let span = detector_span(&rec, detector, 0.8).unwrap();
+            assert!(span.from_secs <= 0.3 + 1e-9, "{detector:?}: {span:?}");
+            assert!(
+                span.to_secs >= 0.9 && span.to_secs <= late + 0.07,
+                "{detector:?}: {span:?}"
+            );
+            let op = operating_point(&rec, Detector::new(detector, 0.8).unwrap(), span);
+            assert!(op.hit_rate > 0.97, "{detector:?}: {op:?}");
+            // The background fires on 1 % of the windows (9.6 a minute);
+            // early responses counted as false alarms would add 50 ErrPs'
+            // worth (about 10 a minute for the literal reading).
+            let bound = match detector.mode {
+                DetectorMode::Literal => 12.0,
+                DetectorMode::Smoothed => 2.0,
+            };
+            assert!(op.false_alarms_per_min < bound, "{detector:?}: {op:?}");
+        }
+        // A span that starts at the peak's fifth, as a fraction-of-peak
+        // rule gives, would call the early responses false alarms.
+        let late_span = ResponseSpan {
+            from_secs: 0.5625,
+            to_secs: 1.0,
+        };
+        let op = operating_point(
+            &rec,
+            Detector::new(DetectorParams::literal(), 0.8).unwrap(),
+            late_span,
+        );
+        assert!(op.false_alarms_per_min > 14.0, "{op:?}");
     }
 }

@@ -4,7 +4,7 @@
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
-use super::detector::Detector;
+use super::detector::{Detector, DetectorParams};
 use super::{SlidingWindow, WINDOW_STEP_SECS};
 use crate::continuous::ContinuousFeatures;
 use crate::erp::AssessmentKind;
@@ -152,23 +152,73 @@ impl ResponseSpan {
 /// Lags examined for a response, s after time zero.
 const LAG_RANGE_SECS: f64 = 2.0;
 
-/// Measures the span of window ends over which the decoder responds to an
-/// ErrP: for every lag (window end minus time zero, in steps of 62.5 ms, up
-/// to 2 s) the share of windows at or above `t_e`, minus the share over
-/// windows with no ErrP in the last 2 s; the span runs from the first to the
-/// last lag whose excess is at least `fraction` of the largest excess.
-pub fn response_span(recording: &OnlineRecording, t_e: f64, fraction: f64) -> ResponseSpan {
+/// A lag responds when as many firings as it has, or more, would come by
+/// chance with this probability at most (binomial, at the background rate):
+/// one-sided, so that over the 33 lags examined a stray lag is unlikely
+/// (about 3 %) to stretch the span.
+pub const SPAN_ALPHA: f64 = 0.001;
+
+/// P(X >= k) for X ~ Binomial(n, p).
+pub fn binomial_upper_tail(k: usize, n: usize, p: f64) -> f64 {
+    if k == 0 {
+        return 1.0;
+    }
+    if k > n {
+        return 0.0;
+    }
+    if p <= 0.0 {
+        return 0.0;
+    }
+    if p >= 1.0 {
+        return 1.0;
+    }
+    // 1 - P(X < k), the terms built by their ratios.
+    let mut term = (1.0 - p).powi(n as i32);
+    let mut below = 0.0;
+    for i in 0..k {
+        below += term;
+        term *= (n - i) as f64 / (i + 1) as f64 * p / (1.0 - p);
+    }
+    (1.0 - below).max(0.0)
+}
+
+/// The windows of `recording` at which `detector` fires.
+pub fn firings(recording: &OnlineRecording, mut detector: Detector) -> Vec<bool> {
+    recording
+        .p_error
+        .iter()
+        .enumerate()
+        .map(|(k, &p)| {
+            detector
+                .push(p, OnlineRecording::window_end_secs(k))
+                .detected
+        })
+        .collect()
+}
+
+/// Measures the span of lags over which `fired` (one flag per window of
+/// `recording`, for example [`firings`] of a detector) responds to an ErrP.
+///
+/// For every lag (window end minus the latest ErrP's time zero, in steps of
+/// 62.5 ms, up to 2 s) the firings are compared with the background rate,
+/// over windows with no ErrP in the last 2 s. A lag responds when that many
+/// firings would come by chance with probability [`SPAN_ALPHA`] at most
+/// (binomial upper tail at the background rate); the span runs from the
+/// first to the last responding lag. So an early response (a window that holds only the
+/// start of an ErrP) counts as a response as soon as it is more frequent
+/// than chance, not only when it is a sizeable share of the peak: scoring
+/// over this span does not call early responses false alarms.
+pub fn response_span(recording: &OnlineRecording, fired: &[bool]) -> ResponseSpan {
     let n_lags = (LAG_RANGE_SECS / WINDOW_STEP_SECS).round() as usize + 1;
     let mut above = vec![0usize; n_lags];
     let mut count = vec![0usize; n_lags];
     let (mut base_above, mut base_n) = (0usize, 0usize);
     let mut next = 0; // first ErrP after the current window
-    for (k, &p) in recording.p_error.iter().enumerate() {
+    for (k, &hit) in fired.iter().enumerate().take(recording.p_error.len()) {
         let t = OnlineRecording::window_end_secs(k);
         while next < recording.errps.len() && recording.errps[next] <= t {
             next += 1;
         }
-        let hit = p >= t_e;
         match next.checked_sub(1).map(|i| recording.errps[i]) {
             Some(o) if t - o <= LAG_RANGE_SECS + 1e-9 => {
                 let lag = ((t - o) / WINDOW_STEP_SECS).round() as usize;
@@ -181,32 +231,45 @@ pub fn response_span(recording: &OnlineRecording, t_e: f64, fraction: f64) -> Re
             }
         }
     }
-    let base = base_above as f64 / base_n.max(1) as f64;
-    let excess: Vec<f64> = (0..n_lags)
-        .map(|l| above[l] as f64 / count[l].max(1) as f64 - base)
-        .collect();
-    let peak = excess.iter().copied().fold(0.0, f64::max);
+    // The background rate, at least one firing's worth, so that a decoder
+    // that never fires on background EEG still needs a few firings at a lag.
+    let base = (base_above.max(1) as f64 / base_n.max(1) as f64).min(1.0);
+    let responds = |l: usize| {
+        above[l] > 0
+            && above[l] as f64 > base * count[l] as f64
+            && binomial_upper_tail(above[l], count[l], base) <= SPAN_ALPHA
+    };
     let lag_secs = |l: usize| l as f64 * WINDOW_STEP_SECS;
-    if peak <= 0.0 {
+    match (
+        (0..n_lags).find(|&l| responds(l)),
+        (0..n_lags).rev().find(|&l| responds(l)),
+    ) {
+        (Some(first), Some(last)) => ResponseSpan {
+            from_secs: lag_secs(first),
+            to_secs: lag_secs(last),
+        },
         // A decoder that never responds: the span the features could see
         // (the temporal window's [200, 800] ms).
-        return ResponseSpan {
+        _ => ResponseSpan {
             from_secs: 0.45,
             to_secs: 0.85,
-        };
+        },
     }
-    let first = excess
-        .iter()
-        .position(|&e| e >= fraction * peak)
-        .unwrap_or(0);
-    let last = excess
-        .iter()
-        .rposition(|&e| e >= fraction * peak)
-        .unwrap_or(n_lags - 1);
-    ResponseSpan {
-        from_secs: lag_secs(first),
-        to_secs: lag_secs(last),
-    }
+}
+
+/// The response span of `detector` at `t_e` on `recording`: the span over
+/// which single windows respond at `t_e` ([`response_span`] of the literal
+/// reading's firings), delayed by the detector's smoothing. A mean of the
+/// last n windows responds as soon as its newest window does and until its
+/// oldest stops; its own firings, one event per ErrP at most, are too sparse
+/// at any one lag to be told from chance lag by lag.
+pub fn detector_span(
+    recording: &OnlineRecording,
+    detector: DetectorParams,
+    t_e: f64,
+) -> Result<ResponseSpan> {
+    let windows = firings(recording, Detector::new(DetectorParams::literal(), t_e)?);
+    Ok(response_span(recording, &windows).delayed(detector.delay_secs()))
 }
 
 /// A detector's online operating point, scored per event as

@@ -4,7 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::detector::{Detector, DetectorParams};
-use super::recording::{OnlineRecording, OperatingPoint, operating_point, response_span};
+use super::recording::{OnlineRecording, OperatingPoint, detector_span, operating_point};
 use crate::error::{Result, check};
 
 /// An online operating point to calibrate for, instead of a cross-validated
@@ -77,7 +77,7 @@ pub fn threshold_for_false_alarms(
     false_alarms_per_min: f64,
 ) -> Result<(f64, OperatingPoint)> {
     let at = |t_e: f64| -> Result<OperatingPoint> {
-        let span = response_span(recording, t_e, SPAN_FRACTION).delayed(detector.delay_secs());
+        let span = detector_span(recording, detector, t_e)?;
         Ok(operating_point(
             recording,
             Detector::new(detector, t_e)?,
@@ -102,10 +102,6 @@ pub fn threshold_for_false_alarms(
     }
     Ok(best)
 }
-
-/// Share of the largest excess response at which a response span starts and
-/// ends (see [`response_span`]).
-pub const SPAN_FRACTION: f64 = 0.2;
 
 /// Searches the ErrP-to-noise ratio (and T_e, if false alarms are targeted)
 /// at which the detector's operating point on the held-out recording meets
@@ -137,8 +133,7 @@ pub fn target_online<E: From<crate::error::BciError>>(
         let (t, point) = match target.false_alarms_per_min {
             Some(f) => threshold_for_false_alarms(&recording, detector, f)?,
             None => {
-                let span =
-                    response_span(&recording, t_e, SPAN_FRACTION).delayed(detector.delay_secs());
+                let span = detector_span(&recording, detector, t_e)?;
                 (
                     t_e,
                     operating_point(&recording, Detector::new(detector, t_e)?, span),

@@ -6,9 +6,9 @@ use errp_bci::{
     Accuracy, ContinuousCalibrationParams, ContinuousFeatures, Detector, DetectorMode,
     DetectorParams, EegGenerator, GeneratorParams, Montage, OnlineRecording, OnlineRecordingParams,
     OnlineStep, OnlineTarget, OnlineTargeting, OperatingPoint, Preprocessor, ResponseSpan,
-    SPAN_FRACTION, SlidingWindow, SvmDecoder, SvmModel, TargetingResult, TargetingStep,
-    calibrate_continuous, operating_point, record_online, response_span, rng::derive_seed,
-    target_continuous_accuracy, target_online,
+    SlidingWindow, SvmDecoder, SvmModel, TargetingResult, TargetingStep, calibrate_continuous,
+    detector_span, operating_point, record_online, rng::derive_seed, target_continuous_accuracy,
+    target_online,
 };
 
 use crate::calibration::{Report, Request};
@@ -75,7 +75,7 @@ pub struct OnlineReport {
     /// T_e.
     pub t_e: f64,
     /// The detector in force, scored per ErrP and per minute of error-free
-    /// time over `window_span` delayed by its smoothing.
+    /// time over its own response span (measured from its detections).
     pub point: OperatingPoint,
     /// Each window against T_e on its own (the paper read literally).
     pub literal: OperatingPoint,
@@ -89,11 +89,11 @@ impl OnlineReport {
         detector: DetectorParams,
         t_e: f64,
     ) -> Result<Self> {
-        let window_span = response_span(recording, t_e, SPAN_FRACTION);
+        let window_span = detector_span(recording, DetectorParams::literal(), t_e)?;
         let point = operating_point(
             recording,
             Detector::new(detector, t_e)?,
-            window_span.delayed(detector.delay_secs()),
+            detector_span(recording, detector, t_e)?,
         );
         let literal = operating_point(
             recording,
@@ -115,20 +115,19 @@ impl std::fmt::Display for OnlineReport {
         let row = |f: &mut std::fmt::Formatter<'_>, name: &str, p: &OperatingPoint| {
             writeln!(
                 f,
-                "  {name:<34} hit rate {:5.1} %  false alarms {:5.2}/min  median latency {:.2} s",
+                "  {name:<34} hit rate {:5.1} %  false alarms {:5.2}/min  median latency {:.2} s  \
+                 (responds {:.2}-{:.2} s after an ErrP)",
                 100.0 * p.hit_rate,
                 p.false_alarms_per_min,
-                p.median_latency_secs
+                p.median_latency_secs,
+                p.span.from_secs,
+                p.span.to_secs
             )
         };
         writeln!(
             f,
-            "Online operating point (held-out recording: {} ErrPs, {:.1} min error-free; \
-             windows respond {:.2}-{:.2} s after an ErrP):",
-            self.point.n_errps,
-            self.point.clean_minutes,
-            self.window_span.from_secs,
-            self.window_span.to_secs
+            "Online operating point (held-out recording: {} ErrPs, {:.1} min error-free):",
+            self.point.n_errps, self.point.clean_minutes,
         )?;
         let t_e = format!("{:.3}", self.t_e);
         let t_e = t_e.trim_end_matches('0').trim_end_matches('.');

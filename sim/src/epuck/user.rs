@@ -16,7 +16,9 @@
 //! * **stopped elsewhere** (the stop after a detected error): no judgement;
 //!   a robot halted mid-turn near a goal has not arrived there, so that is
 //!   no judgement either (a stop counts as on a goal when the last motion
-//!   seen before it was a drive, or at the start).
+//!   seen before it was a drive);
+//! * **before the first motion**: no judgement. The user placed the robot on
+//!   its start; the paper times its runs "from the start of the movement".
 //!
 //! The user sees motion over a short window of tracked poses (0.5 s by
 //! default), which is also part of the perception delay. An error onset
@@ -182,8 +184,9 @@ pub struct SyntheticUser {
     state: Judgement,
     last_error_secs: f64,
     last_correct_secs: f64,
-    /// The robot's last seen motion before it stood still was a drive (or it
-    /// has not moved yet): standing on a goal is then an arrival there.
+    /// The robot's last seen motion before it stood still was a drive:
+    /// standing on a goal is then an arrival there (never before the first
+    /// motion).
     arrived: bool,
 }
 
@@ -198,7 +201,7 @@ impl SyntheticUser {
             state: Judgement::None,
             last_error_secs: f64::NEG_INFINITY,
             last_correct_secs: f64::NEG_INFINITY,
-            arrived: true,
+            arrived: false,
         }
     }
 
@@ -377,8 +380,17 @@ mod tests {
             Judgement::Error
         );
         assert_eq!(u.judge(SeenMotion::Still, &at(0.0), false), Judgement::None);
-        // Stopped on Athens (1.0, 1.0) is a wrong goal; on Pisa it is right.
+        // Before the first motion a stop on a goal is not judged: the user
+        // put the robot there.
         let on_athens = pose(1.0, 1.0, 0.0);
+        assert_eq!(
+            u.judge(SeenMotion::Still, &on_athens, false),
+            Judgement::None
+        );
+        // Arrived by driving, stopped on Athens (1.0, 1.0) is a wrong goal;
+        // on Pisa it is right.
+        let mut u = u;
+        u.arrived = true;
         assert_eq!(
             u.judge(SeenMotion::Still, &on_athens, false),
             Judgement::Error

@@ -22,6 +22,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters_backend::{BackendColor, BackendCoord, DrawingErrorKind, FontTransform};
 
+mod fit;
 mod glyph_text;
 mod legend;
 mod panels;
@@ -32,6 +33,7 @@ use glyph_text::*;
 /// A point from the paper to overlay on the cost panel (Table 1 subjects, or
 /// the paper's e-puck runs).
 pub use errp_sim::task::PaperPoint;
+pub use fit::{Curve, CurvePoint, FitPanel, FitPlot, fit_png, fit_svg};
 use legend::*;
 use panels::*;
 use series::*;
@@ -184,13 +186,18 @@ pub fn png(plot: &SweepPlot) -> Result<Vec<u8>, PlotError> {
         draw(&root, plot)?;
         root.present().map_err(draw_error)?;
     }
+    encode_png(&pixels, WIDTH)
+}
+
+/// Encodes RGB `pixels`, `width` wide and [`HEIGHT`] high, as a PNG file.
+fn encode_png(pixels: &[u8], width: u32) -> Result<Vec<u8>, PlotError> {
     let mut out = Vec::new();
     {
-        let mut encoder = png::Encoder::new(&mut out, WIDTH, HEIGHT);
+        let mut encoder = png::Encoder::new(&mut out, width, HEIGHT);
         encoder.set_color(png::ColorType::Rgb);
         encoder.set_depth(png::BitDepth::Eight);
         let mut writer = encoder.write_header()?;
-        writer.write_image_data(&pixels)?;
+        writer.write_image_data(pixels)?;
         writer.finish()?;
     }
     Ok(out)

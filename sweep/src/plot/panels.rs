@@ -2,7 +2,11 @@
 
 use super::*;
 
-/// A panel's chart type: accuracy against a real-valued y.
+/// The x axis of a sweep's panels.
+const ACCURACY_DESC: &str = "decoder accuracy (mean of per-class rates)";
+
+/// A panel's chart type: accuracy (or another parameter) against a
+/// real-valued y.
 pub(super) type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
 /// Builds a panel's axes, grid and labels.
@@ -11,8 +15,8 @@ pub(super) fn panel<'a, DB: DrawingBackend + 'a>(
     caption: &str,
     x_range: std::ops::Range<f64>,
     y_range: std::ops::Range<f64>,
-    y_desc: &str,
-    y_format: &dyn Fn(&f64) -> String,
+    (x_desc, y_desc): (&str, &str),
+    (x_format, y_format): (&dyn Fn(&f64) -> String, &dyn Fn(&f64) -> String),
 ) -> Result<Chart<'a, DB>, PlotError> {
     let mut chart = ChartBuilder::on(area)
         .caption(caption, font(CAPTION_SIZE))
@@ -31,11 +35,11 @@ pub(super) fn panel<'a, DB: DrawingBackend + 'a>(
         .axis_style(BLACK.mix(0.8))
         .x_labels(6)
         .y_labels(6)
-        .x_label_formatter(&|x| format!("{x:.1}"))
+        .x_label_formatter(x_format)
         .y_label_formatter(y_format)
         .label_style(font(TICK_SIZE))
         .axis_desc_style(font(AXIS_DESC_SIZE))
-        .x_desc("decoder accuracy (mean of per-class rates)")
+        .x_desc(x_desc)
         .y_desc(y_desc)
         .draw()
         .map_err(draw_error)?;
@@ -53,8 +57,8 @@ pub(super) fn draw_success_panel<DB: DrawingBackend>(
         "Success rate (95% Wilson interval)",
         x_range,
         -0.02..1.04,
-        "success rate",
-        &|y| format!("{y:.1}"),
+        (ACCURACY_DESC, "success rate"),
+        (&|x| format!("{x:.1}"), &|y| format!("{y:.1}")),
     )?;
     let mut obstacles = Vec::new();
     for (i, series) in plot.series.iter().enumerate() {
@@ -140,8 +144,8 @@ pub(super) fn draw_cost_panel<DB: DrawingBackend>(
         "Cost of successful episodes (mean ± 1 sd)",
         x_range,
         0.0..y_top,
-        &plot.cost_label,
-        &|y| format_tick(*y),
+        (ACCURACY_DESC, &plot.cost_label),
+        (&|x| format!("{x:.1}"), &|y| format_tick(*y)),
     )?;
     let mut obstacles = Vec::new();
     for (i, (series, bars)) in plot.series.iter().zip(&bars).enumerate() {

@@ -1,0 +1,14 @@
+//! Unstated parameters estimated from the paper's own numbers by maximum
+//! likelihood over a grid, with Monte Carlo likelihoods (`errp fit`).
+
+mod density;
+mod epuck;
+mod surface;
+
+pub use density::{Observed, SimRun, log_kde, log_likelihood, percentile_of, quantile, resample};
+pub use epuck::{
+    DENSITY, EpuckFit, EpuckFitSpec, FIT_FILES, FIT_FORMAT, FitOutcome, HeldOut, MAX_BOOTSTRAP,
+    MAX_CALIBRATIONS, MAX_FIT_POINTS, MAX_FIT_RUNS, PaperRun, Provenance, RunStats, analyse,
+    fit_plot, paper_runs, run_dir, run_epuck_fit, surface_csv, sweep_dir,
+};
+pub use surface::{CHI2_1_95, Surface, argmax};
