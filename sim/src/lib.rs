@@ -50,5 +50,5 @@ pub use scenario_file::{
 };
 pub use stats::{
     StreamingPearson, correlation_p_value, incomplete_beta, mean_sd, median, pearson,
-    wilson_interval,
+    percentile_of, quantile, wilson_interval,
 };

@@ -1,5 +1,5 @@
-//! Small statistics: mean and sd, median, Pearson correlation with its
-//! two-sided p-value, Wilson intervals.
+//! Small statistics: mean and sd, median, quantiles and percentiles,
+//! Pearson correlation with its two-sided p-value, Wilson intervals.
 
 /// Mean and sample standard deviation.
 pub fn mean_sd(xs: &[f64]) -> (f64, f64) {
@@ -28,6 +28,34 @@ pub fn median(xs: &[f64]) -> f64 {
         v[n / 2]
     } else {
         0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// The share of `values` below `x`, ties counted half (the mid-rank
+/// percentile, 0 to 1); NaN for no values.
+pub fn percentile_of(values: &[f64], x: f64) -> f64 {
+    if values.is_empty() {
+        return f64::NAN;
+    }
+    let below = values.iter().filter(|&&v| v < x).count() as f64;
+    let equal = values.iter().filter(|&&v| v == x).count() as f64;
+    (below + 0.5 * equal) / values.len() as f64
+}
+
+/// The `q` quantile (0 to 1) of `values` by linear interpolation between
+/// order statistics; NaN for no values.
+pub fn quantile(values: &[f64], q: f64) -> f64 {
+    if values.is_empty() {
+        return f64::NAN;
+    }
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let pos = q.clamp(0.0, 1.0) * (v.len() - 1) as f64;
+    let (i, frac) = (pos.floor() as usize, pos - pos.floor());
+    if i + 1 < v.len() {
+        v[i] + frac * (v[i + 1] - v[i])
+    } else {
+        v[i]
     }
 }
 
@@ -262,5 +290,19 @@ mod tests {
     fn ln_gamma_known_values() {
         assert!((ln_gamma(5.0) - 24f64.ln()).abs() < 1e-12);
         assert!((ln_gamma(0.5) - std::f64::consts::PI.sqrt().ln()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn percentiles_and_quantiles() {
+        let v = [1.0, 2.0, 3.0, 4.0];
+        assert_eq!(percentile_of(&v, 2.5), 0.5);
+        assert_eq!(percentile_of(&v, 2.0), 0.375);
+        assert_eq!(percentile_of(&v, 0.0), 0.0);
+        assert_eq!(percentile_of(&v, 9.0), 1.0);
+        assert!(percentile_of(&[], 1.0).is_nan());
+        assert_eq!(quantile(&v, 0.5), 2.5);
+        assert_eq!(quantile(&v, 0.0), 1.0);
+        assert_eq!(quantile(&v, 1.0), 4.0);
+        assert!((quantile(&v, 0.1) - 1.3).abs() < 1e-12);
     }
 }

@@ -313,6 +313,23 @@ pub fn format_number(x: f64) -> String {
     format!("{x}")
 }
 
+/// A share (0 to 1) as an English ordinal percentile: `0.213` is "21st",
+/// `0.5` "50th", `0.125` "13th"; "-" for NaN.
+pub fn ordinal_percent(share: f64) -> String {
+    if !share.is_finite() {
+        return "-".into();
+    }
+    let n = (100.0 * share).round() as i64;
+    let suffix = match (n % 10, n % 100) {
+        (_, 11..=13) => "th",
+        (1, _) => "st",
+        (2, _) => "nd",
+        (3, _) => "rd",
+        _ => "th",
+    };
+    format!("{n}{suffix}")
+}
+
 /// Correct decisions of an accuracy's two classes: (hits on errors, hits on
 /// correct actions, their fraction of all decisions; NaN with none).
 pub fn overall(a: &Accuracy) -> (usize, usize, f64) {
@@ -325,4 +342,31 @@ pub fn overall(a: &Accuracy) -> (usize, usize, f64) {
         (hits_error + hits_correct) as f64 / n as f64
     };
     (hits_error, hits_correct, acc)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ordinals() {
+        let o = ordinal_percent;
+        assert_eq!(
+            [
+                o(0.0),
+                o(0.01),
+                o(0.02),
+                o(0.03),
+                o(0.11),
+                o(0.12),
+                o(0.213),
+                o(0.5),
+                o(1.0)
+            ],
+            [
+                "0th", "1st", "2nd", "3rd", "11th", "12th", "21st", "50th", "100th"
+            ]
+        );
+        assert_eq!(o(f64::NAN), "-");
+    }
 }

@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
+use errp_sim::task::ordinal_percent;
 use errp_sweep::TargetCache;
 use errp_sweep::fit::{EpuckFit, EpuckFitSpec, FitOutcome, Provenance, run_epuck_fit};
 use errp_sweep::parse_accuracies;
@@ -230,14 +231,14 @@ fn print_fit(fit: &EpuckFit) {
         let (_, _, t, d) = &fit.observations[i];
         println!(
             "Held out {}: fitted to the other run alone, accuracy {:.3}; there {} reaches the \
-             goal in {} % of runs, its {t} s lie at the {} th percentile of their times and its \
-             {d} detections at the {} th.",
+             goal in {} % of runs, and the paper's {t} s lie at the {} percentile of their times \
+             and its {d} detections at the {}.",
             h.name,
             h.fitted_without,
             h.name,
             pct(h.stats.p_reached()),
-            pct(h.stats.time_percentile),
-            pct(h.stats.detections_percentile)
+            ordinal_percent(h.stats.time_percentile),
+            ordinal_percent(h.stats.detections_percentile)
         );
     }
 }

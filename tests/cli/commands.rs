@@ -442,3 +442,91 @@ fn prepare_only_fills_the_cache_so_that_shards_search_nothing() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_small_fit_prints_its_estimate_and_writes_its_files() {
+    let dir = temp_dir("fit");
+    let out = dir.join("fit");
+    let cache = dir.join("cache");
+    let (o, c) = (out.to_str().unwrap(), cache.to_str().unwrap());
+    let args = [
+        "fit",
+        "epuck",
+        "--accuracy",
+        "0.8,0.95",
+        "--calibrations",
+        "1",
+        "--runs",
+        "5",
+        "--bootstrap",
+        "10",
+        "--out",
+        o,
+        "--cache",
+        c,
+        "--quiet",
+    ];
+    let run = errp(&args);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let text = String::from_utf8_lossy(&run.stdout);
+    assert!(text.contains("Estimate: accuracy"), "{text}");
+    assert!(text.contains("Held out Mexico to Pisa"), "{text}");
+    assert_eq!(
+        files_in(&out),
+        [
+            "fit.json",
+            "fit.png",
+            "fit.svg",
+            "lisbon_to_tokyo",
+            "mexico_to_pisa",
+            "surface.csv"
+        ]
+    );
+    let json = std::fs::read_to_string(out.join("fit.json")).unwrap();
+    assert!(
+        json.contains("\"commit\"") && json.contains("fit epuck"),
+        "{json}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_fit_input_is_exit_2_naming_the_flag() {
+    let dir = temp_dir("fit-bad");
+    let o = dir.join("out");
+    let o = o.to_str().unwrap();
+    let e = refused(&["fit", "epuck", "--runs", "2", "--out", o, "--no-cache"]);
+    assert!(e.contains("--runs 2") && e.contains("5 to 100000"), "{e}");
+    let e = refused(&[
+        "fit",
+        "epuck",
+        "--accuracy",
+        "0.8",
+        "--out",
+        o,
+        "--no-cache",
+    ]);
+    assert!(e.contains("--accuracy") && e.contains("2 to"), "{e}");
+    let e = refused(&[
+        "fit",
+        "epuck",
+        "--accuracy",
+        "0.8,1.5",
+        "--out",
+        o,
+        "--no-cache",
+    ]);
+    assert!(e.contains("1.5"), "{e}");
+    let e = refused(&[
+        "fit",
+        "epuck",
+        "--calibrations",
+        "0",
+        "--out",
+        o,
+        "--no-cache",
+    ]);
+    assert!(e.contains("--calibrations 0"), "{e}");
+    assert!(!Path::new(o).exists(), "a refused fit leaves nothing");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -86,8 +86,8 @@ fn the_continuous_controller_gives_the_golden_run() {
     let (start, _) = goal_pose("Mexico", 0.0);
     let r = run(start, Some(pisa), 300.0);
     let got = (names(&r.targets), r.secs, r.pose);
+    // No stop on Mexico first: the run starts with the movement.
     let via = [
-        "Mexico",
         "Havana",
         "Bogota",
         "Rio de Janeiro",
@@ -97,7 +97,7 @@ fn the_continuous_controller_gives_the_golden_run() {
         "Pisa",
     ];
     assert_eq!(got.0, via, "{got:?}");
-    assert_eq!(got.1, 45.5625, "{got:?}");
+    assert_eq!(got.1, 44.5625, "{got:?}");
     let end = (got.2.x_m, got.2.y_m, got.2.heading_rad);
     let golden = (1.7864316376747638, 1.7862697106836318, 0.7913298063228643);
     assert!(

@@ -8,6 +8,8 @@ use errp_robot::GoalLayout;
 use crate::epuck::episode::EpuckEpisodeResult;
 use crate::epuck::run::EpuckSummary;
 use crate::paper::PAPER_EPUCK;
+use crate::stats::{percentile_of, quantile};
+use crate::task::ordinal_percent;
 
 /// The header line of the per-run table ([`EpuckRunRow`]).
 pub struct EpuckRunHeader;
@@ -109,6 +111,30 @@ impl fmt::Display for EpuckSummaryReport<'_> {
         for (label, value, paper) in medians {
             writeln!(f, "  {label:<20} {value:.1}{}", note(paper))?;
         }
+        let q = |v: &[f64]| (quantile(v, 0.1), quantile(v, 0.9));
+        let (t10, t90) = q(&s.reached_secs);
+        let (d10, d90) = q(&s.reached_detected);
+        writeln!(
+            f,
+            "  central 80 %         time {t10:.1}-{t90:.1} s, detected {d10:.0}-{d90:.0}"
+        )?;
+        if let Some(&(_, secs, det)) = paper {
+            writeln!(
+                f,
+                "  the paper's run      at the {} percentile of time and the {} of detections",
+                ordinal_percent(percentile_of(&s.reached_secs, secs)),
+                ordinal_percent(percentile_of(&s.reached_detected, det as f64))
+            )?;
+        }
+        writeln!(
+            f,
+            "  median time to goal  {}   (a run on a wrong city never reaches it)",
+            if s.median_secs_to_goal.is_finite() {
+                format!("{:.1} s", s.median_secs_to_goal)
+            } else {
+                "never: fewer than half the runs reach it".to_string()
+            }
+        )?;
         writeln!(f, "  median false         {:.1}", s.median_false)?;
         let [turning, driving, on_goal] = s.phase_shares.map(|x| 100.0 * x);
         writeln!(

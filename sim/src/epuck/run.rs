@@ -160,6 +160,16 @@ pub struct EpuckSummary {
     pub median_detected: f64,
     /// Median false detections over those runs.
     pub median_false: f64,
+    /// Times of the runs that reached the goal (s), sorted.
+    pub reached_secs: Vec<f64>,
+    /// Detections of those runs, sorted.
+    pub reached_detected: Vec<f64>,
+    /// Median time to the goal over every run, a run that converged on
+    /// another goal or timed out counting as never reaching it (infinite
+    /// when fewer than half the runs reach it). Unlike the median over the
+    /// runs that reached the goal, it cannot improve when a worse decoder
+    /// lets the slow runs end on a wrong goal instead.
+    pub median_secs_to_goal: f64,
     /// Window accuracy pooled over every run.
     pub online: Accuracy,
     /// Detections per second of run, pooled over every run.
@@ -174,6 +184,11 @@ pub struct EpuckSummary {
     pub hit_rate: f64,
     /// False detections per minute of error-free time, pooled.
     pub false_alarms_per_min: f64,
+}
+
+fn sorted(mut v: Vec<f64>) -> Vec<f64> {
+    v.sort_by(f64::total_cmp);
+    v
 }
 
 /// Summarises `results`.
@@ -191,6 +206,23 @@ pub fn summarise(results: &[EpuckEpisodeResult]) -> EpuckSummary {
         median_secs: crate::stats::median(&col(&|r| r.time_secs)),
         median_detected: crate::stats::median(&col(&|r| r.detected_errors as f64)),
         median_false: crate::stats::median(&col(&|r| r.false_detections as f64)),
+        reached_secs: sorted(col(&|r| r.time_secs)),
+        reached_detected: sorted(col(&|r| r.detected_errors as f64)),
+        median_secs_to_goal: {
+            let t = sorted(
+                results
+                    .iter()
+                    .map(|r| {
+                        if r.reached() {
+                            r.time_secs
+                        } else {
+                            f64::INFINITY
+                        }
+                    })
+                    .collect(),
+            );
+            t.get(t.len() / 2).copied().unwrap_or(f64::NAN)
+        },
         online: Accuracy::pooled(results.iter().map(|r| &r.online)),
         detections_per_sec: sum(&|r| r.detected_errors as f64) / sum(&|r| r.time_secs),
         phase_shares: {

@@ -16,6 +16,8 @@
 
 use rand::Rng;
 
+pub use errp_sim::{percentile_of, quantile};
+
 /// One simulated run, as the likelihood sees it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SimRun {
@@ -86,34 +88,6 @@ pub fn log_kde(samples: &[[f64; 2]], x: [f64; 2]) -> f64 {
     let top = terms.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let sum: f64 = terms.iter().map(|t| (t - top).exp()).sum();
     top + sum.ln() - (m as f64).ln() - (2.0 * std::f64::consts::PI * h[0] * h[1]).ln()
-}
-
-/// The share of `values` below `x`, ties counted half (the mid-rank
-/// percentile, 0 to 1); NaN for no values.
-pub fn percentile_of(values: &[f64], x: f64) -> f64 {
-    if values.is_empty() {
-        return f64::NAN;
-    }
-    let below = values.iter().filter(|&&v| v < x).count() as f64;
-    let equal = values.iter().filter(|&&v| v == x).count() as f64;
-    (below + 0.5 * equal) / values.len() as f64
-}
-
-/// The `q` quantile (0 to 1) of `values` by linear interpolation between
-/// order statistics; NaN for no values.
-pub fn quantile(values: &[f64], q: f64) -> f64 {
-    if values.is_empty() {
-        return f64::NAN;
-    }
-    let mut v = values.to_vec();
-    v.sort_by(f64::total_cmp);
-    let pos = q.clamp(0.0, 1.0) * (v.len() - 1) as f64;
-    let (i, frac) = (pos.floor() as usize, pos - pos.floor());
-    if i + 1 < v.len() {
-        v[i] + frac * (v[i + 1] - v[i])
-    } else {
-        v[i]
-    }
 }
 
 /// A bootstrap replicate of `runs`, resampled in two stages as they were
@@ -217,19 +191,5 @@ mod tests {
         // one twice (share 0 or 1), each about half the time.
         let extreme = shares.iter().filter(|&&s| s == 0.0 || s == 1.0).count();
         assert!((150..250).contains(&extreme), "{extreme}");
-    }
-
-    #[test]
-    fn percentiles_and_quantiles() {
-        let v = [1.0, 2.0, 3.0, 4.0];
-        assert_eq!(percentile_of(&v, 2.5), 0.5);
-        assert_eq!(percentile_of(&v, 2.0), 0.375);
-        assert_eq!(percentile_of(&v, 0.0), 0.0);
-        assert_eq!(percentile_of(&v, 9.0), 1.0);
-        assert!(percentile_of(&[], 1.0).is_nan());
-        assert_eq!(quantile(&v, 0.5), 2.5);
-        assert_eq!(quantile(&v, 0.0), 1.0);
-        assert_eq!(quantile(&v, 1.0), 4.0);
-        assert!((quantile(&v, 0.1) - 1.3).abs() < 1e-12);
     }
 }

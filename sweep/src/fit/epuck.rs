@@ -604,27 +604,35 @@ pub fn fit_plot(fit: &EpuckFit) -> FitPlot {
     let s = &fit.surface;
     let best = s.total[s.estimate];
     let rel = |v: f64| v - best;
+    // Each run's curve relative to its own maximum.
     let mut ll_curves: Vec<Curve> = fit
         .observations
         .iter()
         .enumerate()
-        .map(|(i, (name, ..))| Curve {
-            label: name.clone(),
-            points: (0..s.grid.len())
-                .map(|j| {
-                    let sd = if s.mc_sd[i][j].is_finite() {
-                        s.mc_sd[i][j]
-                    } else {
-                        0.0
-                    };
-                    CurvePoint {
-                        x: s.grid[j],
-                        y: rel(s.log_lik[i][j]),
-                        lo: rel(s.log_lik[i][j] - sd),
-                        hi: rel(s.log_lik[i][j] + sd),
-                    }
-                })
-                .collect(),
+        .map(|(i, (name, ..))| {
+            let top = s.log_lik[i]
+                .iter()
+                .copied()
+                .fold(f64::NEG_INFINITY, f64::max);
+            Curve {
+                label: name.clone(),
+                points: (0..s.grid.len())
+                    .map(|j| {
+                        let sd = if s.mc_sd[i][j].is_finite() {
+                            s.mc_sd[i][j]
+                        } else {
+                            0.0
+                        };
+                        let v = s.log_lik[i][j] - top;
+                        CurvePoint {
+                            x: s.grid[j],
+                            y: v,
+                            lo: v - sd,
+                            hi: v + sd,
+                        }
+                    })
+                    .collect(),
+            }
         })
         .collect();
     ll_curves.push(Curve {
@@ -693,7 +701,7 @@ pub fn fit_plot(fit: &EpuckFit) -> FitPlot {
         panels: vec![
             FitPanel {
                 caption: "Log-likelihood (± Monte Carlo sd)".into(),
-                y_desc: "log-likelihood - maximum".into(),
+                y_desc: "log-likelihood - its maximum".into(),
                 curves: ll_curves,
                 references: Vec::new(),
                 y_floor: Some(-12.0),

@@ -1,9 +1,11 @@
 //! The integration tests of `errp_sweep`, one binary: what sweeps compute
 //! (`results`: sharded + merged equals unsharded, 1 thread equals 2, a
 //! resumed sweep equals an uninterrupted one, the numbers move the right
-//! way) and how they keep their files whole (`integrity`: locks, corrupted
-//! rows on resume and merge, refused directories).
+//! way), how they keep their files whole (`integrity`: locks, corrupted
+//! rows on resume and merge, refused directories), and the fits built on
+//! them (`fit`).
 
+mod fit;
 mod integrity;
 mod results;
 

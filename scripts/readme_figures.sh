@@ -1,0 +1,90 @@
+#!/usr/bin/env bash
+# The commands behind the figures the README quotes, and their outputs.
+#
+#   scripts/readme_figures.sh [--check] [--cheap] [NAME...]
+#
+# Each figure is a command of the release `errp` (or $ERRP) whose standard
+# output is kept in docs/figures/NAME.txt; the README's tables are copied
+# from those files and name them. Without --check the outputs are written
+# anew; with --check each command runs again and the script fails on any
+# difference (a unified diff shows it). --cheap keeps to the figures that
+# take seconds (CI runs these); NAME... picks figures by name. Every run is
+# seeded and independent of the thread count, so the outputs are exact. The
+# targeting cache is a fresh temporary directory, so nothing on the machine
+# changes a result.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+# name | cost (cheap: seconds; slow: minutes) | errp arguments
+FIGURES=(
+  "epuck_mexico_default|cheap|run scenarios/mexico_to_pisa.toml --runs 200 --quiet"
+  "epuck_lisbon_default|cheap|run scenarios/lisbon_to_tokyo.toml --runs 200 --quiet"
+  "epuck_mexico_optimistic|cheap|run scenarios/variants/mexico_to_pisa_optimistic.toml --runs 200 --quiet"
+  "epuck_lisbon_optimistic|cheap|run scenarios/variants/lisbon_to_tokyo_optimistic.toml --runs 200 --quiet"
+  "epuck_mexico_literal|cheap|run scenarios/variants/mexico_to_pisa_literal.toml --runs 200 --quiet"
+  "epuck_lisbon_literal|cheap|run scenarios/variants/lisbon_to_tokyo_literal.toml --runs 200 --quiet"
+  "fit_epuck|slow|fit epuck --out FIT_DIR --quiet"
+)
+
+check=false
+cheap=false
+names=()
+for arg in "$@"; do
+  case "$arg" in
+    --check) check=true ;;
+    --cheap) cheap=true ;;
+    -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
+    -*) echo "error: unknown option $arg (expected --check, --cheap or figure names)" >&2; exit 2 ;;
+    *) names+=("$arg") ;;
+  esac
+done
+known=" $(for f in "${FIGURES[@]}"; do printf '%s ' "${f%%|*}"; done)"
+for n in "${names[@]}"; do
+  if [[ "$known" != *" $n "* ]]; then
+    echo "error: no figure named $n (known:$known)" >&2
+    exit 2
+  fi
+done
+
+ERRP=${ERRP:-target/release/errp}
+if [ ! -x "$ERRP" ]; then
+  cargo build --release --locked --quiet
+fi
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+export ERRP_CACHE_DIR="$work/cache"
+mkdir -p docs/figures
+
+failed=0
+ran=0
+for entry in "${FIGURES[@]}"; do
+  IFS='|' read -r name cost args <<<"$entry"
+  if [ "${#names[@]}" -gt 0 ] && [[ " ${names[*]} " != *" $name "* ]]; then
+    continue
+  fi
+  if $cheap && [ "$cost" != cheap ]; then
+    continue
+  fi
+  args=${args//FIT_DIR/$work/fit-$name}
+  start=$SECONDS
+  # shellcheck disable=SC2086 # the arguments are words
+  "$ERRP" $args >"$work/$name.out"
+  # File paths of this run's temporary directory are not part of a figure.
+  grep -v -F "$work" "$work/$name.out" >"$work/$name.txt" || true
+  ran=$((ran + 1))
+  if $check; then
+    if diff -u "docs/figures/$name.txt" "$work/$name.txt"; then
+      echo "ok   $name ($((SECONDS - start)) s)"
+    else
+      echo "DIFF $name: the README's figure docs/figures/$name.txt no longer holds" >&2
+      failed=$((failed + 1))
+    fi
+  else
+    cp "$work/$name.txt" "docs/figures/$name.txt"
+    echo "wrote docs/figures/$name.txt ($((SECONDS - start)) s)"
+  fi
+done
+if $check; then
+  echo "$((ran - failed)) passed, $failed failed"
+fi
+[ "$failed" -eq 0 ]

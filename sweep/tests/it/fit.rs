@@ -1,0 +1,283 @@
+//! `errp fit epuck` end to end on a small grid, and the shipped defaults
+//! against the committed fit (`fits/epuck.json`).
+
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+
+use errp_sweep::fit::{EpuckFitSpec, FitOutcome, Provenance, paper_runs, run_epuck_fit};
+
+use crate::{cache, temp_dir};
+
+fn repo(path: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(path)
+}
+
+fn provenance() -> Provenance {
+    Provenance {
+        command: "test".into(),
+        errp_version: "test".into(),
+        commit: "test".into(),
+    }
+}
+
+fn scenario_accuracy(file: &str) -> f64 {
+    let text = std::fs::read_to_string(repo(file)).unwrap();
+    let table: toml::Table = toml::from_str(&text).unwrap();
+    table["user"]["accuracy"].as_float().unwrap()
+}
+
+#[test]
+fn the_shipped_e_puck_decoder_is_the_committed_fit() {
+    let text = std::fs::read_to_string(repo("fits/epuck.json")).unwrap();
+    let fit: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(fit["format"], 1);
+    assert_eq!(fit["parameter"], "user.accuracy");
+    let estimate = fit["estimate"].as_f64().unwrap();
+    let (lo, hi) = (
+        fit["interval_95"][0].as_f64().unwrap(),
+        fit["interval_95"][1].as_f64().unwrap(),
+    );
+    assert!(
+        lo <= estimate && estimate <= hi,
+        "{estimate} in [{lo}, {hi}]"
+    );
+    // Made by a committed program, at its default settings.
+    let commit = fit["provenance"]["commit"].as_str().unwrap();
+    assert!(
+        commit.len() == 40 && commit.chars().all(|c| c.is_ascii_hexdigit()),
+        "fits/epuck.json was made by {commit:?}, not a clean commit"
+    );
+    assert_eq!(fit["spec"]["calibrations"], 5);
+    assert_eq!(fit["spec"]["runs"], 100);
+    // The grid's maximum is the estimate.
+    let total: Vec<f64> = fit["surface"]["total"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap_or(f64::NEG_INFINITY))
+        .collect();
+    let grid: Vec<f64> = fit["surface"]["grid"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let best = errp_sweep::fit::argmax(&total);
+    assert_eq!(grid[best], estimate);
+    // Every shipped scenario with the paper's decoder uses it.
+    for file in [
+        "scenarios/mexico_to_pisa.toml",
+        "scenarios/lisbon_to_tokyo.toml",
+        "scenarios/obstacles_havana_to_seoul.toml",
+        "scenarios/variants/mexico_to_pisa_literal.toml",
+        "scenarios/variants/lisbon_to_tokyo_literal.toml",
+    ] {
+        assert_eq!(
+            scenario_accuracy(file),
+            estimate,
+            "{file} and fits/epuck.json disagree"
+        );
+    }
+    // The hand-picked decoder stays as a named variant.
+    for file in [
+        "scenarios/variants/mexico_to_pisa_optimistic.toml",
+        "scenarios/variants/lisbon_to_tokyo_optimistic.toml",
+    ] {
+        assert_eq!(scenario_accuracy(file), 0.95, "{file}");
+    }
+}
+
+#[test]
+fn shipped_scenarios_have_distinct_seeds() {
+    let mut seeds = Vec::new();
+    for entry in std::fs::read_dir(repo("scenarios")).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            let table: toml::Table =
+                toml::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+            seeds.push((table["seed"].as_integer().unwrap(), path));
+        }
+    }
+    assert!(seeds.len() >= 5);
+    seeds.sort();
+    for w in seeds.windows(2) {
+        assert_ne!(w[0].0, w[1].0, "{:?} and {:?} share a seed", w[0].1, w[1].1);
+    }
+}
+
+#[test]
+fn a_small_fit_writes_its_files_resumes_to_the_same_bytes_and_guards_its_directory() {
+    let out = temp_dir("fit");
+    let spec = EpuckFitSpec {
+        accuracies: vec![0.8, 0.95],
+        calibrations: 1,
+        runs: 5,
+        seed: 3,
+        bootstrap: 20,
+    };
+    let cancel = AtomicBool::new(false);
+    let mut sweeps = Vec::new();
+    let run = |sweeps: &mut Vec<u64>| {
+        run_epuck_fit(
+            &spec,
+            &out,
+            &cache(),
+            provenance(),
+            &cancel,
+            &(),
+            |_, _, _, seed| sweeps.push(seed),
+        )
+        .unwrap()
+    };
+    let FitOutcome::Complete(fit, files) = run(&mut sweeps) else {
+        panic!("not interrupted")
+    };
+    assert_eq!(sweeps, vec![3, 3]);
+    assert_eq!(files.len(), 4);
+    assert_eq!(fit.stats.len(), 2);
+    assert!(fit.stats.iter().flatten().all(|s| s.runs == 5));
+    assert!(spec.accuracies.contains(&fit.estimate));
+    let first = std::fs::read(out.join("fit.json")).unwrap();
+    let csv = std::fs::read_to_string(out.join("surface.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 3, "{csv}");
+    assert!(
+        std::fs::read(out.join("fit.png"))
+            .unwrap()
+            .starts_with(b"\x89PNG")
+    );
+    // A rerun finds every run on disk and writes the same bytes.
+    let FitOutcome::Complete(..) = run(&mut sweeps) else {
+        panic!("not interrupted")
+    };
+    assert_eq!(std::fs::read(out.join("fit.json")).unwrap(), first);
+    // A directory holding anything else is refused, untouched.
+    let foreign = temp_dir("fit-foreign");
+    std::fs::create_dir_all(&foreign).unwrap();
+    std::fs::write(foreign.join("mine.txt"), "mine").unwrap();
+    let e = run_epuck_fit(
+        &spec,
+        &foreign,
+        &cache(),
+        provenance(),
+        &cancel,
+        &(),
+        |_, _, _, _| {},
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("mine.txt") && e.contains("--out"), "{e}");
+    assert_eq!(std::fs::read_dir(&foreign).unwrap().count(), 1);
+    // Bad settings name their flag and range.
+    let bad = EpuckFitSpec {
+        runs: 2,
+        ..spec.clone()
+    };
+    let e = run_epuck_fit(
+        &bad,
+        &out,
+        &cache(),
+        provenance(),
+        &cancel,
+        &(),
+        |_, _, _, _| {},
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("--runs 2") && e.contains("5 to"), "{e}");
+    let _ = std::fs::remove_dir_all(&out);
+    let _ = std::fs::remove_dir_all(&foreign);
+    assert_eq!(paper_runs().len(), 2);
+}
+
+/// The median time to Pisa with a run that converged on a wrong city
+/// counted as never reaching it (the median over the successful runs alone
+/// is not monotonic: at a poor accuracy only runs that happened to be
+/// quick reach Pisa before a wrong city takes them).
+fn median_time_to_goal(rows: &[(bool, f64)]) -> f64 {
+    let mut t: Vec<f64> = rows
+        .iter()
+        .map(|&(ok, t)| if ok { t } else { f64::INFINITY })
+        .collect();
+    t.sort_by(f64::total_cmp);
+    t[t.len() / 2]
+}
+
+#[test]
+#[ignore = "slow (2500 e-puck runs, about 3 minutes in release): .ci/run runs it"]
+fn the_median_time_to_pisa_does_not_rise_with_accuracy() {
+    use errp_sweep::{Shard, SweepOptions, SweepSpec, SweepTask, run_sweep, sweep_fixed};
+    let out = temp_dir("monotonic");
+    let names = errp_sweep::InputNames {
+        scenario: "--scenario",
+        task: "--task",
+        eeg: "--eeg",
+    };
+    let spec = SweepSpec {
+        task: SweepTask::Epuck,
+        scenario_path: "scenarios/mexico_to_pisa.toml".into(),
+        scenario_toml: paper_runs()[0].scenario.to_string(),
+        accuracies: vec![0.75, 0.8, 0.85, 0.9, 0.95],
+        axes: vec![],
+        fixed: sweep_fixed(SweepTask::Epuck, None, names).unwrap(),
+        episodes: 500,
+        seed: 1,
+    };
+    let opts = SweepOptions {
+        out: out.clone(),
+        cache: cache(),
+        shard: Shard::ALL,
+        chunk: 0,
+        repair: false,
+    };
+    run_sweep(&spec, &opts, &AtomicBool::new(false), &()).unwrap();
+    let text = std::fs::read_to_string(out.join("episodes.csv")).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |n: &str| header.iter().position(|c| *c == n).unwrap();
+    let (lv, ok, t) = (col("level"), col("success"), col("time_secs"));
+    let mut levels = vec![Vec::new(); 5];
+    for l in lines {
+        let f: Vec<&str> = l.split(',').collect();
+        levels[f[lv].parse::<usize>().unwrap()].push((f[ok] == "1", f[t].parse::<f64>().unwrap()));
+    }
+    // Monte Carlo error of each median: the sd over 200 bootstrap samples.
+    let mut rng = errp_bci::rng::stream(1, "test/bootstrap");
+    let stats: Vec<(f64, f64, f64)> = levels
+        .iter()
+        .map(|rows| {
+            use rand::Rng;
+            let boots: Vec<f64> = (0..200)
+                .map(|_| {
+                    let b: Vec<(bool, f64)> = (0..rows.len())
+                        .map(|_| rows[rng.random_range(0..rows.len())])
+                        .collect();
+                    median_time_to_goal(&b)
+                })
+                .filter(|v| v.is_finite())
+                .collect();
+            let m = boots.iter().sum::<f64>() / boots.len().max(1) as f64;
+            let sd = (boots.iter().map(|v| (v - m).powi(2)).sum::<f64>()
+                / boots.len().max(2) as f64)
+                .sqrt();
+            let reached = rows.iter().filter(|r| r.0).count() as f64 / rows.len() as f64;
+            (median_time_to_goal(rows), sd, reached)
+        })
+        .collect();
+    for w in stats.windows(2) {
+        let ((m0, s0, _), (m1, s1, _)) = (w[0], w[1]);
+        let tolerance = 2.0 * (s0.max(0.0).hypot(s1.max(0.0)));
+        assert!(
+            m1 <= m0 + tolerance || m0.is_infinite(),
+            "median time to Pisa rose with accuracy: {stats:?}"
+        );
+    }
+    // And the share that reaches Pisa rises (within 2 binomial sd).
+    for w in stats.windows(2) {
+        let (p0, p1) = (w[0].2, w[1].2);
+        let sd = ((p0 * (1.0 - p0) + p1 * (1.0 - p1)) / 500.0).sqrt();
+        assert!(p1 >= p0 - 2.0 * sd, "{stats:?}");
+    }
+    // At the top of the range the median is finite: most runs reach Pisa.
+    assert!(stats[4].0.is_finite() && stats[4].2 > 0.8, "{stats:?}");
+    let _ = std::fs::remove_dir_all(&out);
+}
