@@ -203,7 +203,7 @@ fn median_time_to_goal(rows: &[(bool, f64)]) -> f64 {
 }
 
 #[test]
-#[ignore = "slow (2500 e-puck runs, about 3 minutes in release): .ci/run runs it"]
+#[ignore = "slow (2500 e-puck runs, about 3 minutes): .ci/run runs it"]
 fn the_median_time_to_pisa_does_not_rise_with_accuracy() {
     use errp_sweep::{Shard, SweepOptions, SweepSpec, SweepTask, run_sweep, sweep_fixed};
     let out = temp_dir("monotonic");
