@@ -23,7 +23,8 @@ FIGURES=(
   "epuck_lisbon_optimistic|cheap|run scenarios/variants/lisbon_to_tokyo_optimistic.toml --runs 200 --quiet"
   "epuck_mexico_literal|cheap|run scenarios/variants/mexico_to_pisa_literal.toml --runs 200 --quiet"
   "epuck_lisbon_literal|cheap|run scenarios/variants/lisbon_to_tokyo_literal.toml --runs 200 --quiet"
-  "fit_epuck|slow|fit epuck --out FIT_DIR --quiet"
+  "sweep_epuck|slow|sweep --task epuck --accuracy 0.55:0.95:0.05 --param strategy=greedy,info_gain --episodes 100 --seed 1 --out OUT_DIR --quiet"
+  "fit_epuck|slow|fit epuck --out OUT_DIR --quiet"
 )
 
 check=false
@@ -65,7 +66,7 @@ for entry in "${FIGURES[@]}"; do
   if $cheap && [ "$cost" != cheap ]; then
     continue
   fi
-  args=${args//FIT_DIR/$work/fit-$name}
+  args=${args//OUT_DIR/$work/out-$name}
   start=$SECONDS
   # shellcheck disable=SC2086 # the arguments are words
   "$ERRP" $args >"$work/$name.out"

@@ -6,12 +6,11 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use errp_sim::task::ordinal_percent;
-use errp_sweep::TargetCache;
 use errp_sweep::fit::{EpuckFit, EpuckFitSpec, FitOutcome, Provenance, run_epuck_fit};
 use errp_sweep::parse_accuracies;
 
 use crate::cli::parse_seed;
-use crate::commands::sweep::{Progress, slurm_cpus, wall_clock};
+use crate::commands::sweep::{Progress, Workers, wall_clock};
 use crate::interrupt;
 
 /// `errp fit`.
@@ -54,16 +53,8 @@ pub struct EpuckFitArgs {
     /// fit.png.
     #[arg(long, value_name = "DIR", default_value = "fit-epuck")]
     out: PathBuf,
-    /// Worker threads, 1 to 1024 (default: $SLURM_CPUS_PER_TASK inside a
-    /// Slurm job, else one per core). Results do not depend on it.
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
-    threads: Option<u64>,
-    /// Where targeting results are cached (as `errp sweep`).
-    #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
-    cache: Option<PathBuf>,
-    /// Do not read or write the targeting cache.
-    #[arg(long)]
-    no_cache: bool,
+    #[command(flatten)]
+    workers: Workers,
     /// No progress output.
     #[arg(long)]
     quiet: bool,
@@ -87,22 +78,11 @@ fn fit_epuck(args: &EpuckFitArgs) -> Result<bool> {
         seed: args.seed,
         bootstrap: args.bootstrap,
     };
-    let cache = match (&args.cache, args.no_cache) {
-        (_, true) => TargetCache::disabled(),
-        (Some(dir), false) => TargetCache::new(dir),
-        (None, false) => TargetCache::default_location(),
-    };
+    let cache = args.workers.cache();
     if let Some(why) = cache.problem() {
         eprintln!("warning: {why}");
     }
-    let threads = match args.threads {
-        Some(n) => n as usize,
-        None => slurm_cpus().unwrap_or_else(rayon::current_num_threads),
-    };
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .context("cannot start the worker threads")?;
+    let (pool, threads) = args.workers.pool()?;
     let provenance = Provenance {
         command: std::env::args().collect::<Vec<_>>().join(" "),
         errp_version: env!("CARGO_PKG_VERSION").to_string(),

@@ -73,17 +73,8 @@ pub struct SweepArgs {
     /// `errp merge`.
     #[arg(long, value_name = "K/N")]
     shard: Option<String>,
-    /// Worker threads, 1 to 1024 (default: $SLURM_CPUS_PER_TASK inside a
-    /// Slurm job, else one per core). Results do not depend on it.
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
-    threads: Option<u64>,
-    /// Where targeting results are cached (default: $ERRP_CACHE_DIR, else
-    /// $XDG_CACHE_HOME/errp, else ~/.cache/errp).
-    #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
-    cache: Option<PathBuf>,
-    /// Do not read or write the targeting cache.
-    #[arg(long)]
-    no_cache: bool,
+    #[command(flatten)]
+    workers: Workers,
     /// On resume, drop an invalid row of DIR/episodes.csv (and the rows
     /// after it) and run them again, instead of stopping at it.
     #[arg(long)]
@@ -96,6 +87,48 @@ pub struct SweepArgs {
     /// No progress output.
     #[arg(long)]
     quiet: bool,
+}
+
+/// Where the work runs: threads and the targeting cache (`errp sweep`,
+/// `errp fit`).
+#[derive(clap::Args)]
+pub(crate) struct Workers {
+    /// Worker threads, 1 to 1024 (default: $SLURM_CPUS_PER_TASK inside a
+    /// Slurm job, else one per core). Results do not depend on it.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
+    threads: Option<u64>,
+    /// Where targeting results are cached (default: $ERRP_CACHE_DIR, else
+    /// $XDG_CACHE_HOME/errp, else ~/.cache/errp).
+    #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
+    cache: Option<PathBuf>,
+    /// Do not read or write the targeting cache.
+    #[arg(long)]
+    no_cache: bool,
+}
+
+impl Workers {
+    /// The targeting cache asked for.
+    pub(crate) fn cache(&self) -> TargetCache {
+        match (&self.cache, self.no_cache) {
+            (_, true) => TargetCache::disabled(),
+            (Some(dir), false) => TargetCache::new(dir),
+            (None, false) => TargetCache::default_location(),
+        }
+    }
+
+    /// The worker threads: `--threads`, else $SLURM_CPUS_PER_TASK, else one
+    /// per core.
+    pub(crate) fn pool(&self) -> Result<(rayon::ThreadPool, usize)> {
+        let threads = match self.threads {
+            Some(n) => n as usize,
+            None => slurm_cpus().unwrap_or_else(rayon::current_num_threads),
+        };
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .context("cannot start the worker threads")?;
+        Ok((pool, threads))
+    }
 }
 
 /// `errp merge`.
@@ -255,11 +288,7 @@ pub fn sweep(args: &SweepArgs) -> Result<bool> {
         Some(s) => Shard::parse(s)?,
         None => Shard::ALL,
     };
-    let cache = match (&args.cache, args.no_cache) {
-        (_, true) => TargetCache::disabled(),
-        (Some(dir), false) => TargetCache::new(dir),
-        (None, false) => TargetCache::default_location(),
-    };
+    let cache = args.workers.cache();
     // Validate every level before printing anything or starting work
     // (`run_sweep` checks them again, before it creates the directory).
     spec.levels()?;
@@ -270,14 +299,7 @@ pub fn sweep(args: &SweepArgs) -> Result<bool> {
         }
         eprintln!("warning: {why}");
     }
-    let threads = match args.threads {
-        Some(n) => n as usize,
-        None => slurm_cpus().unwrap_or_else(rayon::current_num_threads),
-    };
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .context("cannot start the worker threads")?;
+    let (pool, threads) = args.workers.pool()?;
     let progress = Progress::new(args.quiet);
     if args.prepare_only {
         return prepare(&spec, &cache, &pool, &progress).map(|()| true);
@@ -355,7 +377,7 @@ pub fn sweep(args: &SweepArgs) -> Result<bool> {
 }
 
 /// The CPUs Slurm gave this job's task (`$SLURM_CPUS_PER_TASK`), if set.
-pub(crate) fn slurm_cpus() -> Option<usize> {
+fn slurm_cpus() -> Option<usize> {
     std::env::var("SLURM_CPUS_PER_TASK")
         .ok()?
         .trim()

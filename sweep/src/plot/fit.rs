@@ -63,39 +63,25 @@ pub struct FitPlot {
 /// Width of one panel, pixels.
 const PANEL_WIDTH: u32 = 520;
 
-/// Renders a fit figure as an SVG document (text as `<text>`, as
-/// [`svg()`]).
-pub fn fit_svg(plot: &FitPlot) -> Result<String, PlotError> {
-    register_font()?;
-    let width = PANEL_WIDTH * plot.panels.len().max(1) as u32;
-    let mut out = String::new();
-    {
-        let root = SVGBackend::with_string(&mut out, (width, HEIGHT)).into_drawing_area();
-        draw_fit(&root, plot)?;
-        root.present().map_err(draw_error)?;
+impl Figure for FitPlot {
+    fn width(&self) -> u32 {
+        PANEL_WIDTH * self.panels.len().max(1) as u32
     }
-    Ok(out)
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), PlotError> {
+        draw_fit(root, self)
+    }
 }
 
-/// Renders a fit figure as a PNG file (8-bit RGB, as [`png()`]).
+/// Renders a fit figure as an SVG document (text as `<text>` elements in
+/// the viewer's sans-serif font, as a sweep's figure).
+pub fn fit_svg(plot: &FitPlot) -> Result<String, PlotError> {
+    render_svg(plot)
+}
+
+/// Renders a fit figure as a PNG file (8-bit RGB, text set in the embedded
+/// DejaVu Sans, as a sweep's figure).
 pub fn fit_png(plot: &FitPlot) -> Result<Vec<u8>, PlotError> {
-    register_font()?;
-    let width = PANEL_WIDTH * plot.panels.len().max(1) as u32;
-    let mut pixels = vec![0u8; width as usize * HEIGHT as usize * 3];
-    {
-        let bitmap =
-            BitMapBackend::<RGBPixel>::with_buffer_and_format(&mut pixels, (width, HEIGHT))
-                .map_err(draw_error)?;
-        let font = FontRef::try_from_slice(FONT_BYTES).map_err(|_| PlotError::Font)?;
-        let root = GlyphText {
-            inner: bitmap,
-            font,
-        }
-        .into_drawing_area();
-        draw_fit(&root, plot)?;
-        root.present().map_err(draw_error)?;
-    }
-    encode_png(&pixels, width)
+    render_png(plot)
 }
 
 fn draw_fit<DB: DrawingBackend>(
@@ -172,7 +158,7 @@ fn draw_fit_panel<DB: DrawingBackend>(
     if let Some(floor) = fit.y_floor {
         y_lo = y_lo.max(floor);
     }
-    if !(y_lo < y_hi) {
+    if y_lo.partial_cmp(&y_hi) != Some(std::cmp::Ordering::Less) {
         (y_lo, y_hi) = (y_lo.min(0.0) - 1.0, y_hi.max(0.0) + 1.0);
         if !y_lo.is_finite() || !y_hi.is_finite() {
             (y_lo, y_hi) = (0.0, 1.0);

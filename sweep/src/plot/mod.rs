@@ -149,33 +149,48 @@ pub enum PlotError {
     Png(#[from] png::EncodingError),
 }
 
-/// Renders the figure as an SVG document.
-///
-/// Text is left as `<text>` elements with `font-family="sans-serif"`, so the
-/// viewer's sans-serif font sets it.
-pub fn svg(plot: &SweepPlot) -> Result<String, PlotError> {
+/// Something drawn on one drawing area, `width()` by [`HEIGHT`] pixels,
+/// by the same code for the SVG and the PNG.
+trait Figure {
+    /// Width of the figure, pixels.
+    fn width(&self) -> u32;
+    /// Draws the whole figure on `root`.
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), PlotError>;
+}
+
+impl Figure for SweepPlot {
+    fn width(&self) -> u32 {
+        WIDTH
+    }
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), PlotError> {
+        draw(root, self)
+    }
+}
+
+/// Renders `figure` as an SVG document: text is left as `<text>` elements
+/// with `font-family="sans-serif"`, so the viewer's sans-serif font sets it.
+fn render_svg(figure: &impl Figure) -> Result<String, PlotError> {
     register_font()?;
     let mut out = String::new();
     {
-        let root = SVGBackend::with_string(&mut out, (WIDTH, HEIGHT)).into_drawing_area();
-        draw(&root, plot)?;
+        let root = SVGBackend::with_string(&mut out, (figure.width(), HEIGHT)).into_drawing_area();
+        figure.draw_on(&root)?;
         root.present().map_err(draw_error)?;
     }
     Ok(out)
 }
 
-/// Renders the figure as a PNG file (8-bit RGB), text set in the embedded
-/// DejaVu Sans.
-///
-/// Text is rasterised by this module (`GlyphText`) rather than by plotters' own
+/// Renders `figure` as a PNG file (8-bit RGB), text set in the embedded
+/// DejaVu Sans by this module (`GlyphText`) rather than by plotters' own
 /// `ab_glyph` renderer, which drops each glyph's left side bearing and so
 /// spaces letters unevenly.
-pub fn png(plot: &SweepPlot) -> Result<Vec<u8>, PlotError> {
+fn render_png(figure: &impl Figure) -> Result<Vec<u8>, PlotError> {
     register_font()?;
-    let mut pixels = vec![0u8; WIDTH as usize * HEIGHT as usize * 3];
+    let width = figure.width();
+    let mut pixels = vec![0u8; width as usize * HEIGHT as usize * 3];
     {
         let bitmap =
-            BitMapBackend::<RGBPixel>::with_buffer_and_format(&mut pixels, (WIDTH, HEIGHT))
+            BitMapBackend::<RGBPixel>::with_buffer_and_format(&mut pixels, (width, HEIGHT))
                 .map_err(draw_error)?;
         let font = FontRef::try_from_slice(FONT_BYTES).map_err(|_| PlotError::Font)?;
         let root = GlyphText {
@@ -183,10 +198,24 @@ pub fn png(plot: &SweepPlot) -> Result<Vec<u8>, PlotError> {
             font,
         }
         .into_drawing_area();
-        draw(&root, plot)?;
+        figure.draw_on(&root)?;
         root.present().map_err(draw_error)?;
     }
-    encode_png(&pixels, WIDTH)
+    encode_png(&pixels, width)
+}
+
+/// Renders the figure as an SVG document.
+///
+/// Text is left as `<text>` elements with `font-family="sans-serif"`, so the
+/// viewer's sans-serif font sets it.
+pub fn svg(plot: &SweepPlot) -> Result<String, PlotError> {
+    render_svg(plot)
+}
+
+/// Renders the figure as a PNG file (8-bit RGB), text set in the embedded
+/// DejaVu Sans.
+pub fn png(plot: &SweepPlot) -> Result<Vec<u8>, PlotError> {
+    render_png(plot)
 }
 
 /// Encodes RGB `pixels`, `width` wide and [`HEIGHT`] high, as a PNG file.

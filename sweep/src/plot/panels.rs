@@ -2,6 +2,9 @@
 
 use super::*;
 
+/// How an axis writes its tick labels.
+pub(super) type TickFormat<'a> = &'a dyn Fn(&f64) -> String;
+
 /// The x axis of a sweep's panels.
 const ACCURACY_DESC: &str = "decoder accuracy (mean of per-class rates)";
 
@@ -16,7 +19,7 @@ pub(super) fn panel<'a, DB: DrawingBackend + 'a>(
     x_range: std::ops::Range<f64>,
     y_range: std::ops::Range<f64>,
     (x_desc, y_desc): (&str, &str),
-    (x_format, y_format): (&dyn Fn(&f64) -> String, &dyn Fn(&f64) -> String),
+    (x_format, y_format): (TickFormat, TickFormat),
 ) -> Result<Chart<'a, DB>, PlotError> {
     let mut chart = ChartBuilder::on(area)
         .caption(caption, font(CAPTION_SIZE))
