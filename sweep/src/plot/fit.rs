@@ -88,16 +88,7 @@ fn draw_fit<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     plot: &FitPlot,
 ) -> Result<(), PlotError> {
-    root.fill(&WHITE).map_err(draw_error)?;
-    let (title_area, body) = root.split_vertically(TITLE_BAND);
-    let (w, h) = title_area.dim_in_pixel();
-    title_area
-        .draw_text(
-            &plot.title,
-            &font(TITLE_SIZE).pos(Pos::new(HPos::Center, VPos::Center)),
-            (w as i32 / 2, h as i32 / 2 + 2),
-        )
-        .map_err(draw_error)?;
+    let body = titled(root, &plot.title)?;
     let n = plot.panels.len().max(1);
     let areas = body.split_evenly((1, n));
     let xs = plot

@@ -256,21 +256,31 @@ fn colour(i: usize) -> RGBColor {
     PALETTE[i % PALETTE.len()]
 }
 
-/// Draws the whole figure on `root`.
-fn draw<DB: DrawingBackend>(
+/// Clears `root` to white and sets `title` in its top band; the area below
+/// it, for the panels.
+fn titled<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
-    plot: &SweepPlot,
-) -> Result<(), PlotError> {
+    title: &str,
+) -> Result<DrawingArea<DB, Shift>, PlotError> {
     root.fill(&WHITE).map_err(draw_error)?;
     let (title_area, body) = root.split_vertically(TITLE_BAND);
     let (w, h) = title_area.dim_in_pixel();
     title_area
         .draw_text(
-            &plot.title,
+            title,
             &font(TITLE_SIZE).pos(Pos::new(HPos::Center, VPos::Center)),
             (w as i32 / 2, h as i32 / 2 + 2),
         )
         .map_err(draw_error)?;
+    Ok(body)
+}
+
+/// Draws the whole figure on `root`.
+fn draw<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    plot: &SweepPlot,
+) -> Result<(), PlotError> {
+    let body = titled(root, &plot.title)?;
 
     let (left, right) = body.split_horizontally(WIDTH / 2);
     let x_range = x_range(plot);
