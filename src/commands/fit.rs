@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use errp_sim::task::ordinal_percent;
 use errp_sweep::fit::{EpuckFit, EpuckFitSpec, FitOutcome, Provenance, run_epuck_fit};
 use errp_sweep::parse_accuracies;
@@ -120,7 +120,8 @@ fn fit_epuck(args: &EpuckFitArgs) -> Result<bool> {
         )
     });
     interrupt::graceful(false);
-    let outcome = outcome.with_context(|| format!("--out {}", args.out.display()))?;
+    // The library's errors name --out, or the file under it.
+    let outcome = outcome?;
     if let Some(bar) = &progress.bar {
         bar.finish_and_clear();
     }
