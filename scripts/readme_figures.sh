@@ -3,8 +3,8 @@
 #
 #   scripts/readme_figures.sh [--check] [--cheap] [NAME...]
 #
-# Each figure is a command of the release `errp` (or $ERRP) whose standard
-# output is kept in docs/figures/NAME.txt; the README's tables are copied
+# Each figure is a command of the release `errp` (or $ERRP), or a script
+# ("sh: ..."), whose standard output is kept in docs/figures/NAME.txt; the README's tables are copied
 # from those files and name them. Without --check the outputs are written
 # anew; with --check each command runs again and the script fails on any
 # difference (a unified diff shows it). --cheap keeps to the figures that
@@ -25,6 +25,9 @@ FIGURES=(
   "epuck_lisbon_literal|cheap|run scenarios/variants/lisbon_to_tokyo_literal.toml --runs 200 --quiet"
   "sweep_epuck|slow|sweep --task epuck --accuracy 0.55:0.95:0.05 --param strategy=greedy,info_gain --episodes 100 --seed 1 --out OUT_DIR --quiet"
   "fit_epuck|slow|fit epuck --out OUT_DIR --quiet"
+  "table1|cheap|table1 --seed 1 --quiet"
+  "fit_grid|slow|fit grid --out OUT_DIR --quiet"
+  "table1_seeds|slow|sh: python3 scripts/table1_seeds.py --seeds 10"
 )
 
 check=false
@@ -68,8 +71,12 @@ for entry in "${FIGURES[@]}"; do
   fi
   args=${args//OUT_DIR/$work/out-$name}
   start=$SECONDS
-  # shellcheck disable=SC2086 # the arguments are words
-  "$ERRP" $args >"$work/$name.out"
+  if [[ "$args" == "sh: "* ]]; then
+    ERRP="$ERRP" bash -c "${args#sh: }" >"$work/$name.out"
+  else
+    # shellcheck disable=SC2086 # the arguments are words
+    "$ERRP" $args >"$work/$name.out"
+  fi
   # File paths of this run's temporary directory are not part of a figure.
   grep -v -F "$work" "$work/$name.out" >"$work/$name.txt" || true
   ran=$((ran + 1))

@@ -49,7 +49,7 @@ def test_grid_run_matches_errp_run(root):
         mean = 100 * (r.acc_correct + r.acc_error) / 2
         assert f"{mean:.1f}" == nums[5]
     assert df.attrs["task"] == "grid"
-    cal = re.search(r"mean ([\d.]+) % \(cross-validated\)", text).group(1)
+    cal = re.search(r"([\d.]+) % cross-validated", text).group(1)
     assert f"{100 * df.attrs['decoder']['cv_mean']:.2f}" == cal
 
 

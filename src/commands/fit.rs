@@ -5,9 +5,14 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
+use errp_sim::grid::GridTaskParams;
 use errp_sim::task::ordinal_percent;
-use errp_sweep::fit::{EpuckFit, EpuckFitSpec, FitOutcome, Provenance, run_epuck_fit};
-use errp_sweep::parse_accuracies;
+use errp_sweep::fit::{
+    EpuckFit, EpuckFitSpec, FitOutcome, GridFit, GridFitOutcome, GridFitSpec, Provenance,
+    run_epuck_fit, run_grid_fit,
+};
+use errp_sweep::{parse_accuracies, parse_values};
+use toml::Value;
 
 use crate::cli::parse_seed;
 use crate::commands::sweep::{Progress, Workers, wall_clock};
@@ -24,6 +29,51 @@ pub enum FitCommand {
     /// interval, each run held out in turn, and DIR/fit.json, surface.csv,
     /// fit.svg and fit.png. Rerunning into DIR resumes.
     Epuck(EpuckFitArgs),
+    /// The grid task's Q-value scale (control.goal_reward at the paper's tau
+    /// = 0.3), fitted to Table 1's fixed goals (the four subjects' mean
+    /// actions at their accuracies, every goal reached) and checked on the
+    /// free goals and on r, which the fit does not see: each subject's
+    /// decoders calibrated to their online accuracy, five runs per group,
+    /// the likelihood of each subject's row estimated from the simulated
+    /// groups, the maximum-likelihood goal reward with its 95 %
+    /// likelihood-ratio interval, each subject's own estimate, and
+    /// DIR/fit.json, surface.csv, fit.svg and fit.png.
+    Grid(GridFitArgs),
+}
+
+/// `errp fit grid`.
+#[derive(clap::Args)]
+pub struct GridFitArgs {
+    /// The goal-reward grid: start:stop:step (stop included) or a,b,c, each
+    /// in (0, 100]. The shipped default before the fit was 1.
+    #[arg(long, default_value = "1:10:0.5", allow_negative_numbers = true)]
+    goal_reward: String,
+    /// The device's epsilon (probability of a random action), held fixed;
+    /// the paper does not give it.
+    #[arg(long, default_value_t = GridTaskParams::default().control.epsilon, allow_negative_numbers = true)]
+    epsilon: f64,
+    /// Calibrations per subject and goal set (1 to 50).
+    #[arg(long, default_value_t = 5)]
+    calibrations: usize,
+    /// Groups of five runs (one per start/goal pair) per calibration and
+    /// goal reward (2 to 1000).
+    #[arg(long, default_value_t = 40)]
+    repeats: usize,
+    /// The base seed.
+    #[arg(long, default_value_t = 1, value_parser = parse_seed, allow_negative_numbers = true)]
+    seed: u64,
+    /// Bootstrap replicates of the simulated groups, for the Monte Carlo
+    /// error (10 to 10000).
+    #[arg(long, default_value_t = 200)]
+    bootstrap: usize,
+    /// Output directory: fit.json, surface.csv, fit.svg, fit.png.
+    #[arg(long, value_name = "DIR", default_value = "fit-grid")]
+    out: PathBuf,
+    #[command(flatten)]
+    workers: Workers,
+    /// No progress output.
+    #[arg(long)]
+    quiet: bool,
 }
 
 /// `errp fit epuck`.
@@ -67,6 +117,7 @@ pub(crate) const COMMIT: &str = env!("ERRP_COMMIT");
 pub fn fit(cmd: &FitCommand) -> Result<bool> {
     match cmd {
         FitCommand::Epuck(args) => fit_epuck(args),
+        FitCommand::Grid(args) => fit_grid(args),
     }
 }
 
@@ -220,6 +271,191 @@ fn print_fit(fit: &EpuckFit) {
             pct(h.stats.p_reached()),
             ordinal_percent(h.stats.time_percentile),
             ordinal_percent(h.stats.detections_percentile)
+        );
+    }
+}
+
+/// Parses `--goal-reward`: numbers (the range check is the fit's).
+fn parse_goal_rewards(text: &str) -> Result<Vec<f64>> {
+    parse_values(text, "--goal-reward")?
+        .into_iter()
+        .map(|v| match v {
+            Value::Float(x) => Ok(x),
+            Value::Integer(i) => Ok(i as f64),
+            other => Err(anyhow::anyhow!(
+                "--goal-reward {text:?} is invalid: {other:?} is not a number (e.g. 0.5:4:0.25)"
+            )),
+        })
+        .collect()
+}
+
+fn provenance() -> Provenance {
+    Provenance {
+        command: std::env::args().collect::<Vec<_>>().join(" "),
+        errp_version: env!("CARGO_PKG_VERSION").to_string(),
+        commit: COMMIT.to_string(),
+    }
+}
+
+fn fit_grid(args: &GridFitArgs) -> Result<bool> {
+    let spec = GridFitSpec {
+        goal_rewards: parse_goal_rewards(&args.goal_reward)?,
+        epsilon: args.epsilon,
+        calibrations: args.calibrations,
+        repeats: args.repeats,
+        seed: args.seed,
+        bootstrap: args.bootstrap,
+    };
+    let cache = args.workers.cache();
+    if let Some(why) = cache.problem() {
+        eprintln!("warning: {why}");
+    }
+    let (pool, threads) = args.workers.pool()?;
+    let progress = Progress::new(args.quiet);
+    progress.line(&format!(
+        "Fitting the grid's Q-value scale to Table 1's fixed goals: {} goal rewards x 4 subjects \
+         x 2 goal sets x {} calibrations x {} groups of 5 runs, seed {}, epsilon {}, into {} on \
+         {threads} thread(s)",
+        spec.goal_rewards.len(),
+        spec.calibrations,
+        spec.repeats,
+        spec.seed,
+        spec.epsilon,
+        args.out.display()
+    ));
+    let started = wall_clock();
+    let outcome = pool.install(|| {
+        run_grid_fit(
+            &spec,
+            &args.out,
+            &cache,
+            provenance(),
+            &interrupt::CANCEL,
+            &progress,
+        )
+    });
+    interrupt::graceful(false);
+    let outcome = outcome?;
+    if let Some(bar) = &progress.bar {
+        bar.finish_and_clear();
+    }
+    match outcome {
+        GridFitOutcome::Interrupted => {
+            eprintln!(
+                "Interrupted: nothing written; the decoders' targetings are cached, so a rerun \
+                 starts with the episodes."
+            );
+            Ok(false)
+        }
+        GridFitOutcome::Complete(fit, files) => {
+            if !args.quiet {
+                eprintln!("Done in {:.0} s.", started.elapsed().as_secs_f64());
+            }
+            print_grid_fit(&fit);
+            println!("Wrote:");
+            for f in files {
+                println!("  {}", f.display());
+            }
+            Ok(true)
+        }
+    }
+}
+
+fn print_grid_fit(fit: &GridFit) {
+    let s = &fit.surface;
+    println!(
+        "Grid Q-value scale (goal reward at tau = 0.3) fitted to Table 1's fixed goals ({} \
+         calibrations x {} groups of 5 runs per subject and point, epsilon {}, seed {}):",
+        fit.spec.calibrations, fit.spec.repeats, fit.spec.epsilon, fit.spec.seed
+    );
+    print!("{:>6}  {:>15}  {:>8}", "reward", "log L (MC sd)", "free L");
+    for row in &fit.fixed {
+        print!(
+            "  | {:<27}",
+            format!("{} fixed [{}]", row.subject, row.actions_mean)
+        );
+    }
+    println!("  | r<0 fixed/free");
+    for j in 0..s.grid.len() {
+        let mark = if j == s.estimate { "*" } else { " " };
+        print!(
+            "{mark}{:>5}  {:>7.2} ({:>5.2})  {:>8.2}",
+            errp_sim::task::format_number(s.grid[j]),
+            s.total[j],
+            s.total_sd[j],
+            fit.free_log_lik[j]
+        );
+        for per_point in &fit.fixed_stats {
+            let st = &per_point[j];
+            print!(
+                "  | {:>5.1} +- {:>5.1} {:>4}% z{:>+5.1}",
+                st.actions.0,
+                st.actions.1,
+                pct(st.reached as f64 / st.runs.max(1) as f64),
+                st.z
+            );
+        }
+        let share =
+            |t: &errp_sweep::fit::TableStats| pct(t.r_negative as f64 / t.tables.max(1) as f64);
+        println!(
+            "  | {:>3}% / {:>3}%",
+            share(&fit.fixed_tables[j]),
+            share(&fit.free_tables[j])
+        );
+    }
+    let edge = |at: bool| if at { " (the grid's end)" } else { "" };
+    let num = errp_sim::task::format_number;
+    println!(
+        "Estimate: goal reward {}; 95 % likelihood-ratio interval {}{}-{}{}; Monte Carlo spread \
+         of the estimate (5-95 % over {} bootstrap replicates) {}-{}.",
+        num(fit.estimate),
+        num(fit.interval_95.0),
+        edge(fit.interval_at_edge.0),
+        num(fit.interval_95.1),
+        edge(fit.interval_at_edge.1),
+        fit.spec.bootstrap,
+        num(fit.mc_interval_90.0),
+        num(fit.mc_interval_90.1)
+    );
+    let own: Vec<String> = fit
+        .fixed
+        .iter()
+        .zip(&fit.own_estimates)
+        .map(|(row, e)| format!("{} {}", row.subject, num(*e)))
+        .collect();
+    println!("Each subject alone: {}.", own.join(", "));
+    let j = s.estimate;
+    println!("At the estimate (ours [paper], z = difference in standard errors):");
+    for (set, rows, stats) in [
+        ("fixed (fitted)", &fit.fixed, &fit.fixed_stats),
+        ("free (held out)", &fit.free, &fit.free_stats),
+    ] {
+        for (row, per_point) in rows.iter().zip(stats) {
+            let st = &per_point[j];
+            println!(
+                "  {} {set}: actions {:.1} +- {:.1} [{} +- {}], z {:+.1}; reached {}/{}; online \
+                 accuracy {:.1} % [{:.2}]",
+                row.subject,
+                st.actions.0,
+                st.actions.1,
+                row.actions_mean,
+                row.actions_sd,
+                st.z,
+                st.reached,
+                st.runs,
+                100.0 * st.online_accuracy,
+                100.0 * row.accuracy
+            );
+        }
+    }
+    for (set, t) in [
+        ("fixed", &fit.fixed_tables[j]),
+        ("free", &fit.free_tables[j]),
+    ] {
+        println!(
+            "  Tables of 20 runs ({set} goals, held out): all 20 reached in {}/{}; r negative in \
+             {}/{}, median r {:.2}.",
+            t.all_reached, t.tables, t.r_negative, t.tables, t.median_r
         );
     }
 }

@@ -127,9 +127,11 @@ pub(crate) fn run_grid(args: &RunArgs, mut scenario: GridScenario) -> Result<()>
         .context("calibrating the decoder")?;
     if let Some(c) = &calibration {
         println!(
-            "Decoder calibrated on 400 actions: correct {:.2} %, error {:.2} %, mean {:.2} % (cross-validated)",
-            100.0 * c.calibrated.accuracy.correct,
-            100.0 * c.calibrated.accuracy.error,
+            "Decoder calibrated on 400 actions: mean accuracy {:.2} % on held-out epochs (the \
+             target; correct {:.2} %, error {:.2} %), {:.2} % cross-validated",
+            100.0 * c.targeting.accuracy.mean(),
+            100.0 * c.targeting.accuracy.correct,
+            100.0 * c.targeting.accuracy.error,
             100.0 * c.calibrated.accuracy.mean()
         );
     }

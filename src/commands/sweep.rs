@@ -207,7 +207,7 @@ impl Progress {
 impl SweepObserver for Progress {
     fn decoder_ready(&self, info: &DecoderInfo, done: usize, total: usize) {
         let reached = info.cv_mean.map_or("exact (oracle)".to_string(), |m| {
-            format!("{:.2} %", 100.0 * m)
+            format!("{:.2} % cross-validated", 100.0 * m)
         });
         self.line(&format!(
             "  decoder {done}/{total}: accuracy {} -> {reached}{} [{:.1} s]",

@@ -27,7 +27,7 @@ pub(crate) fn table1(args: &Table1Args) -> Result<()> {
     let cells = run_table1(&options, |label, s| {
         if !quiet {
             eprintln!(
-                "  {label}: ErrP-to-noise {:.4} -> {:.2} %",
+                "  {label}: ErrP-to-noise {:.4} -> {:.2} % on held-out epochs",
                 s.ratio,
                 100.0 * s.accuracy.mean()
             );

@@ -3,8 +3,9 @@
 //! p(error).
 
 use errp_bci::{
-    Assessment, AssessmentKind, Components, EegBlock, EegGenerator, EpochWindow, ErrorModel,
-    GeneratorParams, LdaModel, Montage, PlattScaling, Preprocessor, rng::derive_seed, rng::stream,
+    Accuracy, Assessment, AssessmentKind, Components, EegBlock, EegGenerator, EpochWindow,
+    ErrorModel, GeneratorParams, LdaModel, Montage, PlattScaling, Preprocessor, rng::derive_seed,
+    rng::stream,
 };
 use rand::Rng;
 use serde::{Deserialize, Serialize};
@@ -155,6 +156,30 @@ impl EpochBankParts {
             correct: mix(&self.noise.1, &self.erp.1),
             decoder,
         }
+    }
+}
+
+impl EpochBankParts {
+    /// The accuracy of `model` (decision >= 0 is "error", as online) on
+    /// every epoch of the bank mixed at ErrP-to-noise `ratio`: the online
+    /// accuracy of a decoder reading this user's EEG at that ratio, measured
+    /// on epochs it was not trained on.
+    pub fn score(&self, model: &impl ErrorModel, ratio: f64) -> Accuracy {
+        let mut labels = Vec::new();
+        let mut predicted = Vec::new();
+        let mut row = Vec::new();
+        for (error, (noise, erp)) in [
+            (true, (&self.noise.0, &self.erp.0)),
+            (false, (&self.noise.1, &self.erp.1)),
+        ] {
+            for ((xn, _), (xe, _)) in noise.iter().zip(erp) {
+                row.clear();
+                row.extend(xn.iter().zip(xe).map(|(a, b)| a + ratio * b));
+                labels.push(error);
+                predicted.push(model.decision(&row) >= 0.0);
+            }
+        }
+        Accuracy::score(&labels, &predicted)
     }
 }
 

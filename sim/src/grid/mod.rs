@@ -25,8 +25,9 @@ pub use episode::{
 pub use params::GridTaskParams;
 pub use report::{GridEpisodeHeader, GridEpisodeRow, Table1Report};
 pub use run::{
-    GridRunReport, GridShared, PreparedGrid, eeg_decoder, pooled_accuracy, prepare_decoder,
-    prepare_grid_decoder, run_grid_scenario, run_grid_scenario_with,
+    GridRunReport, GridShared, HELD_OUT_PER_CLASS, PreparedGrid, eeg_decoder, pooled_accuracy,
+    prepare_decoder, prepare_grid_decoder, run_grid_scenario, run_grid_scenario_with,
+    target_online_accuracy,
 };
 pub use scenario::{
     DecoderChoice, EegMode, GridScenario, MAX_ACTIONS, MAX_BANK_PER_CLASS, MAX_EPISODES,

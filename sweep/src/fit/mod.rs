@@ -3,6 +3,7 @@
 
 mod density;
 mod epuck;
+mod grid;
 mod surface;
 
 pub use density::{Observed, SimRun, log_kde, log_likelihood, percentile_of, quantile, resample};
@@ -10,5 +11,11 @@ pub use epuck::{
     DENSITY, EpuckFit, EpuckFitSpec, FIT_FILES, FIT_FORMAT, FitOutcome, HeldOut, MAX_BOOTSTRAP,
     MAX_CALIBRATIONS, MAX_FIT_POINTS, MAX_FIT_RUNS, PaperRun, Provenance, RunStats, analyse,
     fit_plot, paper_runs, run_dir, run_epuck_fit, surface_csv, sweep_dir,
+};
+pub use grid::{
+    CellStats, GRID_DENSITY, GRID_FIT_BANK, GRID_FIT_FILES, GRID_FIT_FORMAT, GridFit,
+    GridFitOutcome, GridFitSpec, MAX_GRID_CALIBRATIONS, MAX_GRID_REPEATS, PaperRow, TableStats,
+    grid_fit_plot, grid_surface_csv, group_log_likelihood, log_normal_density, paper_rows,
+    run_grid_fit,
 };
 pub use surface::{CHI2_1_95, Surface, argmax};

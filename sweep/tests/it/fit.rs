@@ -4,7 +4,10 @@
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
-use errp_sweep::fit::{EpuckFitSpec, FitOutcome, Provenance, paper_runs, run_epuck_fit};
+use errp_sweep::fit::{
+    EpuckFitSpec, FitOutcome, GridFitOutcome, GridFitSpec, Provenance, paper_runs, run_epuck_fit,
+    run_grid_fit,
+};
 
 use crate::{cache, temp_dir};
 
@@ -280,4 +283,82 @@ fn the_median_time_to_pisa_does_not_rise_with_accuracy() {
     // At the top of the range the median is finite: most runs reach Pisa.
     assert!(stats[4].0.is_finite() && stats[4].2 > 0.8, "{stats:?}");
     let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn a_small_grid_fit_writes_its_files_and_refuses_bad_settings() {
+    let out = temp_dir("fit-grid");
+    let spec = GridFitSpec {
+        goal_rewards: vec![1.0, 8.0],
+        epsilon: 0.1,
+        calibrations: 1,
+        repeats: 2,
+        seed: 5,
+        bootstrap: 10,
+    };
+    let cancel = AtomicBool::new(false);
+    let GridFitOutcome::Complete(fit, files) =
+        run_grid_fit(&spec, &out, &cache(), provenance(), &cancel, &()).unwrap()
+    else {
+        panic!("not interrupted")
+    };
+    assert_eq!(files.len(), 4);
+    assert!(spec.goal_rewards.contains(&fit.estimate));
+    // 4 subjects x 2 points, 2 groups of 5 runs each.
+    assert_eq!(fit.fixed_stats.len(), 4);
+    assert!(
+        fit.fixed_stats
+            .iter()
+            .chain(&fit.free_stats)
+            .flatten()
+            .all(|s| s.runs == 10 && s.groups.0 == 2)
+    );
+    assert!(fit.fixed_tables.iter().all(|t| t.tables == 2));
+    // A larger Q scale moves the belief further per action: fewer actions
+    // for the subject with the best decoder (S1), on both goal sets.
+    for stats in [&fit.fixed_stats, &fit.free_stats] {
+        assert!(stats[0][1].actions.0 < stats[0][0].actions.0, "{stats:?}");
+    }
+    let csv = std::fs::read_to_string(out.join("surface.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 3, "{csv}");
+    assert!(csv.starts_with("goal_reward,log_lik,"), "{csv}");
+    // A directory holding anything else is refused, untouched.
+    let foreign = temp_dir("fit-grid-foreign");
+    std::fs::create_dir_all(&foreign).unwrap();
+    std::fs::write(foreign.join("mine.txt"), "mine").unwrap();
+    let e = run_grid_fit(&spec, &foreign, &cache(), provenance(), &cancel, &())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("mine.txt") && e.contains("--out"), "{e}");
+    assert_eq!(std::fs::read_dir(&foreign).unwrap().count(), 1);
+    for (bad, flag) in [
+        (
+            GridFitSpec {
+                epsilon: 1.0,
+                ..spec.clone()
+            },
+            "--epsilon 1",
+        ),
+        (
+            GridFitSpec {
+                goal_rewards: vec![2.0, 1.0],
+                ..spec.clone()
+            },
+            "--goal-reward",
+        ),
+        (
+            GridFitSpec {
+                repeats: 1,
+                ..spec.clone()
+            },
+            "--repeats 1",
+        ),
+    ] {
+        let e = run_grid_fit(&bad, &out, &cache(), provenance(), &cancel, &())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(flag), "{e}");
+    }
+    let _ = std::fs::remove_dir_all(&out);
+    let _ = std::fs::remove_dir_all(&foreign);
 }

@@ -1,0 +1,957 @@
+//! `errp fit grid`: the Q-value scale of the grid task estimated from Table 1
+//! (sec. 4.3), the four subjects' mean actions on the fixed goals, and
+//! checked on what the fit did not see: the free goals and the
+//! accuracy-time correlation r.
+//!
+//! The paper states the soft-max temperature (tau = 0.3) but not the scale
+//! of the Q-values it divides, which is what sets how much one action moves
+//! the belief: it is fitted as `control.goal_reward` (the Q-values are
+//! proportional to it; scaling it by k is dividing tau by k).
+//!
+//! Each subject is simulated as the paper ran them: a decoder calibrated to
+//! the subject's online accuracy on that goal set (Table 1's accuracy row),
+//! then five runs, one per start/goal pair. A subject is simulated with
+//! several calibrations (the decoders a calibration at that accuracy can
+//! give), and each calibration with several repeats of the five runs; a
+//! *group* is five runs of one calibration, one per pair. The likelihood of a
+//! subject's row is P(all five reached) (Jeffreys' estimate over the groups)
+//! times the density of the mean of five runs' actions among the groups that
+//! reached every goal, at the paper's mean: a normal density over ln(mean
+//! actions), fitted to those groups. Episodes read epochs from a bank
+//! ([`EegMode::Bank`]), which agrees with streamed EEG (`errp table1 --eeg
+//! bank`) and is two hundred times faster; every grid point runs the same
+//! episodes' seeds (common random numbers), so the surface is smooth.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
+use errp_bci::rng::{derive_seed, stream};
+use errp_bci::{GoalSet, subjects};
+use errp_robot::{Cell, Grid, QTable};
+use errp_sim::grid::{
+    AssessmentDecoder, DecoderChoice, EegMode, FIXED_PAIRS, GridEpisodeResult, GridScenario,
+    GridShared, GridTaskParams, PErrorChoice, free_pairs, prepare_grid_decoder, run_grid_episode,
+};
+use errp_sim::task::DecoderInfo;
+use errp_sim::{PAPER, Result, SimError, create_dir, mean_sd, pearson, write_atomic};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use super::density::{SimRun, percentile_of, quantile, resample};
+use super::epuck::Provenance;
+use super::surface::{Surface, argmax};
+use crate::cache::TargetCache;
+use crate::observer::SweepObserver;
+use crate::plot::{Curve, CurvePoint, FitPanel, FitPlot, fit_png, fit_svg};
+
+/// What `errp fit grid` runs.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GridFitSpec {
+    /// The grid of Q-value scales (`control.goal_reward`, at tau = 0.3).
+    pub goal_rewards: Vec<f64>,
+    /// The device's epsilon (`control.epsilon`), held fixed.
+    pub epsilon: f64,
+    /// Calibrations per subject and goal set.
+    pub calibrations: usize,
+    /// Groups of five runs per calibration.
+    pub repeats: usize,
+    /// The base seed.
+    pub seed: u64,
+    /// Bootstrap replicates for the Monte Carlo error.
+    pub bootstrap: usize,
+}
+
+/// Epochs per class in each calibration's bank.
+pub const GRID_FIT_BANK: usize = 1000;
+/// The largest number of calibrations per subject and goal set.
+pub const MAX_GRID_CALIBRATIONS: usize = 50;
+/// The largest number of groups per calibration.
+pub const MAX_GRID_REPEATS: usize = 1000;
+
+/// One subject on one goal set, as the paper reports it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PaperRow {
+    /// S1..S4.
+    pub subject: String,
+    /// Mean online accuracy (fraction): what the decoder is calibrated to.
+    pub accuracy: f64,
+    /// Mean actions over the five runs.
+    pub actions_mean: f64,
+    /// Their sd.
+    pub actions_sd: f64,
+}
+
+/// The paper's rows of a goal set, in subject order.
+pub fn paper_rows(goals: GoalSet) -> Vec<PaperRow> {
+    subjects()
+        .iter()
+        .map(|s| {
+            let (_, _, v) = PAPER
+                .iter()
+                .find(|(n, g, _)| *n == s.name && *g == goals)
+                .expect("Table 1 has every subject and goal set");
+            PaperRow {
+                subject: s.name.clone(),
+                accuracy: s.accuracy(goals),
+                actions_mean: v[0],
+                actions_sd: v[1],
+            }
+        })
+        .collect()
+}
+
+/// A subject's simulated runs on a goal set at one grid point.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CellStats {
+    /// Runs.
+    pub runs: usize,
+    /// Runs that converged on the user's goal.
+    pub reached: usize,
+    /// Groups of five runs, and those that reached all five goals.
+    pub groups: (usize, usize),
+    /// Mean and sd of the actions over every run (as `errp table1`).
+    pub actions: (f64, f64),
+    /// Median, 10 % and 90 % of the mean actions of the groups that reached
+    /// every goal.
+    pub group_mean: [f64; 3],
+    /// Where the paper's mean lies among those group means (0 to 1).
+    pub percentile: f64,
+    /// (ours - paper) / sqrt(paper sd^2 / 5 + our sd^2 / runs): the
+    /// difference in standard errors.
+    pub z: f64,
+    /// Mean over runs of each run's online accuracy (mean of the per-class
+    /// rates; runs without an action of a class left out), as Table 1's row.
+    pub online_accuracy: f64,
+}
+
+/// Tables of one goal set at one grid point: each is one group of every
+/// subject (same calibration and repeat index), 20 runs, as the paper's.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TableStats {
+    /// Tables.
+    pub tables: usize,
+    /// Tables in which all 20 goals were reached.
+    pub all_reached: usize,
+    /// Tables in which r (online accuracy vs total time) is negative.
+    pub r_negative: usize,
+    /// Median r.
+    pub median_r: f64,
+}
+
+/// The result of `errp fit grid`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GridFit {
+    /// Result file format.
+    pub format: u32,
+    /// The scenario field fitted.
+    pub parameter: String,
+    /// The maximum-likelihood goal reward (a grid point).
+    pub estimate: f64,
+    /// Its 95 % likelihood-ratio interval.
+    pub interval_95: (f64, f64),
+    /// Whether that interval reaches the grid's ends.
+    pub interval_at_edge: (bool, bool),
+    /// The 5-95 % spread of the estimate over bootstrap replicates.
+    pub mc_interval_90: (f64, f64),
+    /// Table 1's fixed-goal rows (fitted).
+    pub fixed: Vec<PaperRow>,
+    /// Its free-goal rows (held out).
+    pub free: Vec<PaperRow>,
+    /// The likelihood surface of the fixed-goal rows, one observation per
+    /// subject.
+    pub surface: Surface,
+    /// Each subject's own maximum-likelihood goal reward (its profile's
+    /// peak): what would fit that subject alone.
+    pub own_estimates: Vec<f64>,
+    /// The free-goal rows' log-likelihood at every grid point (held out,
+    /// summed over subjects).
+    pub free_log_lik: Vec<f64>,
+    /// `fixed_stats[subject][grid point]`.
+    pub fixed_stats: Vec<Vec<CellStats>>,
+    /// `free_stats[subject][grid point]`.
+    pub free_stats: Vec<Vec<CellStats>>,
+    /// Tables on the fixed goals, per grid point.
+    pub fixed_tables: Vec<TableStats>,
+    /// Tables on the free goals, per grid point.
+    pub free_tables: Vec<TableStats>,
+    /// How the likelihood is estimated, in words.
+    pub density: String,
+    /// What was run.
+    pub spec: GridFitSpec,
+    /// How.
+    pub provenance: Provenance,
+}
+
+/// Result file format written by this version.
+pub const GRID_FIT_FORMAT: u32 = 1;
+
+/// The density estimate, as the result file describes it.
+pub const GRID_DENSITY: &str = "P(all five goals reached) (Jeffreys over the simulated groups of \
+     five runs: (k + 1/2) / (n + 1)) times the normal density of ln(mean actions of the five \
+     runs) fitted to the groups that reached every goal (their mean and sd, at least 0.02)";
+
+/// The files `errp fit grid` writes.
+pub const GRID_FIT_FILES: [&str; 4] = ["fit.json", "surface.csv", "fit.svg", "fit.png"];
+
+/// Smallest sd of ln(mean actions).
+const MIN_SD: f64 = 0.02;
+
+/// log P(all reached) + log density of ln `mean` among the groups that
+/// reached (see the module docs); groups are [`SimRun`]s whose `time_secs`
+/// is the group's mean actions.
+pub fn group_log_likelihood(groups: &[SimRun], mean: f64) -> f64 {
+    let ok: Vec<f64> = groups
+        .iter()
+        .filter(|g| g.reached && g.time_secs > 0.0)
+        .map(|g| g.time_secs.ln())
+        .collect();
+    let p = (ok.len() as f64 + 0.5) / (groups.len() as f64 + 1.0);
+    p.ln() + log_normal_density(&ok, mean.ln())
+}
+
+/// Log of the normal density fitted to `samples` (mean, sample sd, at least
+/// [`MIN_SD`]) at `x`; minus infinity for fewer than two samples. A
+/// parametric density, not a kernel one: the paper's means can lie in the
+/// tail of the simulated ones, where a kernel estimate from a few hundred
+/// groups is all noise.
+pub fn log_normal_density(samples: &[f64], x: f64) -> f64 {
+    if samples.len() < 2 {
+        return f64::NEG_INFINITY;
+    }
+    let (m, sd) = mean_sd(samples);
+    let sd = sd.max(MIN_SD);
+    -0.5 * ((x - m) / sd).powi(2) - sd.ln() - 0.5 * (2.0 * std::f64::consts::PI).ln()
+}
+
+/// One calibration of one subject on one goal set.
+struct Calibration {
+    subject: usize,
+    goals: GoalSet,
+    index: usize,
+    seed: u64,
+    decoder: AssessmentDecoder,
+}
+
+/// A run's outcome, as the fit keeps it.
+#[derive(Debug, Clone, Copy)]
+struct Run {
+    reached: bool,
+    actions: f64,
+    total_secs: f64,
+    online: f64,
+}
+
+impl From<&GridEpisodeResult> for Run {
+    fn from(r: &GridEpisodeResult) -> Self {
+        Self {
+            reached: r.reached(),
+            actions: r.actions as f64,
+            total_secs: r.total_secs,
+            online: r.online.mean(),
+        }
+    }
+}
+
+/// The outcome of [`run_grid_fit`].
+#[derive(Debug)]
+pub enum GridFitOutcome {
+    /// Stopped by the cancel flag (nothing written; the targetings found
+    /// are in the cache).
+    Interrupted,
+    /// The fit, and the files written.
+    Complete(Box<GridFit>, Vec<PathBuf>),
+}
+
+fn check_spec(spec: &GridFitSpec) -> Result<()> {
+    let bad = |what: String| Err(SimError::Sweep(what));
+    if spec.goal_rewards.len() < 2 || spec.goal_rewards.len() > super::MAX_FIT_POINTS {
+        return bad(format!(
+            "--goal-reward gives {} value(s): a fit needs 2 to {}",
+            spec.goal_rewards.len(),
+            super::MAX_FIT_POINTS
+        ));
+    }
+    if let Some(v) = spec
+        .goal_rewards
+        .iter()
+        .find(|v| !(v.is_finite() && **v > 0.0 && **v <= 100.0))
+    {
+        return bad(format!(
+            "--goal-reward {v} is invalid: expected goal rewards in (0, 100]"
+        ));
+    }
+    if spec.goal_rewards.windows(2).any(|w| w[1] <= w[0]) {
+        return bad("--goal-reward must list increasing values".into());
+    }
+    if !(spec.epsilon.is_finite() && (0.0..1.0).contains(&spec.epsilon)) {
+        return bad(format!(
+            "--epsilon {} is invalid: expected a probability in [0, 1)",
+            spec.epsilon
+        ));
+    }
+    if spec.calibrations < 1 || spec.calibrations > MAX_GRID_CALIBRATIONS {
+        return bad(format!(
+            "--calibrations {} is invalid: expected 1 to {MAX_GRID_CALIBRATIONS} per subject \
+             and goal set",
+            spec.calibrations
+        ));
+    }
+    if spec.repeats < 2 || spec.repeats > MAX_GRID_REPEATS {
+        return bad(format!(
+            "--repeats {} is invalid: expected 2 to {MAX_GRID_REPEATS} groups of five runs per \
+             calibration",
+            spec.repeats
+        ));
+    }
+    if spec.bootstrap < 10 || spec.bootstrap > super::MAX_BOOTSTRAP {
+        return bad(format!(
+            "--bootstrap {} is invalid: expected 10 to {} replicates",
+            spec.bootstrap,
+            super::MAX_BOOTSTRAP
+        ));
+    }
+    Ok(())
+}
+
+/// Refuses an `out` that holds anything the fit did not write.
+fn check_out(out: &Path) -> Result<()> {
+    if !out.exists() {
+        return Ok(());
+    }
+    if !out.is_dir() {
+        return Err(SimError::Sweep(format!(
+            "--out {} exists and is not a directory",
+            out.display()
+        )));
+    }
+    let entries = std::fs::read_dir(out).map_err(|source| SimError::Input {
+        path: out.to_path_buf(),
+        source,
+    })?;
+    let mut foreign: Vec<String> = entries
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|name| {
+            !(GRID_FIT_FILES.contains(&name.as_str())
+                || (name.starts_with('.') && name.contains(".partial-")))
+        })
+        .take(6)
+        .collect();
+    if foreign.is_empty() {
+        return Ok(());
+    }
+    foreign.sort();
+    Err(SimError::Sweep(format!(
+        "--out {} holds files that are not a grid fit's ({}); give a new or empty directory",
+        out.display(),
+        foreign.join(", ")
+    )))
+}
+
+/// The scenario of one calibration: the subject's accuracy, the paper's
+/// task with `params`, epochs from a bank.
+fn scenario(accuracy: f64, seed: u64, subject: &str, params: GridTaskParams) -> GridScenario {
+    GridScenario {
+        path: "fit grid".into(),
+        name: format!("{subject} (fit grid)"),
+        description: String::new(),
+        seed,
+        decoder: DecoderChoice::Eeg,
+        p_error: PErrorChoice::Platt,
+        eeg: EegMode::Bank,
+        bank_per_class: GRID_FIT_BANK,
+        accuracy,
+        user: subject.to_string(),
+        episodes: Vec::new(),
+        params,
+    }
+}
+
+/// The start/goal pairs of group `repeat` of a calibration.
+fn pairs(goals: GoalSet, seed: u64, repeat: usize) -> Vec<(Cell, Cell)> {
+    match goals {
+        GoalSet::Fixed => FIXED_PAIRS.to_vec(),
+        GoalSet::Free => free_pairs(
+            &Grid::paper(),
+            5,
+            &mut stream(derive_seed(seed, "fit/grid/free", repeat as u64), "pairs"),
+        ),
+    }
+}
+
+/// Calibrates every subject's decoders, runs every grid point and writes
+/// [`GRID_FIT_FILES`] into `out`. The observer sees each decoder as it is
+/// ready, then the episodes.
+pub fn run_grid_fit(
+    spec: &GridFitSpec,
+    out: &Path,
+    cache: &TargetCache,
+    provenance: Provenance,
+    cancel: &AtomicBool,
+    observer: &dyn SweepObserver,
+) -> Result<GridFitOutcome> {
+    check_spec(spec)?;
+    check_out(out)?;
+    let fixed = paper_rows(GoalSet::Fixed);
+    let free = paper_rows(GoalSet::Free);
+    let base = GridTaskParams::default();
+    let mut jobs = Vec::new();
+    for goals in [GoalSet::Fixed, GoalSet::Free] {
+        for subject in 0..fixed.len() {
+            for index in 0..spec.calibrations {
+                let k = (goals as usize * fixed.len() + subject) * spec.calibrations + index;
+                jobs.push((
+                    subject,
+                    goals,
+                    index,
+                    derive_seed(spec.seed, "fit/grid/calibration", k as u64),
+                ));
+            }
+        }
+    }
+    let done = AtomicUsize::new(0);
+    let calibrations: Vec<Calibration> = jobs
+        .par_iter()
+        .map(|&(subject, goals, index, seed)| {
+            if cancel.load(Ordering::Relaxed) {
+                return Ok(None);
+            }
+            let rows = if goals == GoalSet::Fixed {
+                &fixed
+            } else {
+                &free
+            };
+            let row = &rows[subject];
+            let s = scenario(row.accuracy, seed, &row.subject, base);
+            let prepared = prepare_grid_decoder(&s, &GridShared::default(), cache, |_| {})?;
+            let c = prepared.calibration.as_ref();
+            let info = DecoderInfo {
+                accuracy: row.accuracy,
+                kind: "lda".into(),
+                calibration_seed: seed,
+                errp_to_noise: c.map(|c| c.targeting.ratio),
+                cv_correct: c.map(|c| c.calibrated.accuracy.correct),
+                cv_error: c.map(|c| c.calibrated.accuracy.error),
+                cv_mean: c.map(|c| c.calibrated.accuracy.mean()),
+                online_hit_rate: None,
+                online_false_alarms_per_min: None,
+                cached: prepared.cached,
+            };
+            observer.decoder_ready(&info, done.fetch_add(1, Ordering::Relaxed) + 1, jobs.len());
+            Ok(Some(Calibration {
+                subject,
+                goals,
+                index,
+                seed,
+                decoder: prepared.decoder,
+            }))
+        })
+        .collect::<Result<Vec<Option<Calibration>>>>()?
+        .into_iter()
+        .collect::<Option<Vec<_>>>()
+        .unwrap_or_default();
+    if calibrations.len() != jobs.len() {
+        return Ok(GridFitOutcome::Interrupted);
+    }
+    // runs[point][calibration][repeat][pair]
+    let points = spec.goal_rewards.len();
+    let per_point = calibrations.len() * spec.repeats;
+    let total = points * per_point * 5;
+    let episodes = AtomicUsize::new(0);
+    let mut runs: Vec<Vec<Vec<Vec<Run>>>> = Vec::with_capacity(points);
+    for &g in &spec.goal_rewards {
+        let mut params = base;
+        params.control.goal_reward = g;
+        params.control.epsilon = spec.epsilon;
+        let table = QTable::compute(Grid::paper(), &params.control.q())?;
+        let at_point: Vec<Vec<Vec<Run>>> = calibrations
+            .par_iter()
+            .map(|c| {
+                (0..spec.repeats)
+                    .map(|r| {
+                        if cancel.load(Ordering::Relaxed) {
+                            return Err(SimError::Sweep("interrupted".into()));
+                        }
+                        let group = pairs(c.goals, c.seed, r)
+                            .into_iter()
+                            .enumerate()
+                            .map(|(j, (start, goal))| {
+                                let seed = derive_seed(c.seed, "fit/grid/run", (r * 5 + j) as u64);
+                                run_grid_episode(
+                                    start, goal, &table, &params, &c.decoder, seed, false,
+                                )
+                                .map(|e| Run::from(&e))
+                            })
+                            .collect::<Result<Vec<Run>>>()?;
+                        let n = episodes.fetch_add(5, Ordering::Relaxed) + 5;
+                        observer.episodes_done(n, total);
+                        Ok(group)
+                    })
+                    .collect::<Result<Vec<_>>>()
+            })
+            .collect::<Result<Vec<_>>>()
+            .or_else(|e| {
+                if cancel.load(Ordering::Relaxed) {
+                    Ok(Vec::new())
+                } else {
+                    Err(e)
+                }
+            })?;
+        if at_point.len() != calibrations.len() {
+            return Ok(GridFitOutcome::Interrupted);
+        }
+        runs.push(at_point);
+    }
+    let fit = analyse(spec, &calibrations, &runs, &fixed, &free, provenance);
+    create_dir(out)?;
+    let files = write_fit(&fit, out)?;
+    Ok(GridFitOutcome::Complete(Box::new(fit), files))
+}
+
+/// The groups of one subject on one goal set at a grid point, as
+/// [`SimRun`]s (time = mean actions, reached = every goal reached).
+fn groups_of(
+    calibrations: &[Calibration],
+    at_point: &[Vec<Vec<Run>>],
+    subject: usize,
+    goals: GoalSet,
+) -> Vec<SimRun> {
+    calibrations
+        .iter()
+        .zip(at_point)
+        .filter(|(c, _)| c.subject == subject && c.goals == goals)
+        .flat_map(|(c, groups)| {
+            groups.iter().map(move |g| SimRun {
+                time_secs: g.iter().map(|r| r.actions).sum::<f64>() / g.len() as f64,
+                detections: 0.0,
+                reached: g.iter().all(|r| r.reached),
+                calibration: c.index,
+            })
+        })
+        .collect()
+}
+
+fn cell_stats(
+    calibrations: &[Calibration],
+    at_point: &[Vec<Vec<Run>>],
+    subject: usize,
+    row: &PaperRow,
+    goals: GoalSet,
+) -> CellStats {
+    let all: Vec<Run> = calibrations
+        .iter()
+        .zip(at_point)
+        .filter(|(c, _)| c.subject == subject && c.goals == goals)
+        .flat_map(|(_, groups)| groups.iter().flatten().copied())
+        .collect();
+    let groups = groups_of(calibrations, at_point, subject, goals);
+    let means: Vec<f64> = groups
+        .iter()
+        .filter(|g| g.reached)
+        .map(|g| g.time_secs)
+        .collect();
+    let actions = mean_sd(&all.iter().map(|r| r.actions).collect::<Vec<_>>());
+    let online: Vec<f64> = all
+        .iter()
+        .map(|r| r.online)
+        .filter(|v| v.is_finite())
+        .collect();
+    let se = (row.actions_sd.powi(2) / 5.0 + actions.1.powi(2) / all.len() as f64).sqrt();
+    CellStats {
+        runs: all.len(),
+        reached: all.iter().filter(|r| r.reached).count(),
+        groups: (groups.len(), means.len()),
+        actions,
+        group_mean: [
+            quantile(&means, 0.5),
+            quantile(&means, 0.1),
+            quantile(&means, 0.9),
+        ],
+        percentile: percentile_of(&means, row.actions_mean),
+        z: (actions.0 - row.actions_mean) / se,
+        online_accuracy: mean_sd(&online).0,
+    }
+}
+
+fn table_stats(
+    calibrations: &[Calibration],
+    at_point: &[Vec<Vec<Run>>],
+    goals: GoalSet,
+    subjects: usize,
+    spec: &GridFitSpec,
+) -> TableStats {
+    let mut rs = Vec::new();
+    let mut all_reached = 0;
+    for index in 0..spec.calibrations {
+        for repeat in 0..spec.repeats {
+            let runs: Vec<Run> = (0..subjects)
+                .flat_map(|s| {
+                    let k = calibrations
+                        .iter()
+                        .position(|c| c.subject == s && c.goals == goals && c.index == index)
+                        .expect("every calibration was run");
+                    at_point[k][repeat].clone()
+                })
+                .collect();
+            all_reached += usize::from(runs.iter().all(|r| r.reached));
+            let ok: Vec<&Run> = runs.iter().filter(|r| r.online.is_finite()).collect();
+            let acc: Vec<f64> = ok.iter().map(|r| r.online).collect();
+            let time: Vec<f64> = ok.iter().map(|r| r.total_secs).collect();
+            rs.push(pearson(&acc, &time).0);
+        }
+    }
+    let finite: Vec<f64> = rs.iter().copied().filter(|r| r.is_finite()).collect();
+    TableStats {
+        tables: rs.len(),
+        all_reached,
+        r_negative: finite.iter().filter(|&&r| r < 0.0).count(),
+        median_r: quantile(&finite, 0.5),
+    }
+}
+
+fn analyse(
+    spec: &GridFitSpec,
+    calibrations: &[Calibration],
+    runs: &[Vec<Vec<Vec<Run>>>],
+    fixed: &[PaperRow],
+    free: &[PaperRow],
+    provenance: Provenance,
+) -> GridFit {
+    let n = fixed.len();
+    let groups = |goals: GoalSet| -> Vec<Vec<Vec<SimRun>>> {
+        (0..n)
+            .map(|s| {
+                runs.iter()
+                    .map(|at| groups_of(calibrations, at, s, goals))
+                    .collect()
+            })
+            .collect()
+    };
+    let fixed_groups = groups(GoalSet::Fixed);
+    let free_groups = groups(GoalSet::Free);
+    let log_lik: Vec<Vec<f64>> = fixed_groups
+        .iter()
+        .zip(fixed)
+        .map(|(per_point, row)| {
+            per_point
+                .iter()
+                .map(|g| group_log_likelihood(g, row.actions_mean))
+                .collect()
+        })
+        .collect();
+    let replicates: Vec<Vec<Vec<f64>>> = fixed_groups
+        .iter()
+        .zip(fixed)
+        .enumerate()
+        .map(|(i, (per_point, row))| {
+            per_point
+                .iter()
+                .enumerate()
+                .map(|(j, g)| {
+                    let mut rng = stream(
+                        derive_seed(spec.seed, "fit/grid/bootstrap", (i * 1000 + j) as u64),
+                        "fit/bootstrap",
+                    );
+                    (0..spec.bootstrap)
+                        .map(|_| group_log_likelihood(&resample(g, &mut rng), row.actions_mean))
+                        .collect()
+                })
+                .collect()
+        })
+        .collect();
+    let own_estimates = log_lik
+        .iter()
+        .map(|l| spec.goal_rewards[argmax(l)])
+        .collect();
+    let free_log_lik = (0..spec.goal_rewards.len())
+        .map(|j| {
+            free_groups
+                .iter()
+                .zip(free)
+                .map(|(per_point, row)| group_log_likelihood(&per_point[j], row.actions_mean))
+                .sum()
+        })
+        .collect();
+    let surface = Surface::new(spec.goal_rewards.clone(), log_lik, &replicates);
+    let stats = |rows: &[PaperRow], goals: GoalSet| -> Vec<Vec<CellStats>> {
+        rows.iter()
+            .enumerate()
+            .map(|(s, row)| {
+                runs.iter()
+                    .map(|at| cell_stats(calibrations, at, s, row, goals))
+                    .collect()
+            })
+            .collect()
+    };
+    let tables = |goals: GoalSet| -> Vec<TableStats> {
+        runs.iter()
+            .map(|at| table_stats(calibrations, at, goals, n, spec))
+            .collect()
+    };
+    GridFit {
+        format: GRID_FIT_FORMAT,
+        parameter: "control.goal_reward".into(),
+        estimate: surface.estimate_value(),
+        interval_95: surface.interval,
+        interval_at_edge: surface.interval_at_edge,
+        mc_interval_90: surface.mc_interval,
+        fixed_stats: stats(fixed, GoalSet::Fixed),
+        free_stats: stats(free, GoalSet::Free),
+        fixed_tables: tables(GoalSet::Fixed),
+        free_tables: tables(GoalSet::Free),
+        fixed: fixed.to_vec(),
+        free: free.to_vec(),
+        surface,
+        own_estimates,
+        free_log_lik,
+        density: GRID_DENSITY.into(),
+        spec: spec.clone(),
+        provenance,
+    }
+}
+
+fn write_fit(fit: &GridFit, out: &Path) -> Result<Vec<PathBuf>> {
+    let json = serde_json::to_string_pretty(fit)
+        .map_err(|e| SimError::Sweep(format!("cannot encode the fit: {e}")))?;
+    let plot = grid_fit_plot(fit);
+    let svg = fit_svg(&plot).map_err(|e| SimError::Sweep(e.to_string()))?;
+    let png = fit_png(&plot).map_err(|e| SimError::Sweep(e.to_string()))?;
+    let files = [
+        (GRID_FIT_FILES[0], format!("{json}\n").into_bytes()),
+        (GRID_FIT_FILES[1], grid_surface_csv(fit).into_bytes()),
+        (GRID_FIT_FILES[2], svg.into_bytes()),
+        (GRID_FIT_FILES[3], png),
+    ];
+    let mut written = Vec::new();
+    for (name, bytes) in files {
+        let path = out.join(name);
+        write_atomic(&path, &bytes)?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+/// One row per grid point: the total and each subject's log-likelihood on
+/// the fixed goals, the held-out free goals' total, and each subject's mean
+/// actions, reached share and online accuracy on both goal sets.
+pub fn grid_surface_csv(fit: &GridFit) -> String {
+    let s = &fit.surface;
+    let mut header = vec![
+        "goal_reward".to_string(),
+        "log_lik".into(),
+        "log_lik_mc_sd".into(),
+        "free_log_lik".into(),
+    ];
+    for (set, rows) in [("fixed", &fit.fixed), ("free", &fit.free)] {
+        for row in rows.iter() {
+            let k = format!("{}_{set}", row.subject.to_lowercase());
+            if set == "fixed" {
+                header.push(format!("{k}_log_lik"));
+            }
+            for c in [
+                "p_reached",
+                "actions_mean",
+                "actions_sd",
+                "z",
+                "online_accuracy",
+            ] {
+                header.push(format!("{k}_{c}"));
+            }
+        }
+    }
+    for set in ["fixed", "free"] {
+        header.push(format!("{set}_tables_all_reached"));
+        header.push(format!("{set}_tables_r_negative"));
+        header.push(format!("{set}_median_r"));
+    }
+    let mut out = header.join(",") + "\n";
+    let num = |v: f64| errp_sim::task::format_number(v);
+    for j in 0..s.grid.len() {
+        let mut row = vec![
+            num(s.grid[j]),
+            num(s.total[j]),
+            num(s.total_sd[j]),
+            num(fit.free_log_lik[j]),
+        ];
+        for (fixed, stats) in [(true, &fit.fixed_stats), (false, &fit.free_stats)] {
+            for (i, per_point) in stats.iter().enumerate() {
+                let st = &per_point[j];
+                if fixed {
+                    row.push(num(s.log_lik[i][j]));
+                }
+                row.extend([
+                    num(st.reached as f64 / st.runs.max(1) as f64),
+                    num(st.actions.0),
+                    num(st.actions.1),
+                    num(st.z),
+                    num(st.online_accuracy),
+                ]);
+            }
+        }
+        for t in [&fit.fixed_tables[j], &fit.free_tables[j]] {
+            row.extend([
+                num(t.all_reached as f64 / t.tables.max(1) as f64),
+                num(t.r_negative as f64 / t.tables.max(1) as f64),
+                num(t.median_r),
+            ]);
+        }
+        out += &(row.join(",") + "\n");
+    }
+    out
+}
+
+/// The figure: the log-likelihood of each subject's fixed-goal row and of
+/// all four, then the mean actions on the fixed goals (fitted) and on the
+/// free goals (held out) against the goal reward, the paper's values as
+/// reference lines.
+pub fn grid_fit_plot(fit: &GridFit) -> FitPlot {
+    let s = &fit.surface;
+    let best = s.total[s.estimate];
+    let finite = |v: f64| if v.is_finite() { v } else { 0.0 };
+    let mut ll: Vec<Curve> = fit
+        .fixed
+        .iter()
+        .enumerate()
+        .map(|(i, row)| {
+            let top = s.log_lik[i]
+                .iter()
+                .copied()
+                .fold(f64::NEG_INFINITY, f64::max);
+            Curve {
+                label: row.subject.clone(),
+                points: (0..s.grid.len())
+                    .map(|j| {
+                        let v = s.log_lik[i][j] - top;
+                        let sd = finite(s.mc_sd[i][j]);
+                        CurvePoint {
+                            x: s.grid[j],
+                            y: v,
+                            lo: v - sd,
+                            hi: v + sd,
+                        }
+                    })
+                    .collect(),
+            }
+        })
+        .collect();
+    ll.push(Curve {
+        label: "all four".into(),
+        points: (0..s.grid.len())
+            .map(|j| {
+                let v = s.total[j] - best;
+                let sd = finite(s.total_sd[j]);
+                CurvePoint {
+                    x: s.grid[j],
+                    y: v,
+                    lo: v - sd,
+                    hi: v + sd,
+                }
+            })
+            .collect(),
+    });
+    let actions =
+        |rows: &[PaperRow], stats: &[Vec<CellStats>]| -> (Vec<Curve>, Vec<(String, f64, usize)>) {
+            let curves = rows
+                .iter()
+                .zip(stats)
+                .map(|(row, per_point)| Curve {
+                    label: format!("{} ({:.1} %)", row.subject, 100.0 * row.accuracy),
+                    points: per_point
+                        .iter()
+                        .zip(&s.grid)
+                        .map(|(st, &x)| CurvePoint {
+                            x,
+                            y: st.group_mean[0],
+                            lo: st.group_mean[1],
+                            hi: st.group_mean[2],
+                        })
+                        .collect(),
+                })
+                .collect();
+            let refs = rows
+                .iter()
+                .enumerate()
+                .map(|(i, row)| {
+                    (
+                        format!("paper, {}: {}", row.subject, row.actions_mean),
+                        row.actions_mean,
+                        i,
+                    )
+                })
+                .collect();
+            (curves, refs)
+        };
+    let (fixed_curves, fixed_refs) = actions(&fit.fixed, &fit.fixed_stats);
+    let (free_curves, free_refs) = actions(&fit.free, &fit.free_stats);
+    let (lo, hi) = fit.interval_95;
+    FitPlot {
+        title: format!(
+            "Grid Q-value scale fitted to Table 1's fixed goals: goal reward {} (95 % LR \
+             interval {lo}-{hi}); {} calibrations x {} groups of 5 runs per subject and point",
+            errp_sim::task::format_number(fit.estimate),
+            fit.spec.calibrations,
+            fit.spec.repeats
+        ),
+        x_desc: "goal reward (Q-value scale at tau = 0.3)".into(),
+        estimate: fit.estimate,
+        interval: fit.interval_95,
+        panels: vec![
+            FitPanel {
+                caption: "Log-likelihood, fixed goals (± Monte Carlo sd)".into(),
+                y_desc: "log-likelihood - its maximum".into(),
+                curves: ll,
+                references: Vec::new(),
+                y_floor: Some(-20.0),
+            },
+            FitPanel {
+                caption: "Mean actions of 5 runs, fixed goals (fitted; median, 10-90 %)".into(),
+                y_desc: "actions".into(),
+                curves: fixed_curves,
+                references: fixed_refs,
+                y_floor: Some(0.0),
+            },
+            FitPanel {
+                caption: "Mean actions of 5 runs, free goals (held out)".into(),
+                y_desc: "actions".into(),
+                curves: free_curves,
+                references: free_refs,
+                y_floor: Some(0.0),
+            },
+        ],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_normal_density_integrates_to_one() {
+        let s: Vec<f64> = (0..40).map(|k| 2.0 + 0.05 * k as f64).collect();
+        let dx = 0.001;
+        let total: f64 = (0..8000)
+            .map(|i| log_normal_density(&s, i as f64 * dx).exp() * dx)
+            .sum();
+        assert!((total - 1.0).abs() < 0.01, "{total}");
+        assert_eq!(log_normal_density(&[1.0], 1.0), f64::NEG_INFINITY);
+    }
+
+    #[test]
+    fn the_group_likelihood_prefers_groups_near_the_paper_and_reaching() {
+        let groups = |centre: f64, reached: bool| -> Vec<SimRun> {
+            (0..100)
+                .map(|k| SimRun {
+                    time_secs: centre * (1.0 + 0.002 * (k as f64 - 50.0)),
+                    detections: 0.0,
+                    reached: reached || k % 2 == 0,
+                    calibration: k % 5,
+                })
+                .collect()
+        };
+        let near = group_log_likelihood(&groups(16.0, true), 16.0);
+        assert!(near > group_log_likelihood(&groups(30.0, true), 16.0) + 5.0);
+        // Half the groups fail: about ln 2 lower.
+        let gap = near - group_log_likelihood(&groups(16.0, false), 16.0);
+        assert!((gap - 2f64.ln()).abs() < 0.3, "{gap}");
+    }
+}
