@@ -9,7 +9,7 @@ use errp_sim::grid::GridTaskParams;
 use errp_sim::task::ordinal_percent;
 use errp_sweep::fit::{
     EpuckFit, EpuckFitSpec, FitOutcome, GridFit, GridFitOutcome, GridFitSpec, Provenance,
-    run_epuck_fit, run_grid_fit,
+    REACHED_LEVEL, run_epuck_fit, run_grid_fit,
 };
 use errp_sweep::{parse_accuracies, parse_values};
 use toml::Value;
@@ -424,6 +424,29 @@ fn print_grid_fit(fit: &GridFit) {
         .map(|(row, e)| format!("{} {}", row.subject, num(*e)))
         .collect();
     println!("Each subject alone: {}.", own.join(", "));
+    let p40: Vec<String> = s
+        .grid
+        .iter()
+        .zip(&fit.p_all_reached)
+        .map(|(g, p)| format!("{} {:.3}", num(*g), p))
+        .collect();
+    println!(
+        "P(all 40 of the paper's goals reached), from the tables: {}.",
+        p40.join(", ")
+    );
+    match fit.reached_estimate {
+        Some(g) => println!(
+            "Keeping the paper's 40/40 (P >= {}): goal reward {}, the largest likelihood among \
+             the goal rewards where P(all 40 reached) >= {}.",
+            REACHED_LEVEL,
+            num(g),
+            REACHED_LEVEL
+        ),
+        None => println!(
+            "No goal reward of the grid keeps the paper's 40/40 (P(all 40 reached) >= {}).",
+            REACHED_LEVEL
+        ),
+    }
     let j = s.estimate;
     println!("At the estimate (ours [paper], z = difference in standard errors):");
     for (set, rows, stats) in [

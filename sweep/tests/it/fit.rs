@@ -286,6 +286,80 @@ fn the_median_time_to_pisa_does_not_rise_with_accuracy() {
 }
 
 #[test]
+fn the_shipped_grid_q_scale_is_the_committed_fit() {
+    let text = std::fs::read_to_string(repo("fits/grid.json")).unwrap();
+    let fit: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(fit["format"], 1);
+    assert_eq!(fit["parameter"], "control.goal_reward");
+    let commit = fit["provenance"]["commit"].as_str().unwrap();
+    assert!(
+        commit.len() == 40 && commit.chars().all(|c| c.is_ascii_hexdigit()),
+        "fits/grid.json was made by {commit:?}, not a clean commit"
+    );
+    // At the command's defaults.
+    assert_eq!(fit["spec"]["calibrations"], 5);
+    assert_eq!(fit["spec"]["repeats"], 40);
+    assert_eq!(fit["spec"]["epsilon"], 0.1);
+    let numbers = |key: &str| -> Vec<f64> {
+        fit[key]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap_or(f64::NEG_INFINITY))
+            .collect()
+    };
+    let total: Vec<f64> = fit["surface"]["total"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap_or(f64::NEG_INFINITY))
+        .collect();
+    let grid: Vec<f64> = fit["surface"]["grid"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let estimate = fit["estimate"].as_f64().unwrap();
+    assert_eq!(grid[errp_sweep::fit::argmax(&total)], estimate);
+    // The shipped scale: the largest likelihood where the paper's 40/40 is
+    // not rejected.
+    let p_all = numbers("p_all_reached");
+    let kept: Vec<usize> = (0..grid.len())
+        .filter(|&j| p_all[j] >= errp_sweep::fit::REACHED_LEVEL)
+        .collect();
+    let best = kept
+        .iter()
+        .copied()
+        .max_by(|&a, &b| total[a].total_cmp(&total[b]))
+        .unwrap();
+    let shipped = fit["reached_estimate"].as_f64().unwrap();
+    assert_eq!(grid[best], shipped);
+    let defaults = errp_sim::grid::GridTaskParams::default().control;
+    assert_eq!(defaults.goal_reward, shipped);
+    assert_eq!(defaults.epsilon, 0.1);
+    let control = |file: &str| -> toml::Table {
+        let text = std::fs::read_to_string(repo(file)).unwrap();
+        let table: toml::Table = toml::from_str(&text).unwrap();
+        table["control"].as_table().unwrap().clone()
+    };
+    for file in [
+        "scenarios/grid_fixed_goals.toml",
+        "scenarios/grid_free_goals.toml",
+    ] {
+        assert_eq!(
+            control(file)["goal_reward"].as_float(),
+            Some(shipped),
+            "{file} and fits/grid.json disagree"
+        );
+    }
+    assert_eq!(
+        control("scenarios/variants/grid_fixed_goals_mle.toml")["goal_reward"].as_float(),
+        Some(estimate)
+    );
+}
+
+#[test]
 fn a_small_grid_fit_writes_its_files_and_refuses_bad_settings() {
     let out = temp_dir("fit-grid");
     let spec = GridFitSpec {
