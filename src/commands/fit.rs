@@ -447,8 +447,21 @@ fn print_grid_fit(fit: &GridFit) {
             REACHED_LEVEL
         ),
     }
-    let j = s.estimate;
-    println!("At the estimate (ours [paper], z = difference in standard errors):");
+    print_grid_point(fit, s.estimate, "the estimate");
+    let kept = fit
+        .reached_estimate
+        .and_then(|g| s.grid.iter().position(|&x| x == g));
+    if let Some(j) = kept.filter(|&j| j != s.estimate) {
+        print_grid_point(fit, j, "the goal reward that keeps the paper's 40/40");
+    }
+}
+
+/// The fitted and held-out rows of grid point `j`, against the paper's.
+fn print_grid_point(fit: &GridFit, j: usize, what: &str) {
+    println!(
+        "At {what}, goal reward {} (ours [paper], z = difference in standard errors):",
+        errp_sim::task::format_number(fit.surface.grid[j])
+    );
     for (set, rows, stats) in [
         ("fixed (fitted)", &fit.fixed, &fit.fixed_stats),
         ("free (held out)", &fit.free, &fit.free_stats),

@@ -917,8 +917,11 @@ pub fn grid_fit_plot(fit: &GridFit) -> FitPlot {
     FitPlot {
         title: format!(
             "Grid Q-value scale fitted to Table 1's fixed goals: goal reward {} (95 % LR \
-             interval {lo}-{hi}); {} calibrations x {} groups of 5 runs per subject and point",
+             interval {lo}-{hi}); {} keeps the paper's 40/40 (P >= {REACHED_LEVEL}); {} \
+             calibrations x {} groups of 5 runs per subject and point",
             errp_sim::task::format_number(fit.estimate),
+            fit.reached_estimate
+                .map_or("none".into(), errp_sim::task::format_number),
             fit.spec.calibrations,
             fit.spec.repeats
         ),
