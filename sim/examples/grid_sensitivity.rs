@@ -5,15 +5,16 @@
 //! paper's mean accuracy (74.38 %) and at 90 %, and prints a markdown table:
 //! goals reached and actions (mean +- sd). The first row of each block uses
 //! only what the paper states (tau = 0.3, p_c = 0.9, p = 1 / (1 + e^-y)) plus
-//! our defaults for what it does not (epsilon, reward model).
+//! our defaults for what it does not (epsilon, discount, and the goal reward
+//! fitted by `errp fit grid`).
 //!
-//! `cargo run -p errp_sim --example grid_sensitivity` (a few minutes).
+//! `cargo run --release -p errp_sim --example grid_sensitivity` (about a
+//! minute).
 
-use errp_bci::SessionOptions;
 use errp_robot::{Grid, QTable};
-use errp_sim::calibration::{CalibrationRequest, run_calibration};
 use errp_sim::grid::{
-    AssessmentDecoder, EegDecoder, FIXED_PAIRS, GridTaskParams, PErrorChoice, run_grid_episode,
+    AssessmentDecoder, EegDecoder, FIXED_PAIRS, GridScenario, GridTaskParams, PErrorChoice,
+    prepare_decoder, run_grid_episode,
 };
 use errp_sim::mean_sd;
 
@@ -22,7 +23,8 @@ struct Variant {
     platt: Option<bool>,
     epsilon: f64,
     discount: f64,
-    reward: f64,
+    /// None: the shipped (fitted) goal reward.
+    reward: Option<f64>,
 }
 
 fn main() {
@@ -32,70 +34,79 @@ fn main() {
             platt: Some(false),
             epsilon: 0.1,
             discount: 0.9,
-            reward: 1.0,
+            reward: None,
         },
         Variant {
             label: "p = sigmoid(y), discount 0.5",
             platt: Some(false),
             epsilon: 0.1,
             discount: 0.5,
-            reward: 1.0,
+            reward: None,
         },
         Variant {
             label: "**default: Platt-scaled p**",
             platt: Some(true),
             epsilon: 0.1,
             discount: 0.9,
-            reward: 1.0,
+            reward: None,
         },
         Variant {
             label: "Platt, epsilon 0",
             platt: Some(true),
             epsilon: 0.0,
             discount: 0.9,
-            reward: 1.0,
+            reward: None,
         },
         Variant {
             label: "Platt, epsilon 0.3",
             platt: Some(true),
             epsilon: 0.3,
             discount: 0.9,
-            reward: 1.0,
+            reward: None,
         },
         Variant {
             label: "Platt, discount 0.5",
             platt: Some(true),
             epsilon: 0.1,
             discount: 0.5,
-            reward: 1.0,
+            reward: None,
         },
         Variant {
-            label: "Platt, goal reward 3 (Q scale x3)",
+            label: "Platt, goal reward 1 (before the fit)",
             platt: Some(true),
             epsilon: 0.1,
             discount: 0.9,
-            reward: 3.0,
+            reward: Some(1.0),
+        },
+        Variant {
+            label: "Platt, goal reward 9.5 (the fit's unconstrained estimate)",
+            platt: Some(true),
+            epsilon: 0.1,
+            discount: 0.9,
+            reward: Some(9.5),
         },
         Variant {
             label: "oracle decoder, p = accuracy",
             platt: None,
             epsilon: 0.1,
             discount: 0.9,
-            reward: 1.0,
+            reward: None,
         },
     ];
     println!("| accuracy | variant | goals reached | actions |");
     println!("|---|---|---|---|");
     for accuracy in [0.7438, 0.90] {
-        let report = run_calibration(
-            &CalibrationRequest::new(
-                errp_bci::MeanAccuracy::new(accuracy).expect("an accuracy in (0.5, 1)"),
-                3,
-            ),
-            |_| {},
-            SessionOptions::default(),
+        // The grid's decoder, targeted as every grid scenario's is (online,
+        // on held-out epochs), from calibration seed 3.
+        let mut scenario = GridScenario::load(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../scenarios/grid_fixed_goals.toml"),
         )
-        .expect("calibration");
+        .expect("the shipped scenario");
+        scenario.accuracy = accuracy;
+        scenario.seed = 3;
+        let (_, report) = prepare_decoder(&scenario, |_| {}).expect("calibration");
+        let report = report.expect("an EEG decoder");
         let eeg =
             |choice| AssessmentDecoder::Eeg(Box::new(EegDecoder::from_report(&report, choice)));
         for v in &variants {
@@ -107,7 +118,9 @@ fn main() {
             let mut params = GridTaskParams::default();
             params.control.epsilon = v.epsilon;
             params.control.discount = v.discount;
-            params.control.goal_reward = v.reward;
+            if let Some(reward) = v.reward {
+                params.control.goal_reward = reward;
+            }
             let table = QTable::compute(Grid::paper(), &params.control.q()).expect("Q-values");
             let mut reached = 0;
             let mut actions = Vec::new();

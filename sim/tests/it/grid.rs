@@ -43,14 +43,17 @@ fn pooled(results: &[errp_sim::grid::GridEpisodeResult]) -> Accuracy {
 }
 
 #[test]
-fn at_90_percent_with_the_eeg_decoder_every_episode_reaches_its_goal() {
+fn at_90_percent_with_the_eeg_decoder_nearly_every_episode_reaches_its_goal() {
+    // The fitted Q-value scale (goal reward 2) reaches 93-99 % of the goals
+    // at Table 1's accuracies (`errp fit grid`); at 90 %, at least 90 of
+    // 100 here. A decoder at chance reaches about 1 in 25.
     let decoder = eeg_decoder(0.90, 7);
-    let results = episodes(&decoder, 20, 7);
+    let results = episodes(&decoder, 100, 7);
     let reached = results.iter().filter(|r| r.reached()).count();
     let actions: usize = results.iter().map(|r| r.actions).sum();
-    assert_eq!(
-        reached, 20,
-        "{reached}/20 reached; {actions} actions in all"
+    assert!(
+        reached >= 90,
+        "{reached}/100 reached; {actions} actions in all"
     );
 }
 
@@ -74,8 +77,9 @@ fn banked_epochs_give_the_streamed_accuracy_and_reach_the_goals() {
     let bank = errp_sim::grid::EpochBank::build(eeg, &GridTaskParams::default(), 400, 7).unwrap();
     assert_eq!(bank.len(), 400);
     let decoder = AssessmentDecoder::EegBank(Box::new(bank));
-    let results = episodes(&decoder, 20, 7);
-    assert!(results.iter().all(|r| r.reached()));
+    let results = episodes(&decoder, 40, 7);
+    let reached = results.iter().filter(|r| r.reached()).count();
+    assert!(reached >= 36, "{reached}/40 reached");
     let acc = pooled(&results);
     assert!(
         (acc.mean() - 0.90).abs() <= 0.05,
