@@ -42,7 +42,7 @@ FIELDS = [
     "task", "seed", "name", "decoder", "p_error", "eeg", "bank_per_class", "repeats",
     "runs", "max_secs", "start", "goal", "start_heading_deg", "user.accuracy",
     "user.subject", "user.goals", "user.hit_rate", "user.false_alarms_per_min",
-    "user.fov_deg", "user.reaction_latency_ms", "user.reelicit_secs", "free_goals.count",
+    "user.fov_deg", "user.reaction_latency_ms", "user.reelicit_secs", "user.seed", "free_goals.count",
     "timing.interval_min_secs", "timing.interval_max_secs", "timing.epoch_secs",
     "timing.max_actions", "control.tau", "control.epsilon", "control.p_c", "control.t_e",
     "control.k_n", "control.sigma_deg", "control.stop_secs", "control.goal_hold_secs",

@@ -256,7 +256,7 @@ impl EpuckTask {
     ) -> PyResult<Self> {
         let mut s = load_epuck(scenario, accuracy, overrides, "errp.EpuckTask")?;
         if let Some(seed) = seed {
-            s.seed = seed;
+            s.reseed(seed);
         }
         check_callable(py, "decoder", decoder.as_ref())?;
         let (builtin, report) = py

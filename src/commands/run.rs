@@ -154,7 +154,7 @@ pub(crate) fn run_grid(args: &RunArgs, mut scenario: GridScenario) -> Result<()>
 
 pub(crate) fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<()> {
     if let Some(seed) = args.seed {
-        scenario.seed = seed;
+        scenario.reseed(seed);
     }
     if let Some(runs) = args.runs {
         scenario.runs = runs as usize;
@@ -168,12 +168,17 @@ pub(crate) fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<(
     let goal = &layout.goals()[scenario.episode.goal].name;
     if !quiet {
         eprintln!(
-            "{}: e-puck from ({:.0}, {:.0}) cm to {goal}, {} run(s), {decoder_text}, seed {}",
+            "{}: e-puck from ({:.0}, {:.0}) cm to {goal}, {} run(s), {decoder_text}, seed {}{}",
             scenario.name,
             100.0 * start.x_m,
             100.0 * start.y_m,
             scenario.runs,
-            scenario.seed
+            scenario.seed,
+            if scenario.user_seed == scenario.seed {
+                String::new()
+            } else {
+                format!(" (user seed {})", scenario.user_seed)
+            }
         );
     }
     let (decoder, report) = prepare_continuous_decoder_with(

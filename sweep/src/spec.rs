@@ -572,6 +572,8 @@ impl SweepSpec {
                     // The level's accuracy replaces an online target.
                     user.remove("hit_rate");
                     user.remove("false_alarms_per_min");
+                    // The sweep's seed gives the user (the calibration).
+                    user.remove("seed");
                 }
                 let mut sets: Vec<(&str, Value)> = vec![
                     ("user.accuracy", Value::Float(accuracy)),
@@ -702,6 +704,28 @@ mod tests {
                 proptest::prop_assert!(s.index >= 1 && s.index <= s.count);
             }
         }
+    }
+
+    #[test]
+    fn a_sweep_seed_gives_every_level_its_user() {
+        // A scenario's `[user] seed` (the city scenarios share one) is the
+        // sweep's to set: each sweep seed is another simulated user.
+        let spec = SweepSpec {
+            task: SweepTask::Epuck,
+            scenario_path: "scenarios/lisbon_to_tokyo.toml".into(),
+            scenario_toml: include_str!("../../scenarios/lisbon_to_tokyo.toml").into(),
+            accuracies: vec![0.8],
+            axes: vec![],
+            fixed: vec![],
+            episodes: 1,
+            seed: 7,
+        };
+        let levels = spec.levels().unwrap();
+        let AnyScenario::Epuck(s) = &levels[0].scenario else {
+            panic!("an e-puck scenario")
+        };
+        assert_eq!(s.seed, spec.calibration_seed());
+        assert_eq!(s.user_seed, s.seed);
     }
 
     #[test]

@@ -61,7 +61,7 @@ pub fn prepare_epuck_decoder(
     mut progress: impl FnMut(&TargetingStep),
     online_progress: impl FnMut(&OnlineStep),
 ) -> Result<PreparedEpuck> {
-    let request = ContinuousRequest::new(scenario.accuracy, scenario.seed);
+    let request = ContinuousRequest::new(scenario.accuracy, scenario.user_seed);
     match scenario.online_target {
         None => {
             let mut find = || target_continuous(&request, &mut progress);
@@ -104,7 +104,7 @@ pub fn finish_continuous_decoder(
     decoder.measure_online(
         scenario.params.detector,
         scenario.params.control.t_e,
-        scenario.seed,
+        scenario.user_seed,
     )?;
     Ok(decoder)
 }

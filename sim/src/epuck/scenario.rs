@@ -51,8 +51,15 @@ pub struct EpuckScenario {
     pub name: String,
     /// What it reproduces, in words.
     pub description: String,
-    /// Base seed (calibration and runs).
+    /// Base seed of the runs (and of the calibration, unless `user_seed`
+    /// says otherwise).
     pub seed: u64,
+    /// Seed of the simulated user's calibration: the decoder and its
+    /// operating point measured on held-out EEG (`[user] seed`; by default
+    /// `seed`). The two city scenarios share one, so that their runs are one
+    /// simulated user's, as the paper's two runs were one subject's, while
+    /// their runs draw from seeds of their own.
+    pub user_seed: u64,
     /// The continuous decoder's cross-validated mean accuracy (with an
     /// online target: its hit rate, as the device assumes it).
     pub accuracy: MeanAccuracy,
@@ -71,6 +78,13 @@ pub struct EpuckScenario {
 }
 
 impl EpuckScenario {
+    /// Gives the scenario a new base seed for everything: a new simulated
+    /// user (`user_seed`) and new runs (`errp run --seed`).
+    pub fn reseed(&mut self, seed: u64) {
+        self.seed = seed;
+        self.user_seed = seed;
+    }
+
     /// The decoder in words, as `errp run` prints it and its recording
     /// shows it: "decoder accuracy 75.00 %", or the online target.
     pub fn decoder_text(&self) -> String {
@@ -496,6 +510,7 @@ impl EpuckScenario {
             name: scenario_name(file.name, path),
             description: file.description.unwrap_or_default(),
             seed: file.seed,
+            user_seed: file.user.seed.unwrap_or(file.seed),
             accuracy,
             online_target,
             runs,

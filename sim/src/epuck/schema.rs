@@ -100,6 +100,7 @@ impl<'de> Deserialize<'de> for StartFile {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct UserFile {
+    pub(crate) seed: Option<u64>,
     pub(crate) accuracy: Option<f64>,
     pub(crate) hit_rate: Option<f64>,
     pub(crate) false_alarms_per_min: Option<f64>,

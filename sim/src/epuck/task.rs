@@ -117,7 +117,7 @@ impl Task for EpuckTask {
             "{:?}",
             (
                 s.accuracy,
-                s.seed,
+                s.user_seed,
                 s.online_target,
                 s.params.detector,
                 s.params.control.t_e
@@ -140,7 +140,7 @@ impl Task for EpuckTask {
         let info = DecoderInfo {
             accuracy: s.accuracy.get(),
             kind: "svm".into(),
-            calibration_seed: s.seed,
+            calibration_seed: s.user_seed,
             errp_to_noise: Some(prepared.report.targeting.ratio),
             cv_correct: Some(a.correct),
             cv_error: Some(a.error),

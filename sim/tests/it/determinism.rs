@@ -79,7 +79,24 @@ fn the_same_seed_gives_the_same_run() {
     assert_eq!(batch[3], a);
     let got = digest(&a);
     assert_eq!(
-        got, 0x0cbc_a97b_24b8_d1dc,
+        got, 0x784c_430b_3738_cda2,
         "Lisbon to Tokyo, run 3: digest {got:#x}"
     );
+}
+
+#[test]
+fn the_city_scenarios_share_one_user_and_draw_their_own_runs() {
+    // One simulated user (calibration seed) for both of the paper's runs,
+    // each scenario's runs from its own seed.
+    let m = epuck::scenario("mexico_to_pisa.toml");
+    let l = epuck::scenario("lisbon_to_tokyo.toml");
+    assert_eq!(m.user_seed, l.user_seed);
+    assert_ne!(m.seed, l.seed);
+    // `errp run --seed` gives a new user and new runs.
+    let mut r = l.clone();
+    r.reseed(9);
+    assert_eq!((r.seed, r.user_seed), (9, 9));
+    // Without `[user] seed`, the user is the scenario's seed.
+    let h = epuck::scenario("obstacles_havana_to_seoul.toml");
+    assert_eq!(h.user_seed, h.seed);
 }

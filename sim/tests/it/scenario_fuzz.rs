@@ -44,6 +44,7 @@ const FIELDS: &[&str] = &[
     "user.fov_deg",
     "user.reaction_latency_ms",
     "user.reelicit_secs",
+    "user.seed",
     "free_goals.count",
     "timing.interval_min_secs",
     "timing.interval_max_secs",
