@@ -34,6 +34,7 @@ FIGURES=(
   "fit_grid|slow|fit grid --out OUT_DIR --quiet"
   "fit_grid_epsilon0|slow|fit grid --epsilon 0 --out OUT_DIR --quiet"
   "table1_seeds|slow|sh: python3 scripts/table1_seeds.py --seeds 10"
+  "python_decoders|slow|sh: \${PYTHON:-target/ci-venv/bin/python} python/examples/decoders_in_the_loop.py 2>/dev/null | sed -E 's/ +\\([0-9.]+ s\\)\$//'"
 )
 
 check=false

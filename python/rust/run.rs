@@ -121,7 +121,7 @@ pub(crate) fn run<'py>(
         }
         AnyScenario::Epuck(mut s) => {
             if let Some(seed) = seed {
-                s.seed = seed;
+                s.reseed(seed);
             }
             if let Some(r) = runs {
                 if !(1..=errp_sim::epuck::MAX_RUNS as usize).contains(&r) {
