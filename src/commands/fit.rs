@@ -129,17 +129,8 @@ fn fit_epuck(args: &EpuckFitArgs) -> Result<bool> {
         seed: args.seed,
         bootstrap: args.bootstrap,
     };
-    let cache = args.workers.cache();
-    if let Some(why) = cache.problem() {
-        eprintln!("warning: {why}");
-    }
-    let (pool, threads) = args.workers.pool()?;
-    let provenance = Provenance {
-        command: std::env::args().collect::<Vec<_>>().join(" "),
-        errp_version: env!("CARGO_PKG_VERSION").to_string(),
-        commit: COMMIT.to_string(),
-    };
-    let progress = Progress::new(args.quiet);
+    let (cache, pool, threads, progress) = start(&args.workers, args.quiet)?;
+    let provenance = provenance();
     progress.line(&format!(
         "Fitting the e-puck decoder's accuracy to the paper's two runs: {} accuracies x {} \
          calibrations x {} runs of each scenario, seeds {}-{}, into {} on {threads} thread(s)",
@@ -289,6 +280,21 @@ fn parse_goal_rewards(text: &str) -> Result<Vec<f64>> {
         .collect()
 }
 
+/// What both fits start with: the targeting cache (a warning if it cannot
+/// be used), the worker pool and its size, and the progress output.
+fn start(
+    workers: &Workers,
+    quiet: bool,
+) -> Result<(errp_sweep::TargetCache, rayon::ThreadPool, usize, Progress)> {
+    let cache = workers.cache();
+    if let Some(why) = cache.problem() {
+        eprintln!("warning: {why}");
+    }
+    let (pool, threads) = workers.pool()?;
+    Ok((cache, pool, threads, Progress::new(quiet)))
+}
+
+/// The command line, version and commit, for a fit's result file.
 fn provenance() -> Provenance {
     Provenance {
         command: std::env::args().collect::<Vec<_>>().join(" "),
@@ -306,12 +312,7 @@ fn fit_grid(args: &GridFitArgs) -> Result<bool> {
         seed: args.seed,
         bootstrap: args.bootstrap,
     };
-    let cache = args.workers.cache();
-    if let Some(why) = cache.problem() {
-        eprintln!("warning: {why}");
-    }
-    let (pool, threads) = args.workers.pool()?;
-    let progress = Progress::new(args.quiet);
+    let (cache, pool, threads, progress) = start(&args.workers, args.quiet)?;
     progress.line(&format!(
         "Fitting the grid's Q-value scale to Table 1's fixed goals: {} goal rewards x 4 subjects \
          x 2 goal sets x {} calibrations x {} groups of 5 runs, seed {}, epsilon {}, into {} on \

@@ -100,14 +100,10 @@ fn build_held_out(
     setup: &CalibrationSetup,
     session: &SessionParts,
 ) -> Result<EpochBankParts> {
-    let source = EegSource {
-        generator: &setup.generator,
-        montage: &setup.montage,
-        preprocessor: session.preprocessor(),
-    };
-    EpochBankParts::build(
-        source,
-        &s.params,
+    stream_parts(
+        s,
+        setup,
+        session,
         HELD_OUT_PER_CLASS,
         derive_seed(s.seed, "grid/targeting/held-out", 0),
     )
@@ -143,12 +139,25 @@ fn build_bank(
     setup: &CalibrationSetup,
     session: &SessionParts,
 ) -> Result<EpochBankParts> {
+    stream_parts(s, setup, session, s.bank_per_class, s.seed)
+}
+
+/// `per_class` epochs of each class from `seed`, streamed at `s`'s
+/// inter-action intervals: the EEG of the user of `setup` through
+/// `session`'s preprocessing.
+fn stream_parts(
+    s: &GridScenario,
+    setup: &CalibrationSetup,
+    session: &SessionParts,
+    per_class: usize,
+    seed: u64,
+) -> Result<EpochBankParts> {
     let source = EegSource {
         generator: &setup.generator,
         montage: &setup.montage,
         preprocessor: session.preprocessor(),
     };
-    EpochBankParts::build(source, &s.params, s.bank_per_class, s.seed)
+    EpochBankParts::build(source, &s.params, per_class, seed)
 }
 
 impl GridShared {

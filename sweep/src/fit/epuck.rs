@@ -22,15 +22,16 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
 use errp_bci::rng::stream;
-use errp_sim::{PAPER_EPUCK, Result, SimError, create_dir, write_atomic};
+use errp_sim::{PAPER_EPUCK, Result, SimError, create_dir};
 use serde::Serialize;
 
 use super::density::{Observed, SimRun, log_likelihood, percentile_of, quantile, resample};
+use super::files;
 use super::surface::Surface;
 use crate::cache::TargetCache;
 use crate::manifest::EPISODES;
 use crate::observer::SweepObserver;
-use crate::plot::{Curve, CurvePoint, FitPanel, FitPlot, fit_png, fit_svg};
+use crate::plot::{Curve, CurvePoint, FitPanel, FitPlot};
 use crate::run::{SweepOptions, SweepOutcome, run_sweep};
 use crate::spec::{InputNames, Shard, SweepSpec, SweepTask, sweep_fixed};
 
@@ -198,8 +199,7 @@ pub const DENSITY: &str = "P(reached) (Jeffreys: (k + 1/2) / (n + 1)) times a Ga
      kernel density of (ln time, detections) over the runs that reached the goal, Scott's \
      bandwidth per dimension (sd n^(-1/6); at least 0.02 and 0.5)";
 
-/// The files a fit writes in its directory, besides the two sweeps.
-pub const FIT_FILES: [&str; 4] = ["fit.json", "surface.csv", "fit.svg", "fit.png"];
+pub use super::files::FIT_FILES;
 
 /// The directory of a paper run's sweeps inside the fit's directory.
 pub fn run_dir(out: &Path, run: &PaperRun) -> PathBuf {
@@ -337,40 +337,8 @@ fn check_spec(spec: &EpuckFitSpec) -> Result<()> {
 
 /// Refuses an `out` that holds anything a fit did not write.
 fn check_out(out: &Path) -> Result<()> {
-    if !out.exists() {
-        return Ok(());
-    }
-    if !out.is_dir() {
-        return Err(SimError::Sweep(format!(
-            "--out {} exists and is not a directory",
-            out.display()
-        )));
-    }
-    let entries = std::fs::read_dir(out).map_err(|source| SimError::Input {
-        path: out.to_path_buf(),
-        source,
-    })?;
     let ours: Vec<PathBuf> = paper_runs().iter().map(|r| run_dir(out, r)).collect();
-    let mut foreign: Vec<String> = entries
-        .flatten()
-        .filter(|e| {
-            let name = e.file_name().to_string_lossy().into_owned();
-            !(FIT_FILES.contains(&name.as_str())
-                || ours.contains(&e.path())
-                || (name.starts_with('.') && name.contains(".partial-")))
-        })
-        .map(|e| e.file_name().to_string_lossy().into_owned())
-        .take(6)
-        .collect();
-    if foreign.is_empty() {
-        return Ok(());
-    }
-    foreign.sort();
-    Err(SimError::Sweep(format!(
-        "--out {} holds files that are not a fit's ({}); give a new or empty directory",
-        out.display(),
-        foreign.join(", ")
-    )))
+    files::check_out(out, |p| ours.iter().any(|o| o == p), "a fit's")
 }
 
 /// Reads a finished e-puck sweep's runs (of `calibration`), grouped by
@@ -534,24 +502,7 @@ pub fn analyse(
 
 /// Writes [`FIT_FILES`] into `out`.
 fn write_fit(fit: &EpuckFit, out: &Path) -> Result<Vec<PathBuf>> {
-    let json = serde_json::to_string_pretty(fit)
-        .map_err(|e| SimError::Sweep(format!("cannot encode the fit: {e}")))?;
-    let plot = fit_plot(fit);
-    let svg = fit_svg(&plot).map_err(|e| SimError::Sweep(e.to_string()))?;
-    let png = fit_png(&plot).map_err(|e| SimError::Sweep(e.to_string()))?;
-    let files = [
-        (FIT_FILES[0], format!("{json}\n").into_bytes()),
-        (FIT_FILES[1], surface_csv(fit).into_bytes()),
-        (FIT_FILES[2], svg.into_bytes()),
-        (FIT_FILES[3], png),
-    ];
-    let mut written = Vec::new();
-    for (name, bytes) in files {
-        let path = out.join(name);
-        write_atomic(&path, &bytes)?;
-        written.push(path);
-    }
-    Ok(written)
+    files::write_fit_files(out, fit, surface_csv(fit), &fit_plot(fit))
 }
 
 /// One row per grid point: the total and each run's log-likelihood with

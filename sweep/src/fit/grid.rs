@@ -33,16 +33,17 @@ use errp_sim::grid::{
     GridShared, GridTaskParams, PErrorChoice, free_pairs, prepare_grid_decoder, run_grid_episode,
 };
 use errp_sim::task::DecoderInfo;
-use errp_sim::{PAPER, Result, SimError, create_dir, mean_sd, pearson, write_atomic};
+use errp_sim::{PAPER, Result, SimError, create_dir, mean_sd, pearson};
 use rayon::prelude::*;
 use serde::Serialize;
 
 use super::density::{SimRun, percentile_of, quantile, resample};
 use super::epuck::Provenance;
+use super::files;
 use super::surface::{Surface, argmax};
 use crate::cache::TargetCache;
 use crate::observer::SweepObserver;
-use crate::plot::{Curve, CurvePoint, FitPanel, FitPlot, fit_png, fit_svg};
+use crate::plot::{Curve, CurvePoint, FitPanel, FitPlot};
 
 /// What `errp fit grid` runs.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -204,8 +205,8 @@ pub const GRID_DENSITY: &str = "P(all five goals reached) (Jeffreys over the sim
      five runs: (k + 1/2) / (n + 1)) times the normal density of ln(mean actions of the five \
      runs) fitted to the groups that reached every goal (their mean and sd, at least 0.02)";
 
-/// The files `errp fit grid` writes.
-pub const GRID_FIT_FILES: [&str; 4] = ["fit.json", "surface.csv", "fit.svg", "fit.png"];
+/// The files `errp fit grid` writes (those of every fit).
+pub use super::files::FIT_FILES as GRID_FIT_FILES;
 
 /// Smallest sd of ln(mean actions).
 const MIN_SD: f64 = 0.02;
@@ -329,37 +330,7 @@ fn check_spec(spec: &GridFitSpec) -> Result<()> {
 
 /// Refuses an `out` that holds anything the fit did not write.
 fn check_out(out: &Path) -> Result<()> {
-    if !out.exists() {
-        return Ok(());
-    }
-    if !out.is_dir() {
-        return Err(SimError::Sweep(format!(
-            "--out {} exists and is not a directory",
-            out.display()
-        )));
-    }
-    let entries = std::fs::read_dir(out).map_err(|source| SimError::Input {
-        path: out.to_path_buf(),
-        source,
-    })?;
-    let mut foreign: Vec<String> = entries
-        .flatten()
-        .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|name| {
-            !(GRID_FIT_FILES.contains(&name.as_str())
-                || (name.starts_with('.') && name.contains(".partial-")))
-        })
-        .take(6)
-        .collect();
-    if foreign.is_empty() {
-        return Ok(());
-    }
-    foreign.sort();
-    Err(SimError::Sweep(format!(
-        "--out {} holds files that are not a grid fit's ({}); give a new or empty directory",
-        out.display(),
-        foreign.join(", ")
-    )))
+    files::check_out(out, |_| false, "a grid fit's")
 }
 
 /// The scenario of one calibration: the subject's accuracy, the paper's
@@ -739,24 +710,7 @@ fn analyse(
 }
 
 fn write_fit(fit: &GridFit, out: &Path) -> Result<Vec<PathBuf>> {
-    let json = serde_json::to_string_pretty(fit)
-        .map_err(|e| SimError::Sweep(format!("cannot encode the fit: {e}")))?;
-    let plot = grid_fit_plot(fit);
-    let svg = fit_svg(&plot).map_err(|e| SimError::Sweep(e.to_string()))?;
-    let png = fit_png(&plot).map_err(|e| SimError::Sweep(e.to_string()))?;
-    let files = [
-        (GRID_FIT_FILES[0], format!("{json}\n").into_bytes()),
-        (GRID_FIT_FILES[1], grid_surface_csv(fit).into_bytes()),
-        (GRID_FIT_FILES[2], svg.into_bytes()),
-        (GRID_FIT_FILES[3], png),
-    ];
-    let mut written = Vec::new();
-    for (name, bytes) in files {
-        let path = out.join(name);
-        write_atomic(&path, &bytes)?;
-        written.push(path);
-    }
-    Ok(written)
+    files::write_fit_files(out, fit, grid_surface_csv(fit), &grid_fit_plot(fit))
 }
 
 /// One row per grid point: the total and each subject's log-likelihood on

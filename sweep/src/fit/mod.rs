@@ -3,6 +3,7 @@
 
 mod density;
 mod epuck;
+mod files;
 mod grid;
 mod surface;
 

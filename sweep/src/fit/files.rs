@@ -1,0 +1,77 @@
+//! What every fit writes, and the directory it writes into.
+
+use std::path::{Path, PathBuf};
+
+use errp_sim::{Result, SimError, write_atomic};
+use serde::Serialize;
+
+use crate::plot::{FitPlot, fit_png, fit_svg};
+
+/// The files a fit writes in its directory.
+pub const FIT_FILES: [&str; 4] = ["fit.json", "surface.csv", "fit.svg", "fit.png"];
+
+/// Writes [`FIT_FILES`] into `out`, each atomically: `fit` as JSON, the
+/// surface's CSV and the figure as SVG and PNG.
+pub(crate) fn write_fit_files(
+    out: &Path,
+    fit: &impl Serialize,
+    csv: String,
+    plot: &FitPlot,
+) -> Result<Vec<PathBuf>> {
+    let json = serde_json::to_string_pretty(fit)
+        .map_err(|e| SimError::Sweep(format!("cannot encode the fit: {e}")))?;
+    let svg = fit_svg(plot).map_err(|e| SimError::Sweep(e.to_string()))?;
+    let png = fit_png(plot).map_err(|e| SimError::Sweep(e.to_string()))?;
+    let files = [
+        (FIT_FILES[0], format!("{json}\n").into_bytes()),
+        (FIT_FILES[1], csv.into_bytes()),
+        (FIT_FILES[2], svg.into_bytes()),
+        (FIT_FILES[3], png),
+    ];
+    let mut written = Vec::new();
+    for (name, bytes) in files {
+        let path = out.join(name);
+        write_atomic(&path, &bytes)?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+/// Refuses an `out` that holds anything but [`FIT_FILES`], partial files
+/// and the entries `ours` accepts (a fit's sweeps); `what` names the fit in
+/// the message ("a fit's", "a grid fit's").
+pub(crate) fn check_out(out: &Path, ours: impl Fn(&Path) -> bool, what: &str) -> Result<()> {
+    if !out.exists() {
+        return Ok(());
+    }
+    if !out.is_dir() {
+        return Err(SimError::Sweep(format!(
+            "--out {} exists and is not a directory",
+            out.display()
+        )));
+    }
+    let entries = std::fs::read_dir(out).map_err(|source| SimError::Input {
+        path: out.to_path_buf(),
+        source,
+    })?;
+    let mut foreign: Vec<String> = entries
+        .flatten()
+        .filter(|e| {
+            let name = e.file_name().to_string_lossy().into_owned();
+            !(FIT_FILES.contains(&name.as_str())
+                || ours(&e.path())
+                || (name.starts_with('.') && name.contains(".partial-")))
+        })
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .take(6)
+        .collect();
+    if foreign.is_empty() {
+        return Ok(());
+    }
+    foreign.sort();
+    Err(SimError::Sweep(format!(
+        "--out {} holds files that are not {what} ({}); give a new or empty directory",
+        out.display(),
+        foreign.join(", ")
+    )))
+}
