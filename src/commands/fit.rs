@@ -274,7 +274,7 @@ fn parse_goal_rewards(text: &str) -> Result<Vec<f64>> {
             Value::Float(x) => Ok(x),
             Value::Integer(i) => Ok(i as f64),
             other => Err(anyhow::anyhow!(
-                "--goal-reward {text:?} is invalid: {other:?} is not a number (e.g. 0.5:4:0.25)"
+                "--goal-reward {text:?} is invalid: {other} is not a number (e.g. 1:10:0.5)"
             )),
         })
         .collect()

@@ -527,6 +527,18 @@ fn bad_fit_input_is_exit_2_naming_the_flag() {
         "--no-cache",
     ]);
     assert!(e.contains("--calibrations 0"), "{e}");
+    for (args, want) in [
+        (&["--epsilon", "1.5"][..], "--epsilon 1.5"),
+        (&["--goal-reward", "abc"][..], "--goal-reward \"abc\""),
+        (&["--goal-reward", "0:1:0.5"][..], "(0, 100]"),
+        (&["--repeats", "1"][..], "2 to 1000"),
+    ] {
+        let mut full = vec!["fit", "grid"];
+        full.extend_from_slice(args);
+        full.extend_from_slice(&["--out", o, "--no-cache"]);
+        let e = refused(&full);
+        assert!(e.contains(want), "{args:?}: {e}");
+    }
     assert!(!Path::new(o).exists(), "a refused fit leaves nothing");
     let _ = std::fs::remove_dir_all(&dir);
 }
