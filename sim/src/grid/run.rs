@@ -17,6 +17,7 @@ use crate::grid::decoder::{
 };
 use crate::grid::episode::{GridDecoding, GridEpisodeResult, run_grid_episode_with};
 use crate::grid::scenario::{DecoderChoice, EegMode, GridScenario};
+use crate::task::DecoderInfo;
 
 /// Everything a grid run produced.
 #[derive(Debug, Clone)]
@@ -62,6 +63,32 @@ pub struct PreparedGrid {
     pub calibration: Option<CalibrationReport>,
     /// True if the targeting came from the cache.
     pub cached: bool,
+}
+
+impl PreparedGrid {
+    /// What a sweep or a fit reports of the decoder of `s`: the requested
+    /// accuracy, the ratio found and the session's cross-validated rates.
+    pub fn info(&self, s: &GridScenario) -> DecoderInfo {
+        let calibration = self.calibration.as_ref();
+        let accuracy = calibration.map(|c| c.calibrated.accuracy);
+        DecoderInfo {
+            accuracy: s.accuracy,
+            kind: if calibration.is_some() {
+                "lda"
+            } else {
+                "oracle"
+            }
+            .into(),
+            calibration_seed: s.seed,
+            errp_to_noise: calibration.map(|c| c.targeting.ratio),
+            cv_correct: accuracy.map(|a| a.correct),
+            cv_error: accuracy.map(|a| a.error),
+            cv_mean: accuracy.map(|a| a.mean()),
+            online_hit_rate: None,
+            online_false_alarms_per_min: None,
+            cached: self.cached,
+        }
+    }
 }
 
 /// What the decoders of several grid scenarios can share, simulated once:

@@ -141,25 +141,7 @@ impl Task for GridTask {
         cache: &dyn TargetingCache,
     ) -> Result<(AssessmentDecoder, DecoderInfo)> {
         let prepared = prepare_grid_decoder(s, shared, cache, |_| {})?;
-        let calibration = prepared.calibration.as_ref();
-        let accuracy = calibration.map(|c| c.calibrated.accuracy);
-        let info = DecoderInfo {
-            accuracy: s.accuracy,
-            kind: if calibration.is_some() {
-                "lda"
-            } else {
-                "oracle"
-            }
-            .into(),
-            calibration_seed: s.seed,
-            errp_to_noise: calibration.map(|c| c.targeting.ratio),
-            cv_correct: accuracy.map(|a| a.correct),
-            cv_error: accuracy.map(|a| a.error),
-            cv_mean: accuracy.map(|a| a.mean()),
-            online_hit_rate: None,
-            online_false_alarms_per_min: None,
-            cached: prepared.cached,
-        };
+        let info = prepared.info(s);
         Ok((prepared.decoder, info))
     }
 

@@ -553,57 +553,8 @@ pub fn surface_csv(fit: &EpuckFit) -> String {
 /// accuracy with the paper's runs as reference lines.
 pub fn fit_plot(fit: &EpuckFit) -> FitPlot {
     let s = &fit.surface;
-    let best = s.total[s.estimate];
-    let rel = |v: f64| v - best;
-    // Each run's curve relative to its own maximum.
-    let mut ll_curves: Vec<Curve> = fit
-        .observations
-        .iter()
-        .enumerate()
-        .map(|(i, (name, ..))| {
-            let top = s.log_lik[i]
-                .iter()
-                .copied()
-                .fold(f64::NEG_INFINITY, f64::max);
-            Curve {
-                label: name.clone(),
-                points: (0..s.grid.len())
-                    .map(|j| {
-                        let sd = if s.mc_sd[i][j].is_finite() {
-                            s.mc_sd[i][j]
-                        } else {
-                            0.0
-                        };
-                        let v = s.log_lik[i][j] - top;
-                        CurvePoint {
-                            x: s.grid[j],
-                            y: v,
-                            lo: v - sd,
-                            hi: v + sd,
-                        }
-                    })
-                    .collect(),
-            }
-        })
-        .collect();
-    ll_curves.push(Curve {
-        label: "both runs".into(),
-        points: (0..s.grid.len())
-            .map(|j| {
-                let sd = if s.total_sd[j].is_finite() {
-                    s.total_sd[j]
-                } else {
-                    0.0
-                };
-                CurvePoint {
-                    x: s.grid[j],
-                    y: rel(s.total[j]),
-                    lo: rel(s.total[j] - sd),
-                    hi: rel(s.total[j] + sd),
-                }
-            })
-            .collect(),
-    });
+    let labels: Vec<String> = fit.observations.iter().map(|(n, ..)| n.clone()).collect();
+    let ll_curves = files::log_lik_curves(s, &labels, "both runs");
     let spread = |k: usize, pick: &dyn Fn(&RunStats) -> [f64; 3]| -> Vec<Curve> {
         let _ = k;
         fit.observations

@@ -5,7 +5,8 @@ use std::path::{Path, PathBuf};
 use errp_sim::{Result, SimError, write_atomic};
 use serde::Serialize;
 
-use crate::plot::{FitPlot, fit_png, fit_svg};
+use super::surface::Surface;
+use crate::plot::{Curve, CurvePoint, FitPlot, fit_png, fit_svg};
 
 /// The files a fit writes in its directory.
 pub const FIT_FILES: [&str; 4] = ["fit.json", "surface.csv", "fit.svg", "fit.png"];
@@ -74,4 +75,53 @@ pub(crate) fn check_out(out: &Path, ours: impl Fn(&Path) -> bool, what: &str) ->
         out.display(),
         foreign.join(", ")
     )))
+}
+
+/// The log-likelihood panel of a fit's figure: each observation's curve
+/// (labelled by `labels`) relative to its own maximum, and their sum
+/// (`total_label`) relative to the estimate's, each with +- its Monte Carlo
+/// sd (none where that is not finite).
+pub(crate) fn log_lik_curves(s: &Surface, labels: &[String], total_label: &str) -> Vec<Curve> {
+    let finite = |v: f64| if v.is_finite() { v } else { 0.0 };
+    let mut curves: Vec<Curve> = labels
+        .iter()
+        .enumerate()
+        .map(|(i, label)| {
+            let top = s.log_lik[i]
+                .iter()
+                .copied()
+                .fold(f64::NEG_INFINITY, f64::max);
+            Curve {
+                label: label.clone(),
+                points: (0..s.grid.len())
+                    .map(|j| {
+                        let sd = finite(s.mc_sd[i][j]);
+                        let v = s.log_lik[i][j] - top;
+                        CurvePoint {
+                            x: s.grid[j],
+                            y: v,
+                            lo: v - sd,
+                            hi: v + sd,
+                        }
+                    })
+                    .collect(),
+            }
+        })
+        .collect();
+    let best = s.total[s.estimate];
+    curves.push(Curve {
+        label: total_label.into(),
+        points: (0..s.grid.len())
+            .map(|j| {
+                let sd = finite(s.total_sd[j]);
+                CurvePoint {
+                    x: s.grid[j],
+                    y: s.total[j] - best,
+                    lo: (s.total[j] - sd) - best,
+                    hi: (s.total[j] + sd) - best,
+                }
+            })
+            .collect(),
+    });
+    curves
 }

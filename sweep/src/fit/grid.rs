@@ -32,7 +32,6 @@ use errp_sim::grid::{
     AssessmentDecoder, DecoderChoice, EegMode, FIXED_PAIRS, GridEpisodeResult, GridScenario,
     GridShared, GridTaskParams, PErrorChoice, free_pairs, prepare_grid_decoder, run_grid_episode,
 };
-use errp_sim::task::DecoderInfo;
 use errp_sim::{PAPER, Result, SimError, create_dir, mean_sd, pearson};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -409,20 +408,11 @@ pub fn run_grid_fit(
             let row = &rows[subject];
             let s = scenario(row.accuracy, seed, &row.subject, base);
             let prepared = prepare_grid_decoder(&s, &GridShared::default(), cache, |_| {})?;
-            let c = prepared.calibration.as_ref();
-            let info = DecoderInfo {
-                accuracy: row.accuracy,
-                kind: "lda".into(),
-                calibration_seed: seed,
-                errp_to_noise: c.map(|c| c.targeting.ratio),
-                cv_correct: c.map(|c| c.calibrated.accuracy.correct),
-                cv_error: c.map(|c| c.calibrated.accuracy.error),
-                cv_mean: c.map(|c| c.calibrated.accuracy.mean()),
-                online_hit_rate: None,
-                online_false_alarms_per_min: None,
-                cached: prepared.cached,
-            };
-            observer.decoder_ready(&info, done.fetch_add(1, Ordering::Relaxed) + 1, jobs.len());
+            observer.decoder_ready(
+                &prepared.info(&s),
+                done.fetch_add(1, Ordering::Relaxed) + 1,
+                jobs.len(),
+            );
             Ok(Some(Calibration {
                 subject,
                 goals,
@@ -516,12 +506,15 @@ fn groups_of(
         .collect()
 }
 
+/// The statistics of one subject on one goal set at a grid point; `groups`
+/// are its [`groups_of`].
 fn cell_stats(
     calibrations: &[Calibration],
     at_point: &[Vec<Vec<Run>>],
     subject: usize,
     row: &PaperRow,
     goals: GoalSet,
+    groups: &[SimRun],
 ) -> CellStats {
     let all: Vec<Run> = calibrations
         .iter()
@@ -529,7 +522,6 @@ fn cell_stats(
         .filter(|(c, _)| c.subject == subject && c.goals == goals)
         .flat_map(|(_, groups)| groups.iter().flatten().copied())
         .collect();
-    let groups = groups_of(calibrations, at_point, subject, goals);
     let means: Vec<f64> = groups
         .iter()
         .filter(|g| g.reached)
@@ -658,15 +650,16 @@ fn analyse(
         })
         .collect();
     let surface = Surface::new(spec.goal_rewards.clone(), log_lik, &replicates);
-    let stats = |rows: &[PaperRow], goals: GoalSet| -> Vec<Vec<CellStats>> {
+    let stats = |rows: &[PaperRow], goals: GoalSet, groups: &[Vec<Vec<SimRun>>]| {
         rows.iter()
             .enumerate()
             .map(|(s, row)| {
                 runs.iter()
-                    .map(|at| cell_stats(calibrations, at, s, row, goals))
+                    .zip(&groups[s])
+                    .map(|(at, g)| cell_stats(calibrations, at, s, row, goals, g))
                     .collect()
             })
-            .collect()
+            .collect::<Vec<Vec<CellStats>>>()
     };
     let tables = |goals: GoalSet| -> Vec<TableStats> {
         runs.iter()
@@ -692,8 +685,8 @@ fn analyse(
         interval_95: surface.interval,
         interval_at_edge: surface.interval_at_edge,
         mc_interval_90: surface.mc_interval,
-        fixed_stats: stats(fixed, GoalSet::Fixed),
-        free_stats: stats(free, GoalSet::Free),
+        fixed_stats: stats(fixed, GoalSet::Fixed, &fixed_groups),
+        free_stats: stats(free, GoalSet::Free, &free_groups),
         fixed_tables,
         free_tables,
         p_all_reached,
@@ -790,49 +783,8 @@ pub fn grid_surface_csv(fit: &GridFit) -> String {
 /// reference lines.
 pub fn grid_fit_plot(fit: &GridFit) -> FitPlot {
     let s = &fit.surface;
-    let best = s.total[s.estimate];
-    let finite = |v: f64| if v.is_finite() { v } else { 0.0 };
-    let mut ll: Vec<Curve> = fit
-        .fixed
-        .iter()
-        .enumerate()
-        .map(|(i, row)| {
-            let top = s.log_lik[i]
-                .iter()
-                .copied()
-                .fold(f64::NEG_INFINITY, f64::max);
-            Curve {
-                label: row.subject.clone(),
-                points: (0..s.grid.len())
-                    .map(|j| {
-                        let v = s.log_lik[i][j] - top;
-                        let sd = finite(s.mc_sd[i][j]);
-                        CurvePoint {
-                            x: s.grid[j],
-                            y: v,
-                            lo: v - sd,
-                            hi: v + sd,
-                        }
-                    })
-                    .collect(),
-            }
-        })
-        .collect();
-    ll.push(Curve {
-        label: "all four".into(),
-        points: (0..s.grid.len())
-            .map(|j| {
-                let v = s.total[j] - best;
-                let sd = finite(s.total_sd[j]);
-                CurvePoint {
-                    x: s.grid[j],
-                    y: v,
-                    lo: v - sd,
-                    hi: v + sd,
-                }
-            })
-            .collect(),
-    });
+    let labels: Vec<String> = fit.fixed.iter().map(|r| r.subject.clone()).collect();
+    let ll = files::log_lik_curves(s, &labels, "all four");
     let actions =
         |rows: &[PaperRow], stats: &[Vec<CellStats>]| -> (Vec<Curve>, Vec<(String, f64, usize)>) {
             let curves = rows
