@@ -23,6 +23,16 @@ fn provenance() -> Provenance {
     }
 }
 
+/// A JSON array of numbers from a fit file; null (how JSON writes a
+/// log-likelihood of minus infinity) reads as minus infinity.
+fn numbers(v: &serde_json::Value) -> Vec<f64> {
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap_or(f64::NEG_INFINITY))
+        .collect()
+}
+
 fn scenario_accuracy(file: &str) -> f64 {
     let text = std::fs::read_to_string(repo(file)).unwrap();
     let table: toml::Table = toml::from_str(&text).unwrap();
@@ -53,18 +63,9 @@ fn the_shipped_e_puck_decoder_is_the_committed_fit() {
     assert_eq!(fit["spec"]["calibrations"], 5);
     assert_eq!(fit["spec"]["runs"], 100);
     // The grid's maximum is the estimate.
-    let total: Vec<f64> = fit["surface"]["total"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap_or(f64::NEG_INFINITY))
-        .collect();
-    let grid: Vec<f64> = fit["surface"]["grid"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap())
-        .collect();
+    let total = numbers(&fit["surface"]["total"]);
+    let grid = numbers(&fit["surface"]["grid"]);
+    assert!(grid.iter().all(|g| g.is_finite()), "{grid:?}");
     let best = errp_sweep::fit::argmax(&total);
     assert_eq!(grid[best], estimate);
     // Every shipped scenario with the paper's decoder uses it.
@@ -300,31 +301,14 @@ fn the_shipped_grid_q_scale_is_the_committed_fit() {
     assert_eq!(fit["spec"]["calibrations"], 5);
     assert_eq!(fit["spec"]["repeats"], 40);
     assert_eq!(fit["spec"]["epsilon"], 0.1);
-    let numbers = |key: &str| -> Vec<f64> {
-        fit[key]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|v| v.as_f64().unwrap_or(f64::NEG_INFINITY))
-            .collect()
-    };
-    let total: Vec<f64> = fit["surface"]["total"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap_or(f64::NEG_INFINITY))
-        .collect();
-    let grid: Vec<f64> = fit["surface"]["grid"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap())
-        .collect();
+    let total = numbers(&fit["surface"]["total"]);
+    let grid = numbers(&fit["surface"]["grid"]);
+    assert!(grid.iter().all(|g| g.is_finite()), "{grid:?}");
     let estimate = fit["estimate"].as_f64().unwrap();
     assert_eq!(grid[errp_sweep::fit::argmax(&total)], estimate);
     // The shipped scale: the largest likelihood where the paper's 40/40 is
     // not rejected.
-    let p_all = numbers("p_all_reached");
+    let p_all = numbers(&fit["p_all_reached"]);
     let kept: Vec<usize> = (0..grid.len())
         .filter(|&j| p_all[j] >= errp_sweep::fit::REACHED_LEVEL)
         .collect();
