@@ -109,13 +109,13 @@ for host in node-a node-b; do
 done
 wait
 grep -h "Prepared" "$work"/node-*.log >&2
-entries=$(find "$cache" -name 'grid-*.json' | wc -l)
+entries=$(find "$cache" -name 'grid-lda-online-*.json' | wc -l)
 partials=$(find "$cache" -name '.*partial*' | wc -l)
 [ "$entries" = 2 ] && [ "$partials" = 0 ] || { say "cache: $entries entries, $partials partials"; exit 1; }
 python3 -c 'import json, sys
 for p in sys.argv[1:]:
     e = json.load(open(p))
-    assert e["request"].startswith("grid-lda v1 ") and e["result"]["ratio"] > 0, p' "$cache"/grid-*.json
+    assert e["request"].startswith("grid-lda-online v1 ") and e["result"]["ratio"] > 0, p' "$cache"/grid-lda-online-*.json
 "$errp" sweep --task grid --accuracy 0.7,0.8 --seed 9 --prepare-only --cache "$cache" \
   | grep -q "(0 searched now, 2 already cached)"
 say "two hosts, one pid: both prepared, 2 whole entries, read back as cache hits"
