@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Hostile-but-fair use of the `errp` program, case after case.
 
-Usage: fuzz_cli.py ERRP [--seconds N] [--seed S] [--memory-gib G] [--list]
+Usage: fuzz_cli.py ERRP [--seconds N] [--seed S] [--memory-gib G] [--only FAMILY] [--list]
 
 Cases are made by a structured generator: every shipped scenario with one
 field (any it has or could have) set to an edge value of every TOML type,
@@ -19,6 +19,17 @@ Grid scenarios run with the oracle decoder and e-puck scenarios with
 `--runs 1`, so that a valid case takes seconds. Cases run in a shuffled
 order (seeded) until --seconds have passed (default: all of them); the
 counts are printed at the end and any failure makes the exit code 1.
+
+A second family (`hostile_cases`, about 200) changes the program's
+surroundings instead of its input: standard output or error closed early
+(`| head -1`) or on a full disk (`/dev/full`); FIFOs, sockets, devices
+and directories where a regular file belongs (scenarios, outputs, a
+sweep's files, cache entries); sweep metadata, rows, locks and cache
+entries edited or damaged; outputs that cannot be written; signals at
+seeded random moments followed by a resume. Each must also end without a
+panic or a hang, leave no temporary or lock, and leave what it did not
+write as it was; some check more (a closed pipe exits 0 with the files
+written; an edited cache entry is searched again and restored).
 """
 
 import argparse
@@ -33,6 +44,8 @@ import tempfile
 import time
 import tomllib
 from pathlib import Path
+
+from fuzz_hostile import build_base, hostile_cases, run_case, signal_cases
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENARIOS = sorted((ROOT / "scenarios").glob("*.toml"))
@@ -226,33 +239,50 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--memory-gib", type=int, default=4)
     ap.add_argument("--list", action="store_true")
+    ap.add_argument("--only", choices=["input", "hostile", "signal"],
+                    help="run one family of cases")
     a = ap.parse_args()
     errp = str(Path(a.errp).resolve())
-    cases = [(label, text, args) for label, text, args in scenario_cases()]
-    cases += [(" ".join(f), None, f) for f in FLAG_CASES]
+    cases = [("input", label, text, args) for label, text, args in scenario_cases()]
+    cases += [("input", " ".join(f), None, f) for f in FLAG_CASES]
+    cases += [("hostile", c.label, None, c) for c in hostile_cases()]
+    cases += [("signal", c.label, at, c) for at, c in signal_cases(20, a.seed)]
     random.Random(a.seed).shuffle(cases)
     if a.list:
-        for label, _, args in cases:
-            print(label, "|", " ".join(args))
+        for kind, label, _, args in cases:
+            print(kind, "|", label, "|", " ".join(args) if kind == "input" else args.command())
         return
     grid_file = ROOT / "scenarios" / "grid_fixed_goals.toml"
     epuck_file = ROOT / "scenarios" / "mexico_to_pisa.toml"
+    if a.only:
+        cases = [c for c in cases if c[0] == a.only]
     started = time.monotonic()
-    ran, ran_ok, refused, failures = 0, 0, 0, []
-    for label, text, args in cases:
+    ran, ran_ok, refused, stopped, failures = 0, 0, 0, 0, []
+    base_dir = tempfile.mkdtemp(prefix="errp-fuzz-base-")
+    base = None
+    for kind, label, text, args in cases:
         if time.monotonic() - started > a.seconds:
             break
-        code, failure = check(errp, label, text, args, a.memory_gib, grid_file, epuck_file)
+        if kind == "input":
+            code, failure = check(errp, label, text, args, a.memory_gib, grid_file, epuck_file)
+        else:
+            if base is None:
+                base = build_base(errp, base_dir)
+            failure, code = run_case(errp, base, args, a.memory_gib, limit_memory,
+                                     signal_at=text if kind == "signal" else None)
         ran += 1
         ran_ok += code == 0
         refused += code == 2
+        stopped += code == 130
         if failure:
             failures.append(failure)
             print("FAIL", failure, file=sys.stderr, flush=True)
+    shutil.rmtree(base_dir, ignore_errors=True)
     for f in failures:
         print(f, file=sys.stderr)
     print(f"fuzz_cli: {ran} of {len(cases)} cases in {time.monotonic() - started:.0f} s: "
-          f"{ran_ok} ran (exit 0), {refused} refused (exit 2), {len(failures)} failed "
+          f"{ran_ok} ran (exit 0), {refused} refused (exit 2), {stopped} stopped by a signal "
+          f"(exit 130), {len(failures)} failed "
           f"(seed {a.seed}, address space {a.memory_gib} GiB)")
     sys.exit(1 if failures else 0)
 

@@ -8,6 +8,8 @@ use clap::ValueEnum;
 use errp_bci::{MeanAccuracy, TargetingStep};
 use errp_sim::grid::EegMode;
 
+use crate::out::errln;
+
 #[derive(Clone, Copy, ValueEnum)]
 pub(crate) enum Goals {
     /// The five goals shared by all subjects.
@@ -26,9 +28,10 @@ pub(crate) struct CalibrateArgs {
     /// Take the accuracy of a subject of Table 1 (S1..S4) instead.
     #[arg(long)]
     pub(crate) subject: Option<String>,
-    /// Which of the subject's accuracies: fixed or free goals.
-    #[arg(long, value_enum, default_value = "fixed", requires = "subject")]
-    pub(crate) goals: Goals,
+    /// Which of the subject's accuracies: fixed or free goals (with
+    /// --subject only). [default: fixed]
+    #[arg(long, value_enum, requires = "subject")]
+    pub(crate) goals: Option<Goals>,
     /// Seed of the synthetic user and session.
     #[arg(long, default_value_t = 1, value_parser = parse_seed, allow_negative_numbers = true)]
     pub(crate) seed: u64,
@@ -173,7 +176,7 @@ pub(crate) fn check_extension(path: &Path, ext: &str, flag: &str) -> Result<()> 
 pub(crate) fn calibration_progress(quiet: bool) -> impl FnMut(&TargetingStep) {
     move |s| {
         if !quiet {
-            eprintln!(
+            errln!(
                 "  calibrating: ErrP-to-noise {:.4} -> mean {:.2} %",
                 s.ratio,
                 100.0 * s.accuracy.mean()

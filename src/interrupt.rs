@@ -10,6 +10,8 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
+use crate::out::errln;
+
 /// Set by the first signal while a sweep writes episodes.
 pub(crate) static CANCEL: AtomicBool = AtomicBool::new(false);
 
@@ -25,7 +27,7 @@ pub(crate) fn install() {
     // the process ends, and the next run removes what it left.
     let _ = ctrlc::set_handler(|| {
         if GRACEFUL.load(Ordering::SeqCst) && !CANCEL.swap(true, Ordering::SeqCst) {
-            eprintln!(
+            errln!(
                 "\nStopping after the episodes in progress (every row on disk is kept; signal \
                  again to stop at once)"
             );
@@ -33,9 +35,9 @@ pub(crate) fn install() {
         }
         let removed = errp_sim::remove_unfinished();
         if removed > 0 {
-            eprintln!("\nInterrupted: removed {removed} unfinished file(s)");
+            errln!("\nInterrupted: removed {removed} unfinished file(s)");
         } else {
-            eprintln!("\nInterrupted");
+            errln!("\nInterrupted");
         }
         std::process::exit(i32::from(EXIT_INTERRUPTED));
     });

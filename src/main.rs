@@ -5,6 +5,7 @@
 mod cli;
 mod commands;
 mod interrupt;
+mod out;
 mod save;
 
 use std::process::ExitCode;
@@ -13,6 +14,7 @@ use clap::{Parser, Subcommand};
 
 use crate::cli::{CalibrateArgs, RunArgs, Table1Args};
 use crate::commands::{calibrate, fit, run, sweep, table1};
+use crate::out::errln;
 
 /// Simulated shared control of a robot from EEG error potentials.
 #[derive(Parser)]
@@ -63,10 +65,7 @@ fn main() -> ExitCode {
         Command::Calibrate(args) => calibrate::calibrate(&args),
         Command::Run(args) => run::run(&args),
         Command::Table1(args) => table1::table1(&args),
-        Command::Subjects => {
-            calibrate::print_subjects();
-            Ok(())
-        }
+        Command::Subjects => calibrate::print_subjects(),
         Command::Merge(args) => sweep::merge(&args),
         Command::Fit(cmd) => match fit::fit(&cmd) {
             Ok(true) => Ok(()),
@@ -79,10 +78,12 @@ fn main() -> ExitCode {
             Err(e) => Err(e),
         },
     };
-    match result {
+    // What standard output still buffers must reach it, or the command
+    // fails (a full disk), as for every line before.
+    match result.and_then(|()| out::flush()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", error_text(&e));
+            errln!("error: {}", error_text(&e));
             ExitCode::from(2)
         }
     }

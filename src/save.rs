@@ -7,6 +7,8 @@ use std::path::Path;
 use anyhow::{Result, bail};
 
 use crate::cli::check_extension;
+#[cfg(feature = "rerun")]
+use crate::out::outln;
 
 /// Checks `--save` before any work: the file name, and that this build can
 /// record at all.
@@ -15,6 +17,7 @@ pub(crate) fn check_save(save: Option<&Path>) -> Result<()> {
         return Ok(());
     };
     check_extension(path, "rrd", "--save")?;
+    check_ours(path, b"RRF2", "a Rerun recording", "--save")?;
     if !cfg!(feature = "rerun") {
         bail!(
             "--save {}: this errp was built without Rerun (cargo's --no-default-features); \
@@ -27,10 +30,38 @@ pub(crate) fn check_save(save: Option<&Path>) -> Result<()> {
 
 /// Prints where a recording went.
 #[cfg(feature = "rerun")]
-pub(crate) fn wrote(path: &Path) {
-    println!(
+pub(crate) fn wrote(path: &Path) -> Result<()> {
+    outln!(
         "Wrote {} (open with: rerun {})",
         path.display(),
         path.display()
-    );
+    )?;
+    Ok(())
+}
+
+/// Refuses to replace an existing `path` that this program did not write:
+/// one that is not empty and does not begin with `magic` (the format's
+/// signature). A special file is left to the writer, which refuses it.
+pub(crate) fn check_ours(path: &Path, magic: &[u8], what: &str, flag: &str) -> Result<()> {
+    use std::io::Read;
+    let Ok(file) = errp_sim::open_regular(path) else {
+        return Ok(());
+    };
+    let mut head = Vec::with_capacity(magic.len());
+    if file
+        .take(magic.len() as u64)
+        .read_to_end(&mut head)
+        .is_err()
+        || head.is_empty()
+    {
+        return Ok(());
+    }
+    if head != magic {
+        bail!(
+            "{flag} {}: the file exists and is not {what}; errp replaces only files it wrote: \
+             move it away or give another name",
+            path.display()
+        );
+    }
+    Ok(())
 }

@@ -81,6 +81,6 @@ pub use subjects::{GoalSet, Subject, subject, subjects};
 pub use svm::{SvmDecoder, SvmModel};
 pub use targeting::{
     MeanAccuracy, SessionParts, TargetingParams, TargetingResult, TargetingStep,
-    inverse_normal_cdf, search_ratio, target_accuracy, target_accuracy_on,
+    inverse_normal_cdf, ratio_text, search_ratio, target_accuracy, target_accuracy_on,
     target_continuous_accuracy,
 };

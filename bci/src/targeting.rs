@@ -57,6 +57,55 @@ pub struct TargetingResult {
     pub steps: Vec<TargetingStep>,
 }
 
+/// An ErrP-to-noise ratio as a message shows it: in full, or in
+/// scientific notation when it is far from 1 (a damaged 1e308 is not 309
+/// digits).
+pub fn ratio_text(ratio: f64) -> String {
+    if ratio != 0.0 && !(1e-4..1e4).contains(&ratio.abs()) {
+        format!("{ratio:e}")
+    } else {
+        ratio.to_string()
+    }
+}
+
+impl TargetingResult {
+    /// Why this result (read back from a cache, say) cannot be the one
+    /// its search found, given `recomputed`, the accuracy its ratio gives
+    /// when evaluated again: `None` if it can.
+    ///
+    /// The ratio must be a positive finite number; the accuracy it gives
+    /// must be the one the result records, within `search.tolerance`; and
+    /// it must be within that tolerance of the request, unless the search
+    /// used every evaluation it had (it then returns its closest).
+    pub fn inconsistency(&self, recomputed: Accuracy, search: &TargetingParams) -> Option<String> {
+        let (got, kept) = (recomputed.mean(), self.accuracy.mean());
+        if !(self.ratio.is_finite() && self.ratio > 0.0) {
+            return Some(format!(
+                "its ErrP-to-noise ratio {} is not a positive number",
+                ratio_text(self.ratio)
+            ));
+        }
+        if !(got - kept).abs().le(&search.tolerance) {
+            return Some(format!(
+                "its ratio {} gives {:.2} % again, not the {:.2} % it records",
+                ratio_text(self.ratio),
+                100.0 * got,
+                100.0 * kept
+            ));
+        }
+        let exhausted = self.steps.len() >= search.max_evaluations;
+        if !(got - self.requested).abs().le(&search.tolerance) && !exhausted {
+            return Some(format!(
+                "its ratio {} gives {:.2} %, not the {:.2} % requested",
+                ratio_text(self.ratio),
+                100.0 * got,
+                100.0 * self.requested
+            ));
+        }
+        None
+    }
+}
+
 /// A requested mean accuracy (the mean of the correct- and error-class
 /// rates), checked once where it enters: strictly between chance (0.5) and
 /// perfect (1), the range a real decoder can be targeted at. Every function

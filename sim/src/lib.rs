@@ -22,6 +22,7 @@
 pub mod calibration;
 pub mod epuck;
 mod error;
+mod files;
 pub mod grid;
 pub mod host;
 mod output;
@@ -36,9 +37,10 @@ mod stats;
 pub mod task;
 
 pub use error::{Result, SimError};
+pub use files::{append_regular, open_regular, open_regular_with, write_regular};
 pub use output::{
-    PendingFile, create_dir, forget_if_interrupted, remove_if_interrupted, remove_unfinished,
-    write_atomic,
+    CreatedDirs, PendingFile, create_dir, create_dirs, forget_if_interrupted,
+    remove_if_interrupted, remove_unfinished, write_atomic,
 };
 pub use paper::{PAPER, PAPER_EPUCK, PAPER_POOLED};
 pub use scenario::{

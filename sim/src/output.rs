@@ -53,6 +53,83 @@ pub fn remove_unfinished() -> usize {
     n
 }
 
+/// Directories made by [`create_dirs`], outermost first: what to remove
+/// to leave the file system as it was.
+#[derive(Debug, Default)]
+pub struct CreatedDirs(Vec<PathBuf>);
+
+impl CreatedDirs {
+    /// True if the directory existed already.
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+
+    /// Has [`remove_unfinished`] remove them (each only if empty by then).
+    pub fn remove_if_interrupted(&self) {
+        for d in &self.0 {
+            remove_if_interrupted(d);
+        }
+    }
+
+    /// Takes them off [`remove_unfinished`]'s list.
+    pub fn forget_if_interrupted(&self) {
+        for d in &self.0 {
+            forget_if_interrupted(d);
+        }
+    }
+
+    /// Removes them, and what the innermost holds: the work failed.
+    pub fn remove(&self) {
+        if let Some(inner) = self.0.last() {
+            let _ = std::fs::remove_dir_all(inner);
+        }
+        for d in self.0.iter().rev().skip(1) {
+            let _ = std::fs::remove_dir(d);
+        }
+        self.forget_if_interrupted();
+    }
+}
+
+/// Creates directory `dir` and its missing parents, and returns those it
+/// made (none if `dir` existed), so that a run that fails or is
+/// interrupted can remove every one of them.
+pub fn create_dirs(dir: &Path) -> Result<CreatedDirs> {
+    let fail = |source| SimError::Output {
+        path: dir.to_path_buf(),
+        source,
+    };
+    let mut missing = Vec::new();
+    let mut at = Some(dir);
+    while let Some(d) = at.filter(|d| !d.as_os_str().is_empty()) {
+        match std::fs::symlink_metadata(d) {
+            Ok(_) => break,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => missing.push(d.to_path_buf()),
+            Err(e) => return Err(fail(e)),
+        }
+        at = d.parent();
+    }
+    missing.reverse();
+    let mut made = CreatedDirs::default();
+    for d in missing {
+        match std::fs::create_dir(&d) {
+            Ok(()) => made.0.push(d),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && d.is_dir() => {}
+            Err(e) => {
+                made.remove();
+                return Err(fail(e));
+            }
+        }
+    }
+    if !dir.is_dir() {
+        made.remove();
+        return Err(fail(std::io::Error::new(
+            std::io::ErrorKind::NotADirectory,
+            "it exists and is not a directory",
+        )));
+    }
+    Ok(made)
+}
+
 /// Creates directory `dir` and its parents (an existing one is fine).
 pub fn create_dir(dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(|source| SimError::Output {
@@ -61,9 +138,22 @@ pub fn create_dir(dir: &Path) -> Result<()> {
     })
 }
 
-/// The prefix of the temporaries of `name`: `.NAME.partial-`.
-fn partial_prefix(name: &std::ffi::OsStr) -> String {
-    format!(".{}.partial-", name.to_string_lossy())
+/// The longest file name most file systems take (NAME_MAX), in bytes.
+const NAME_MAX: usize = 255;
+
+/// The temporary's name for `name`: `.NAME.partial-HOST-PID-RANDOM`, with
+/// NAME shortened (at a character boundary) so that the whole fits in
+/// [`NAME_MAX`] bytes whenever it can: a destination whose own name is
+/// near that limit can still be written.
+fn partial_name(name: &std::ffi::OsStr, host: &str, random: u64) -> String {
+    let tail = format!(".partial-{host}-{}-{random:016x}", std::process::id());
+    let name = name.to_string_lossy();
+    let room = NAME_MAX.saturating_sub(1 + tail.len());
+    let cut = (0..=room.min(name.len()))
+        .rev()
+        .find(|&i| name.is_char_boundary(i))
+        .unwrap_or(0);
+    format!(".{}{tail}", &name[..cut])
 }
 
 /// Removes the temporaries in `dest`'s directory (of any file) left by
@@ -108,46 +198,79 @@ fn remove_stale_partials(dest: &Path) {
 /// is renamed into place by [`PendingFile::commit`]; dropped uncommitted (an
 /// error, a panic, Ctrl-C unwinding), the temporary is removed, so a failed
 /// run never leaves a partial file behind.
+///
+/// A destination that is a symbolic link is written through: the file it
+/// points to is replaced and the link stays.
 #[derive(Debug)]
 pub struct PendingFile {
+    /// The path as given (for messages).
     dest: PathBuf,
+    /// Where the file goes: `dest`, or the file its link points to.
+    target: PathBuf,
     temp: PathBuf,
     committed: bool,
 }
 
+/// The file `dest` names, through a symbolic link (resolved in full) if
+/// it is one; a link to nothing is an error.
+fn link_target(dest: &Path) -> std::io::Result<PathBuf> {
+    match std::fs::symlink_metadata(dest) {
+        Ok(m) if m.file_type().is_symlink() => std::fs::canonicalize(dest).map_err(|e| {
+            std::io::Error::new(
+                e.kind(),
+                format!("it is a symbolic link to a file that cannot be reached ({e})"),
+            )
+        }),
+        _ => Ok(dest.to_path_buf()),
+    }
+}
+
+/// Checks that the existing `target` may be replaced by this process
+/// before any work: a regular file it can write (not a directory, FIFO or
+/// device, not read-only, immutable or another user's in a sticky
+/// directory).
+fn check_replaceable(target: &Path) -> std::io::Result<()> {
+    match std::fs::symlink_metadata(target) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(e),
+        Ok(m) if m.is_dir() => Err(std::io::Error::new(
+            std::io::ErrorKind::IsADirectory,
+            "the path is a directory",
+        )),
+        Ok(_) => crate::files::write_regular(target).map(drop),
+    }
+}
+
 impl PendingFile {
-    /// Reserves `dest`: creates the temporary file now, so that an unwritable
-    /// destination is reported before any long computation. Temporaries in
-    /// `dest`'s directory left by dead processes of this host are removed
-    /// first.
+    /// Reserves `dest`: creates the temporary file now, and checks that an
+    /// existing `dest` can be replaced, so that an unwritable destination
+    /// is reported before any long computation. Temporaries in `dest`'s
+    /// directory left by dead processes of this host are removed first.
     pub fn create(dest: impl AsRef<Path>) -> Result<(Self, File)> {
-        let dest = dest.as_ref().to_path_buf();
+        let given = dest.as_ref().to_path_buf();
         let fail = |source| SimError::Output {
-            path: dest.clone(),
+            path: given.clone(),
             source,
         };
+        if given.as_os_str().as_encoded_bytes().ends_with(b"/") {
+            return Err(fail(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "the path ends in /, so it names a directory, not a file",
+            )));
+        }
+        let dest = link_target(&given).map_err(fail)?;
         let name = dest.file_name().ok_or_else(|| {
             fail(std::io::Error::new(
                 std::io::ErrorKind::InvalidInput,
                 "the path names a directory, not a file",
             ))
         })?;
-        if dest.is_dir() {
-            return Err(fail(std::io::Error::new(
-                std::io::ErrorKind::IsADirectory,
-                "the path is a directory",
-            )));
-        }
+        check_replaceable(&dest).map_err(fail)?;
         remove_stale_partials(&dest);
-        let prefix = format!(
-            "{}{}-{}",
-            partial_prefix(name),
-            host_name(),
-            std::process::id()
-        );
+        let host = host_name();
         let mut tries = 0;
         let (temp, file) = loop {
-            let temp = dest.with_file_name(format!("{prefix}-{:016x}", random_suffix()));
+            let temp = dest.with_file_name(partial_name(name, &host, random_suffix()));
             match File::options().write(true).create_new(true).open(&temp) {
                 Ok(file) => break (temp, file),
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && tries < 8 => {
@@ -159,7 +282,8 @@ impl PendingFile {
         remove_if_interrupted(&temp);
         Ok((
             Self {
-                dest,
+                dest: given,
+                target: dest,
                 temp,
                 committed: false,
             },
@@ -179,7 +303,7 @@ impl PendingFile {
 
     /// Moves the finished file into place.
     pub fn commit(mut self) -> Result<PathBuf> {
-        std::fs::rename(&self.temp, &self.dest).map_err(|source| SimError::Output {
+        std::fs::rename(&self.temp, &self.target).map_err(|source| SimError::Output {
             path: self.dest.clone(),
             source,
         })?;
@@ -216,6 +340,30 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
 mod tests {
     use super::*;
     use std::io::Write;
+
+    /// A destination whose name is 255 bytes long can be written: its
+    /// temporary's name is shortened to fit (it was ~35 bytes over).
+    #[test]
+    fn a_name_at_the_file_system_limit_is_written() {
+        let dir = std::env::temp_dir().join(format!("errp-name-max-{:x}", random_suffix()));
+        create_dir(&dir).unwrap();
+        for name in ["x".repeat(255), format!("{}.rrd", "é".repeat(125))] {
+            let dest = dir.join(&name);
+            write_atomic(&dest, b"whole").unwrap();
+            assert_eq!(
+                std::fs::read(&dest).unwrap(),
+                b"whole",
+                "{} bytes",
+                name.len()
+            );
+            let temp = partial_name(std::ffi::OsStr::new(&name), &host_name(), 7);
+            assert!(
+                temp.len() <= NAME_MAX && temp.contains(".partial-"),
+                "{temp}"
+            );
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn committed_files_appear_and_dropped_ones_vanish() {

@@ -115,10 +115,9 @@ impl RrdFile {
     /// Flushes everything to disk and renames the file into place.
     pub fn finish(self) -> Result<std::path::PathBuf> {
         let path = self.pending.path().to_path_buf();
-        self.stream.flush_blocking().map_err(|e| SimError::Record {
-            path: path.clone(),
-            message: e.to_string(),
-        })?;
+        self.stream
+            .flush_blocking()
+            .map_err(|e| recording_failed(&path, e.to_string()))?;
         self.stream.disconnect();
         drop(self.stream);
         self.pending.commit()
@@ -149,8 +148,35 @@ pub(crate) fn log_decoder_series(
 
 /// Maps a Rerun SDK error to a [`SimError`] about `path`.
 pub(crate) fn record_error(path: &Path) -> impl Fn(rerun::RecordingStreamError) -> SimError + '_ {
-    move |e| SimError::Record {
+    move |e| recording_failed(path, e.to_string())
+}
+
+/// The error of a recording to `path` that failed with the SDK's
+/// `message`. The SDK's file writer says that it stopped ("File-writer
+/// thread shut down prematurely"), not why: a probe written beside the
+/// file finds the usual cause (a full disk, a quota), which leads.
+fn recording_failed(path: &Path, message: String) -> SimError {
+    let message = match probe_space(path) {
+        Err(e) => format!("{e} (the Rerun SDK: {message})"),
+        Ok(()) => message,
+    };
+    SimError::Record {
         path: path.to_path_buf(),
-        message: e.to_string(),
+        message,
     }
+}
+
+/// Writes and syncs 1 MiB beside `path`, then removes it.
+fn probe_space(path: &Path) -> std::io::Result<()> {
+    use std::io::Write;
+    let probe = path.with_file_name(".errp-space-probe");
+    let (pending, mut file) = PendingFile::create(&probe).map_err(|e| match e {
+        SimError::Output { source, .. } => source,
+        other => std::io::Error::other(other.to_string()),
+    })?;
+    let result = file
+        .write_all(&vec![0u8; 1 << 20])
+        .and_then(|()| file.sync_all());
+    drop(pending);
+    result
 }

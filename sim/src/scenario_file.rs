@@ -23,10 +23,7 @@ pub fn read_scenario(path: &Path) -> Result<String> {
     let cannot = |e: &dyn std::fmt::Display| {
         SimError::Scenario(format!("{}: cannot read the scenario: {e}", path.display()))
     };
-    let file = std::fs::File::open(path).map_err(|e| cannot(&e))?;
-    if file.metadata().is_ok_and(|m| m.is_dir()) {
-        return Err(cannot(&"it is a directory, not a TOML file"));
-    }
+    let file = crate::files::open_regular(path).map_err(|e| cannot(&e))?;
     let mut bytes = Vec::new();
     file.take(MAX_SCENARIO_BYTES + 1)
         .read_to_end(&mut bytes)
@@ -111,7 +108,19 @@ fn toml_error(path: &Path, text: Option<&str>, e: &toml::de::Error) -> SimError 
         return SimError::Scenario(format!("{at}: missing field `{}`", within(name)));
     }
     let key = key.unwrap_or("?");
+    // toml hands a date-time to serde as a table: say what it is.
+    let written = text
+        .zip(e.span())
+        .and_then(|(t, s)| t.get(s))
+        .map(str::trim)
+        .filter(|v| v.parse::<toml::value::Datetime>().is_ok());
     match value_and_expected(&message) {
+        Some((value, expected)) if value == "a table" && written.is_some() => {
+            SimError::Scenario(format!(
+                "{at}: field `{key}` = {} (a date-time) is invalid: expected {expected}",
+                written.unwrap_or_default()
+            ))
+        }
         Some((value, expected)) => SimError::Scenario(format!(
             "{at}: field `{key}` = {value} is invalid: expected {expected}"
         )),

@@ -1,18 +1,27 @@
 //! `errp calibrate` and `errp subjects`.
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use errp_bci::{EdfWriter, GoalSet, MeanAccuracy, SessionOptions, subject, subjects};
 use errp_sim::PendingFile;
 use errp_sim::calibration::{CalibrationRequest, run_calibration};
 
 use crate::cli::{CalibrateArgs, Goals, check_extension};
+use crate::out::{errln, outln};
 use crate::save::check_save;
 
 pub(crate) fn calibrate(args: &CalibrateArgs) -> Result<()> {
+    // (clap lets `requires` pass when the required flag conflicts with one
+    // given, as --subject does with --accuracy.)
+    if let (Some(_), None) = (args.goals, &args.subject) {
+        bail!(
+            "--goals chooses which of a --subject's accuracies to target; without --subject \
+             it does nothing: give --subject S1..S4, or leave --goals out"
+        );
+    }
     let (accuracy, who) = match &args.subject {
         Some(name) => {
             let s = subject(name).context("--subject")?;
-            let goals = match args.goals {
+            let goals = match args.goals.unwrap_or(Goals::Fixed) {
                 Goals::Fixed => GoalSet::Fixed,
                 Goals::Free => GoalSet::Free,
             };
@@ -30,6 +39,8 @@ pub(crate) fn calibrate(args: &CalibrateArgs) -> Result<()> {
     check_save(args.save.as_deref())?;
     if let Some(p) = &args.export {
         check_extension(p, "edf", "--export")?;
+        // An EDF file's header begins with its version, "0" and 7 spaces.
+        crate::save::check_ours(p, b"0       ", "an EDF file", "--export")?;
     }
     // Reserve the outputs first: an unwritable path fails before the work.
     let mut edf = match &args.export {
@@ -49,7 +60,7 @@ pub(crate) fn calibrate(args: &CalibrateArgs) -> Result<()> {
 
     let request = CalibrationRequest::new(accuracy, args.seed);
     if !args.quiet {
-        eprintln!(
+        errln!(
             "Targeting a mean accuracy of {:.2} % ({who}), seed {}:",
             100.0 * accuracy.get(),
             args.seed
@@ -58,7 +69,7 @@ pub(crate) fn calibrate(args: &CalibrateArgs) -> Result<()> {
     let quiet = args.quiet;
     let progress = |s: &errp_bci::TargetingStep| {
         if !quiet {
-            eprintln!(
+            errln!(
                 "  ErrP-to-noise {:.4}: correct {:.2} %, error {:.2} %, mean {:.2} %",
                 s.ratio,
                 100.0 * s.accuracy.correct,
@@ -67,9 +78,14 @@ pub(crate) fn calibrate(args: &CalibrateArgs) -> Result<()> {
             );
         }
     };
+    // A failure to write the export stops the session, and is the
+    // export's (naming --export), not the calibration's.
+    let mut export_failed = None;
     let mut sink = |block: &errp_bci::EegBlock, events: &[errp_bci::Assessment]| match edf.as_mut()
     {
-        Some((_, w)) => w.write(block, events),
+        Some((_, w)) => w
+            .write(block, events)
+            .inspect_err(|e| export_failed = Some(e.to_string())),
         None => Ok(()),
     };
     // Grand averages for the recording, the raw session for the export.
@@ -82,56 +98,66 @@ pub(crate) fn calibrate(args: &CalibrateArgs) -> Result<()> {
         },
         ..SessionOptions::default()
     };
-    let report = run_calibration(&request, progress, options).context("calibration failed")?;
+    let report = run_calibration(&request, progress, options);
+    if let (Some(e), Some(p)) = (export_failed, &args.export) {
+        bail!("--export: cannot write {}: {e}", p.display());
+    }
+    let report = report.context("calibration failed")?;
 
     let a = &report.calibrated.accuracy;
     let m = &report.calibrated.model;
-    println!(
+    outln!(
         "Calibration session: {} actions ({} error, {} correct), {}-fold cross-validation",
         a.n_correct + a.n_error,
         a.n_error,
         a.n_correct,
         request.setup.calibration.folds
-    );
-    println!("  correct class  {:6.2} %", 100.0 * a.correct);
-    println!("  error class    {:6.2} %", 100.0 * a.error);
-    println!(
+    )?;
+    outln!("  correct class  {:6.2} %", 100.0 * a.correct)?;
+    outln!("  error class    {:6.2} %", 100.0 * a.error)?;
+    outln!(
         "  mean           {:6.2} %   ({who} {:.2} %, off by {:+.2} points)",
         100.0 * a.mean(),
         100.0 * accuracy.get(),
         100.0 * (a.mean() - accuracy.get())
-    );
-    println!(
+    )?;
+    outln!(
         "  ErrP-to-noise ratio {:.4}; decoder: {} PCA components, Ledoit-Wolf shrinkage {:.3}",
         report.generator.errp_to_noise,
         m.n_components(),
         m.shrinkage()
-    );
+    )?;
 
-    if let Some((pending, writer)) = edf {
-        writer.finish()?;
-        let path = pending.commit()?;
-        println!(
+    if let (Some((pending, writer)), Some(p)) = (edf, &args.export) {
+        writer
+            .finish()
+            .with_context(|| format!("--export: cannot write {}", p.display()))?;
+        let path = pending.commit().context("--export")?;
+        outln!(
             "Wrote {} (EDF+, raw EEG + EOG, 256 Hz, annotated)",
             path.display()
-        );
+        )?;
     }
     #[cfg(feature = "rerun")]
     if let Some(file) = rrd {
         let montage = errp_bci::Montage::standard();
-        crate::save::wrote(&errp_sim::calibration::record_calibration(
-            file, &report, &montage,
-        )?);
+        crate::save::wrote(
+            &errp_sim::calibration::record_calibration(file, &report, &montage)
+                .context("--save")?,
+        )?;
     }
     Ok(())
 }
 
-pub(crate) fn print_subjects() {
-    println!("subject  fixed goals  free goals   (mean accuracy, Table 1)");
+pub(crate) fn print_subjects() -> Result<()> {
+    outln!("subject  fixed goals  free goals   (mean accuracy, Table 1)")?;
     for s in subjects() {
-        println!(
+        outln!(
             "{:<8} {:>9.2} %  {:>8.2} %",
-            s.name, s.fixed_goals_pct, s.free_goals_pct
-        );
+            s.name,
+            s.fixed_goals_pct,
+            s.free_goals_pct
+        )?;
     }
+    Ok(())
 }

@@ -17,6 +17,7 @@ use toml::Value;
 use crate::cli::parse_seed;
 use crate::commands::sweep::{Progress, Workers, wall_clock};
 use crate::interrupt;
+use crate::out::{errln, out, outln};
 
 /// `errp fit`.
 #[derive(clap::Subcommand)]
@@ -169,7 +170,7 @@ fn fit_epuck(args: &EpuckFitArgs) -> Result<bool> {
     }
     match outcome {
         FitOutcome::Interrupted => {
-            eprintln!(
+            errln!(
                 "Interrupted: the runs so far are in {}. Run the same command again to resume.",
                 args.out.display()
             );
@@ -177,12 +178,12 @@ fn fit_epuck(args: &EpuckFitArgs) -> Result<bool> {
         }
         FitOutcome::Complete(fit, files) => {
             if !args.quiet {
-                eprintln!("Done in {:.0} s.", started.elapsed().as_secs_f64());
+                errln!("Done in {:.0} s.", started.elapsed().as_secs_f64());
             }
-            print_fit(&fit);
-            println!("Wrote:");
+            print_fit(&fit)?;
+            outln!("Wrote:")?;
             for f in files {
-                println!("  {}", f.display());
+                outln!("  {}", f.display())?;
             }
             Ok(true)
         }
@@ -198,47 +199,55 @@ fn pct(v: f64) -> String {
     }
 }
 
-fn print_fit(fit: &EpuckFit) {
+fn print_fit(fit: &EpuckFit) -> Result<()> {
     let s = &fit.surface;
-    println!(
+    outln!(
         "E-puck decoder accuracy fitted to the paper's two runs ({} calibrations x {} runs of \
          each scenario per accuracy, seeds from {}):",
-        fit.spec.calibrations, fit.spec.runs, fit.spec.seed
-    );
-    print!("{:>8}  {:>16}", "accuracy", "log L (MC sd)");
+        fit.spec.calibrations,
+        fit.spec.runs,
+        fit.spec.seed
+    )?;
+    out!("{:>8}  {:>16}", "accuracy", "log L (MC sd)")?;
     for (name, ..) in &fit.observations {
-        print!("  | {name:<43}");
+        out!("  | {name:<43}")?;
     }
-    println!();
-    print!("{:>8}  {:>16}", "", "");
+    outln!()?;
+    out!("{:>8}  {:>16}", "", "")?;
     for _ in &fit.observations {
-        print!(
+        out!(
             "  | {:>7} {:>11} {:>9} {:>6} {:>5}",
-            "reached", "median t", "median d", "pct t", "pct d"
-        );
+            "reached",
+            "median t",
+            "median d",
+            "pct t",
+            "pct d"
+        )?;
     }
-    println!();
+    outln!()?;
     for j in 0..s.grid.len() {
         let mark = if j == s.estimate { "*" } else { " " };
-        print!(
+        out!(
             "{mark}{:>7.3}  {:>8.2} ({:>5.2})",
-            s.grid[j], s.total[j], s.total_sd[j]
-        );
+            s.grid[j],
+            s.total[j],
+            s.total_sd[j]
+        )?;
         for i in 0..fit.observations.len() {
             let st = &fit.stats[i][j];
-            print!(
+            out!(
                 "  | {:>6}% {:>9.1} s {:>9.1} {:>5}% {:>4}%",
                 pct(st.p_reached()),
                 st.time_secs[0],
                 st.detections[0],
                 pct(st.time_percentile),
                 pct(st.detections_percentile)
-            );
+            )?;
         }
-        println!();
+        outln!()?;
     }
     let edge = |at: bool| if at { " (the grid's end)" } else { "" };
-    println!(
+    outln!(
         "Estimate: accuracy {:.3}; 95 % likelihood-ratio interval {:.3}{}-{:.3}{}; Monte Carlo \
          spread of the estimate (5-95 % over {} bootstrap replicates) {:.3}-{:.3}.",
         fit.estimate,
@@ -249,10 +258,10 @@ fn print_fit(fit: &EpuckFit) {
         fit.spec.bootstrap,
         fit.mc_interval_90.0,
         fit.mc_interval_90.1
-    );
+    )?;
     for (i, h) in fit.held_out.iter().enumerate() {
         let (_, _, t, d) = &fit.observations[i];
-        println!(
+        outln!(
             "Held out {}: fitted to the other run alone, accuracy {:.3}; there {} reaches the \
              goal in {} % of runs, and the paper's {t} s lie at the {} percentile of their times \
              and its {d} detections at the {}.",
@@ -262,8 +271,9 @@ fn print_fit(fit: &EpuckFit) {
             pct(h.stats.p_reached()),
             ordinal_percent(h.stats.time_percentile),
             ordinal_percent(h.stats.detections_percentile)
-        );
+        )?;
     }
+    Ok(())
 }
 
 /// Parses `--goal-reward`: numbers (the range check is the fit's).
@@ -288,7 +298,7 @@ fn start(
 ) -> Result<(errp_sweep::TargetCache, rayon::ThreadPool, usize, Progress)> {
     let cache = workers.cache();
     if let Some(why) = cache.problem() {
-        eprintln!("warning: {why}");
+        errln!("warning: {why}");
     }
     let (pool, threads) = workers.pool()?;
     Ok((cache, pool, threads, Progress::new(quiet)))
@@ -342,7 +352,7 @@ fn fit_grid(args: &GridFitArgs) -> Result<bool> {
     }
     match outcome {
         GridFitOutcome::Interrupted => {
-            eprintln!(
+            errln!(
                 "Interrupted: nothing written; the decoders' targetings are cached, so a rerun \
                  starts with the episodes."
             );
@@ -350,63 +360,66 @@ fn fit_grid(args: &GridFitArgs) -> Result<bool> {
         }
         GridFitOutcome::Complete(fit, files) => {
             if !args.quiet {
-                eprintln!("Done in {:.0} s.", started.elapsed().as_secs_f64());
+                errln!("Done in {:.0} s.", started.elapsed().as_secs_f64());
             }
-            print_grid_fit(&fit);
-            println!("Wrote:");
+            print_grid_fit(&fit)?;
+            outln!("Wrote:")?;
             for f in files {
-                println!("  {}", f.display());
+                outln!("  {}", f.display())?;
             }
             Ok(true)
         }
     }
 }
 
-fn print_grid_fit(fit: &GridFit) {
+fn print_grid_fit(fit: &GridFit) -> Result<()> {
     let s = &fit.surface;
-    println!(
+    outln!(
         "Grid Q-value scale (goal reward at tau = 0.3) fitted to Table 1's fixed goals ({} \
          calibrations x {} groups of 5 runs per subject and point, epsilon {}, seed {}):",
-        fit.spec.calibrations, fit.spec.repeats, fit.spec.epsilon, fit.spec.seed
-    );
-    print!("{:>6}  {:>15}  {:>8}", "reward", "log L (MC sd)", "free L");
+        fit.spec.calibrations,
+        fit.spec.repeats,
+        fit.spec.epsilon,
+        fit.spec.seed
+    )?;
+    out!("{:>6}  {:>15}  {:>8}", "reward", "log L (MC sd)", "free L")?;
     for row in &fit.fixed {
-        print!(
+        out!(
             "  | {:<27}",
             format!("{} fixed [{}]", row.subject, row.actions_mean)
-        );
+        )?;
     }
-    println!("  | r<0 fixed/free");
+    outln!("  | r<0 fixed/free")?;
     for j in 0..s.grid.len() {
         let mark = if j == s.estimate { "*" } else { " " };
-        print!(
+        out!(
             "{mark}{:>5}  {:>7.2} ({:>5.2})  {:>8.2}",
             errp_sim::task::format_number(s.grid[j]),
             s.total[j],
             s.total_sd[j],
             fit.free_log_lik[j]
-        );
+        )?;
         for per_point in &fit.fixed_stats {
             let st = &per_point[j];
-            print!(
+            out!(
                 "  | {:>5.1} +- {:>5.1} {:>4}% z{:>+5.1}",
                 st.actions.0,
                 st.actions.1,
                 pct(st.reached as f64 / st.runs.max(1) as f64),
                 st.z
-            );
+            )?;
         }
         let share =
             |t: &errp_sweep::fit::TableStats| pct(t.r_negative as f64 / t.tables.max(1) as f64);
-        println!(
+        outln!(
             "  | {:>3}% / {:>3}%",
             share(&fit.fixed_tables[j]),
             share(&fit.free_tables[j])
-        );
+        )?;
     }
     let edge = |at: bool| if at { " (the grid's end)" } else { "" };
     let num = errp_sim::task::format_number;
-    println!(
+    outln!(
         "Estimate: goal reward {}; 95 % likelihood-ratio interval {}{}-{}{}; Monte Carlo spread \
          of the estimate (5-95 % over {} bootstrap replicates) {}-{}.",
         num(fit.estimate),
@@ -417,59 +430,60 @@ fn print_grid_fit(fit: &GridFit) {
         fit.spec.bootstrap,
         num(fit.mc_interval_90.0),
         num(fit.mc_interval_90.1)
-    );
+    )?;
     let own: Vec<String> = fit
         .fixed
         .iter()
         .zip(&fit.own_estimates)
         .map(|(row, e)| format!("{} {}", row.subject, num(*e)))
         .collect();
-    println!("Each subject alone: {}.", own.join(", "));
+    outln!("Each subject alone: {}.", own.join(", "))?;
     let p40: Vec<String> = s
         .grid
         .iter()
         .zip(&fit.p_all_reached)
         .map(|(g, p)| format!("{} {:.3}", num(*g), p))
         .collect();
-    println!(
+    outln!(
         "P(all 40 of the paper's goals reached), from the tables: {}.",
         p40.join(", ")
-    );
+    )?;
     match fit.reached_estimate {
-        Some(g) => println!(
+        Some(g) => outln!(
             "Keeping the paper's 40/40 (P >= {}): goal reward {}, the largest likelihood among \
              the goal rewards where P(all 40 reached) >= {}.",
             REACHED_LEVEL,
             num(g),
             REACHED_LEVEL
-        ),
-        None => println!(
+        )?,
+        None => outln!(
             "No goal reward of the grid keeps the paper's 40/40 (P(all 40 reached) >= {}).",
             REACHED_LEVEL
-        ),
+        )?,
     }
-    print_grid_point(fit, s.estimate, "the estimate");
+    print_grid_point(fit, s.estimate, "the estimate")?;
     let kept = fit
         .reached_estimate
         .and_then(|g| s.grid.iter().position(|&x| x == g));
     if let Some(j) = kept.filter(|&j| j != s.estimate) {
-        print_grid_point(fit, j, "the goal reward that keeps the paper's 40/40");
+        print_grid_point(fit, j, "the goal reward that keeps the paper's 40/40")?;
     }
+    Ok(())
 }
 
 /// The fitted and held-out rows of grid point `j`, against the paper's.
-fn print_grid_point(fit: &GridFit, j: usize, what: &str) {
-    println!(
+fn print_grid_point(fit: &GridFit, j: usize, what: &str) -> Result<()> {
+    outln!(
         "At {what}, goal reward {} (ours [paper], z = difference in standard errors):",
         errp_sim::task::format_number(fit.surface.grid[j])
-    );
+    )?;
     for (set, rows, stats) in [
         ("fixed (fitted)", &fit.fixed, &fit.fixed_stats),
         ("free (held out)", &fit.free, &fit.free_stats),
     ] {
         for (row, per_point) in rows.iter().zip(stats) {
             let st = &per_point[j];
-            println!(
+            outln!(
                 "  {} {set}: actions {:.1} +- {:.1} [{} +- {}], z {:+.1}; reached {}/{}; online \
                  accuracy {:.1} % [{:.2}]",
                 row.subject,
@@ -482,17 +496,22 @@ fn print_grid_point(fit: &GridFit, j: usize, what: &str) {
                 st.runs,
                 100.0 * st.online_accuracy,
                 100.0 * row.accuracy
-            );
+            )?;
         }
     }
     for (set, t) in [
         ("fixed", &fit.fixed_tables[j]),
         ("free", &fit.free_tables[j]),
     ] {
-        println!(
+        outln!(
             "  Tables of 20 runs ({set} goals, held out): all 20 reached in {}/{}; r negative in \
              {}/{}, median r {:.2}.",
-            t.all_reached, t.tables, t.r_negative, t.tables, t.median_r
-        );
+            t.all_reached,
+            t.tables,
+            t.r_negative,
+            t.tables,
+            t.median_r
+        )?;
     }
+    Ok(())
 }

@@ -18,10 +18,16 @@ use errp_sim::grid::{
 use errp_sim::{AnyScenario, load_scenario, load_scenario_with};
 
 use crate::cli::{DecoderArg, RunArgs, calibration_progress};
+use crate::out::{errln, out, outln};
 use crate::save::check_save;
 
 /// The most e-puck runs one recording holds.
 const MAX_RECORDED_RUNS: usize = 100;
+
+/// The most grid episodes one recording holds (each adds about 20 kB to
+/// the file and 150 kB of memory while it is written: measured on 1000
+/// episodes of `grid_fixed_goals.toml`).
+const MAX_RECORDED_EPISODES: usize = 5_000;
 
 pub(crate) fn run(args: &RunArgs) -> Result<()> {
     // Overrides are keys of the scenario file, set before it is parsed, so
@@ -76,6 +82,19 @@ pub(crate) fn run(args: &RunArgs) -> Result<()> {
             );
         }
     }
+    if let (AnyScenario::Grid(s), Some(_)) = (&scenario, &args.save)
+        && s.episodes.len() > MAX_RECORDED_EPISODES
+    {
+        bail!(
+            "--save with {} episodes: a recording holds at most {MAX_RECORDED_EPISODES} grid \
+             episodes (each adds about 20 kB to the file and 150 kB of memory while it is \
+             written, so {:.1} GB here); record fewer (lower `repeats` in {}), or run them \
+             all without --save",
+            s.episodes.len(),
+            s.episodes.len() as f64 * 150e3 / 1e9,
+            args.scenario.display()
+        );
+    }
     match scenario {
         AnyScenario::Grid(s) => {
             if args.runs.is_some() {
@@ -110,7 +129,7 @@ pub(crate) fn run_grid(args: &RunArgs, mut scenario: GridScenario) -> Result<()>
     let rrd = open_recording(args, errp_sim::grid::grid_recording)?;
     let quiet = args.quiet;
     if !quiet {
-        eprintln!(
+        errln!(
             "{}: {} episodes, {} decoder at {:.2} % ({}), seed {}",
             scenario.name,
             scenario.episodes.len(),
@@ -126,28 +145,34 @@ pub(crate) fn run_grid(args: &RunArgs, mut scenario: GridScenario) -> Result<()>
     let (decoder, calibration) = prepare_decoder(&scenario, calibration_progress(quiet))
         .context("calibrating the decoder")?;
     if let Some(c) = &calibration {
-        println!(
+        outln!(
             "Decoder calibrated on 400 actions: mean accuracy {:.2} % on held-out epochs (the \
              target; correct {:.2} %, error {:.2} %), {:.2} % cross-validated",
             100.0 * c.targeting.accuracy.mean(),
             100.0 * c.targeting.accuracy.correct,
             100.0 * c.targeting.accuracy.error,
             100.0 * c.calibrated.accuracy.mean()
-        );
+        )?;
     }
-    println!("{GridEpisodeHeader}");
+    outln!("{GridEpisodeHeader}")?;
+    // A standard output that fails stops nothing here (the episodes run
+    // on); the first failure is the command's.
+    let mut printed = Ok(());
     let episodes = run_grid_scenario(&scenario, &decoder, args.save.is_some(), |k, r| {
-        println!("{}", GridEpisodeRow(k, r));
+        if printed.is_ok() {
+            printed = outln!("{}", GridEpisodeRow(k, r));
+        }
     })?;
+    printed?;
     let report = GridRunReport {
         scenario,
         calibration,
         episodes,
     };
-    print!("{report}");
+    out!("{report}")?;
     #[cfg(feature = "rerun")]
     if let Some(file) = rrd {
-        crate::save::wrote(&errp_sim::grid::record_grid_run(file, &report)?);
+        crate::save::wrote(&errp_sim::grid::record_grid_run(file, &report).context("--save")?)?;
     }
     Ok(())
 }
@@ -167,7 +192,7 @@ pub(crate) fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<(
     let start = &scenario.episode.start;
     let goal = &layout.goals()[scenario.episode.goal].name;
     if !quiet {
-        eprintln!(
+        errln!(
             "{}: e-puck from ({:.0}, {:.0}) cm to {goal}, {} run(s), {decoder_text}, seed {}{}",
             scenario.name,
             100.0 * start.x_m,
@@ -186,7 +211,7 @@ pub(crate) fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<(
         calibration_progress(quiet),
         |s: &OnlineStep| {
             if !quiet {
-                eprintln!(
+                errln!(
                     "  calibrating: ErrP-to-noise {:.4}, T_e {:.3} -> {:.1} % hits, {:.2} false alarms/min",
                     s.ratio,
                     s.t_e,
@@ -198,7 +223,7 @@ pub(crate) fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<(
     )
     .context("calibrating the continuous decoder")?;
     let acc = report.calibrated.accuracy;
-    println!(
+    outln!(
         "SVM decoder calibrated on {} error + {} correct button-locked examples: correct {:.2} %, \
          error {:.2} %, mean {:.2} % (cross-validated); {} support vectors",
         acc.n_error,
@@ -207,9 +232,9 @@ pub(crate) fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<(
         100.0 * acc.error,
         100.0 * acc.mean(),
         decoder.model.n_support()
-    );
+    )?;
     if let Some(online) = &decoder.online {
-        print!("{online}");
+        out!("{online}")?;
     }
     #[cfg(feature = "rerun")]
     let recorded = match &rrd {
@@ -222,24 +247,24 @@ pub(crate) fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<(
         Some(results) => results,
         None => {
             if !quiet && scenario.runs > 1 {
-                eprintln!("  running {} runs in parallel", scenario.runs);
+                errln!("  running {} runs in parallel", scenario.runs);
             }
             run_epuck_batch(&scenario, &decoder, scenario.runs)?
         }
     };
-    println!("{EpuckRunHeader}");
+    outln!("{EpuckRunHeader}")?;
     for (index, result) in results.iter().enumerate() {
-        println!(
+        outln!(
             "{}",
             EpuckRunRow {
                 index,
                 result,
                 layout
             }
-        );
+        )?;
     }
     let summary = summarise(&results);
-    print!(
+    out!(
         "{}",
         EpuckSummaryReport {
             summary: &summary,
@@ -247,10 +272,10 @@ pub(crate) fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<(
             goal,
             t_e: decoder.t_e(scenario.params.control.t_e),
         }
-    );
+    )?;
     #[cfg(feature = "rerun")]
     if let Some(file) = rrd {
-        crate::save::wrote(&file.finish()?);
+        crate::save::wrote(&file.finish().context("--save")?)?;
     }
     Ok(())
 }

@@ -16,6 +16,7 @@ use errp_sweep::{
 
 use crate::cli::parse_seed;
 use crate::interrupt;
+use crate::out::{errln, out, outln};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 /// The task of a sweep, as the flag takes it.
@@ -198,7 +199,7 @@ impl Progress {
     pub(crate) fn line(&self, text: &str) {
         match &self.bar {
             Some(bar) => bar.println(text),
-            None if self.plain => eprintln!("{text}"),
+            None if self.plain => errln!("{text}"),
             None => {}
         }
     }
@@ -233,7 +234,7 @@ impl SweepObserver for Progress {
             let tenth = 10 * done / total;
             let before = self.tenths.swap(tenth, Ordering::Relaxed);
             if tenth != before && tenth > 0 {
-                eprintln!(
+                errln!(
                     "  episodes {done}/{total} [{:.1} s]",
                     self.started.elapsed().as_secs_f64()
                 );
@@ -252,7 +253,15 @@ impl SweepObserver for Progress {
     fn note(&self, text: &str) {
         match &self.bar {
             Some(bar) => bar.println(format!("note: {text}")),
-            None => eprintln!("note: {text}"),
+            None => errln!("note: {text}"),
+        }
+    }
+
+    fn warning(&self, text: &str) {
+        // Shown even with --quiet: something was wrong.
+        match &self.bar {
+            Some(bar) => bar.println(format!("warning: {text}")),
+            None => errln!("warning: {text}"),
         }
     }
 }
@@ -297,7 +306,7 @@ pub fn sweep(args: &SweepArgs) -> Result<bool> {
         if args.prepare_only {
             bail!("--prepare-only keeps the targeting in the cache, and {why}");
         }
-        eprintln!("warning: {why}");
+        errln!("warning: {why}");
     }
     let (pool, threads) = args.workers.pool()?;
     let progress = Progress::new(args.quiet);
@@ -342,7 +351,7 @@ pub fn sweep(args: &SweepArgs) -> Result<bool> {
     let secs = started.elapsed().as_secs_f64();
     match outcome {
         SweepOutcome::Interrupted { done, total } => {
-            eprintln!(
+            errln!(
                 "Interrupted: {done} of {total} episodes are in {}. Run the same command again \
                  to resume.",
                 opts.out.join("episodes.csv").display()
@@ -351,7 +360,7 @@ pub fn sweep(args: &SweepArgs) -> Result<bool> {
         }
         SweepOutcome::Complete { ran, total, report } => {
             if !args.quiet {
-                eprintln!(
+                errln!(
                     "{ran} episodes in {secs:.1} s ({:.0} per second){}",
                     ran as f64 / secs.max(1e-9),
                     if ran < total {
@@ -362,14 +371,14 @@ pub fn sweep(args: &SweepArgs) -> Result<bool> {
                 );
             }
             if let Some(report) = report {
-                print_report(&report);
+                print_report(&report)?;
             } else {
-                println!(
+                outln!(
                     "Shard {shard} done: {total} episodes in {}. When all {} shards are done: \
                      errp merge DIR... --out MERGED",
                     opts.out.display(),
                     shard.count
-                );
+                )?;
             }
             Ok(true)
         }
@@ -410,44 +419,45 @@ fn prepare(
         bar.finish_and_clear();
     }
     let searched = infos.iter().filter(|i| !i.cached).count();
-    println!(
+    outln!(
         "Prepared {} decoder(s) ({searched} searched now, {} already cached), their targeting \
          kept in {}:",
         infos.len(),
         infos.len() - searched,
         dir.display()
-    );
+    )?;
     for i in &infos {
         match (i.cv_mean, i.errp_to_noise) {
-            (Some(m), Some(r)) => println!(
+            (Some(m), Some(r)) => outln!(
                 "  accuracy {} -> {:.2} % cross-validated (ErrP-to-noise {r:.4}){}",
                 i.accuracy,
                 100.0 * m,
                 if i.cached { ", cached" } else { "" }
-            ),
-            _ => println!("  accuracy {}: {} (nothing to target)", i.accuracy, i.kind),
+            )?,
+            _ => outln!("  accuracy {}: {} (nothing to target)", i.accuracy, i.kind)?,
         }
     }
-    println!(
+    outln!(
         "Shards of this sweep run with the same cache now find every targeting there \
          (\"targeting cached\" in their progress)."
-    );
+    )?;
     Ok(())
 }
 
-fn print_report(report: &SweepReport) {
-    print!("{report}");
-    println!("Wrote:");
+fn print_report(report: &SweepReport) -> Result<()> {
+    out!("{report}")?;
+    outln!("Wrote:")?;
     for f in &report.files {
-        println!("  {}", f.display());
+        outln!("  {}", f.display())?;
     }
+    Ok(())
 }
 
 /// Runs `errp merge`.
 pub fn merge(args: &MergeArgs) -> Result<()> {
     let report = merge_sweeps(&args.dirs, Path::new(&args.out))
         .map_err(|e| name_flag(e, "--out", &args.out))?;
-    print_report(&report);
+    print_report(&report)?;
     Ok(())
 }
 

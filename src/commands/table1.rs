@@ -4,6 +4,7 @@ use anyhow::Result;
 use errp_sim::grid::{DecoderChoice, Table1Options, Table1Report, run_table1};
 
 use crate::cli::{DecoderArg, Table1Args};
+use crate::out::{errln, out};
 
 pub(crate) fn table1(args: &Table1Args) -> Result<()> {
     let options = Table1Options {
@@ -18,7 +19,7 @@ pub(crate) fn table1(args: &Table1Args) -> Result<()> {
     };
     let quiet = args.quiet;
     if !quiet {
-        eprintln!(
+        errln!(
             "Table 1: 4 subjects x 2 goal sets x {} runs, seed {} (calibrating 8 decoders in parallel)",
             5 * options.repeats,
             options.seed
@@ -26,13 +27,13 @@ pub(crate) fn table1(args: &Table1Args) -> Result<()> {
     }
     let cells = run_table1(&options, |label, s| {
         if !quiet {
-            eprintln!(
+            errln!(
                 "  {label}: ErrP-to-noise {:.4} -> {:.2} % on held-out epochs",
                 s.ratio,
                 100.0 * s.accuracy.mean()
             );
         }
     })?;
-    print!("{}", Table1Report(&cells));
+    out!("{}", Table1Report(&cells))?;
     Ok(())
 }

@@ -7,6 +7,7 @@
 //! is never used. An unreadable entry is searched again and rewritten.
 
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
 
 use errp_bci::TargetingResult;
 use serde::{Deserialize, Serialize};
@@ -16,11 +17,20 @@ use errp_sim::calibration::TargetingCache;
 use errp_sim::write_atomic;
 
 /// Where targeting results are kept (or nowhere).
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, Default)]
 pub struct TargetCache {
     dir: Option<PathBuf>,
     /// No directory because none could be found (not by choice).
     unset: bool,
+    /// Entries found wrong since the last [`TargetCache::take_warnings`].
+    warnings: Arc<Mutex<Vec<String>>>,
+}
+
+impl PartialEq for TargetCache {
+    /// The same place (what was warned about does not matter).
+    fn eq(&self, other: &Self) -> bool {
+        self.dir == other.dir && self.unset == other.unset
+    }
 }
 
 #[derive(Serialize, Deserialize)]
@@ -34,16 +44,13 @@ impl TargetCache {
     pub fn new(dir: impl Into<PathBuf>) -> Self {
         Self {
             dir: Some(dir.into()),
-            unset: false,
+            ..Self::default()
         }
     }
 
     /// No cache: every targeting is searched.
     pub fn disabled() -> Self {
-        Self {
-            dir: None,
-            unset: false,
-        }
+        Self::default()
     }
 
     /// The default place: `$ERRP_CACHE_DIR`, else `$XDG_CACHE_HOME/errp`,
@@ -60,6 +67,7 @@ impl TargetCache {
         Self {
             unset: dir.is_none(),
             dir,
+            ..Self::default()
         }
     }
 
@@ -86,6 +94,19 @@ impl TargetCache {
         })
     }
 
+    /// What was found wrong in the cache since the last call (each an
+    /// entry that did not verify, and was searched again): for the user.
+    pub fn take_warnings(&self) -> Vec<String> {
+        std::mem::take(&mut *self.warnings.lock().unwrap_or_else(|e| e.into_inner()))
+    }
+
+    fn warn(&self, text: String) {
+        self.warnings
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .push(text);
+    }
+
     /// The cache directory, if any.
     pub fn dir(&self) -> Option<&Path> {
         self.dir.as_deref()
@@ -102,14 +123,18 @@ impl TargetCache {
 
 impl TargetingCache for TargetCache {
     /// Looks `request` up in `kind-HASH.json` under the cache directory
-    /// (the request text is kept in the file and must match); a miss
-    /// searches and stores the result atomically, and a store that fails
-    /// only costs the next run a search.
+    /// (the request text is kept in the file and must match), and has
+    /// `verify` evaluate the entry's ratio again: an entry whose figures do
+    /// not come back is a miss, with a warning naming it (see
+    /// [`TargetCache::take_warnings`]). A miss searches and stores the
+    /// result atomically, and a store that fails only costs the next run a
+    /// search.
     fn get_or_search(
         &self,
         kind: &str,
         request: &str,
         search: &mut dyn FnMut() -> Result<TargetingResult>,
+        verify: &mut dyn FnMut(&TargetingResult) -> Result<Option<String>>,
     ) -> Result<(TargetingResult, bool)> {
         let Some(dir) = &self.dir else {
             return Ok((search()?, false));
@@ -119,11 +144,23 @@ impl TargetingCache for TargetCache {
             "{kind}-{:016x}.json",
             errp_bci::rng::fnv1a(&request)
         ));
-        if let Ok(text) = std::fs::read_to_string(&path)
+        if let Ok(text) = read_entry(&path)
             && let Ok(entry) = serde_json::from_str::<Entry>(&text)
             && entry.request == request
         {
-            return Ok((entry.result, true));
+            let why = match verify(&entry.result) {
+                Ok(None) => return Ok((entry.result, true)),
+                Ok(Some(why)) => why,
+                Err(e) => format!(
+                    "evaluating its ratio {} fails ({e})",
+                    errp_bci::ratio_text(entry.result.ratio)
+                ),
+            };
+            self.warn(format!(
+                "the cached targeting {} is not what its search finds: {why}; searching again \
+                 and replacing it",
+                path.display()
+            ));
         }
         let result = search()?;
         // A cache that cannot be written is not an error: the sweep goes on.
@@ -133,6 +170,28 @@ impl TargetingCache for TargetCache {
         let _ = Self::store(&path, &entry);
         Ok((entry.result, false))
     }
+}
+
+/// The largest cache entry read (an entry is a request and a search's
+/// few dozen steps: a few KiB).
+const MAX_ENTRY_BYTES: u64 = 1 << 20;
+
+/// The text of the entry at `path`: a regular file of at most
+/// [`MAX_ENTRY_BYTES`] (anything else, a FIFO included, is a miss, found
+/// without waiting).
+fn read_entry(path: &Path) -> std::io::Result<String> {
+    use std::io::Read;
+    let mut text = String::new();
+    errp_sim::open_regular(path)?
+        .take(MAX_ENTRY_BYTES + 1)
+        .read_to_string(&mut text)?;
+    if text.len() as u64 > MAX_ENTRY_BYTES {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            "over the size of a cache entry",
+        ));
+    }
+    Ok(text)
 }
 
 #[cfg(test)]
@@ -153,6 +212,11 @@ mod tests {
             accuracy,
             steps: vec![errp_bci::TargetingStep { ratio, accuracy }],
         }
+    }
+
+    /// A verification that accepts every entry.
+    fn ok(_: &TargetingResult) -> Result<Option<String>> {
+        Ok(None)
     }
 
     fn scratch(name: &str) -> PathBuf {
@@ -177,16 +241,16 @@ mod tests {
         let cache = TargetCache::new(&dir);
         let ratio = 0.1 + 0.2; // not a short decimal
         let (r, hit) = cache
-            .get_or_search("k", "a", &mut || Ok(result(ratio)))
+            .get_or_search("k", "a", &mut || Ok(result(ratio)), &mut ok)
             .unwrap();
         assert!(!hit && r.ratio == ratio);
         let (r, hit) = cache
-            .get_or_search("k", "a", &mut || panic!("a hit searches nothing"))
+            .get_or_search("k", "a", &mut || panic!("a hit searches nothing"), &mut ok)
             .unwrap();
         assert!(hit && r.ratio.to_bits() == ratio.to_bits());
         // Another request is another entry.
         let (_, hit) = cache
-            .get_or_search("k", "b", &mut || Ok(result(0.5)))
+            .get_or_search("k", "b", &mut || Ok(result(0.5)), &mut ok)
             .unwrap();
         assert!(!hit);
         // An entry cut short (or for another request) is searched again and
@@ -197,16 +261,26 @@ mod tests {
         let mut searched = 0;
         for _ in 0..2 {
             let _ = cache
-                .get_or_search("k", "a", &mut || {
-                    searched += 1;
-                    Ok(result(ratio))
-                })
+                .get_or_search(
+                    "k",
+                    "a",
+                    &mut || {
+                        searched += 1;
+                        Ok(result(ratio))
+                    },
+                    &mut ok,
+                )
                 .unwrap();
             let _ = cache
-                .get_or_search("k", "b", &mut || {
-                    searched += 1;
-                    Ok(result(0.5))
-                })
+                .get_or_search(
+                    "k",
+                    "b",
+                    &mut || {
+                        searched += 1;
+                        Ok(result(0.5))
+                    },
+                    &mut ok,
+                )
                 .unwrap();
         }
         assert_eq!(searched, 1, "the damaged entry once, then hits");
@@ -224,10 +298,15 @@ mod tests {
             for _ in 0..8 {
                 s.spawn(|| {
                     let (r, _) = cache
-                        .get_or_search("k", "same", &mut || {
-                            std::thread::sleep(std::time::Duration::from_millis(20));
-                            Ok(result(0.42))
-                        })
+                        .get_or_search(
+                            "k",
+                            "same",
+                            &mut || {
+                                std::thread::sleep(std::time::Duration::from_millis(20));
+                                Ok(result(0.42))
+                            },
+                            &mut ok,
+                        )
                         .unwrap();
                     assert_eq!(r.ratio, 0.42);
                 });
@@ -236,7 +315,7 @@ mod tests {
         let names = entries(&dir);
         assert_eq!(names.len(), 1, "{names:?}");
         let (r, hit) = cache
-            .get_or_search("k", "same", &mut || panic!("whole: a hit"))
+            .get_or_search("k", "same", &mut || panic!("whole: a hit"), &mut ok)
             .unwrap();
         assert!(hit && r == result(0.42));
         std::fs::remove_dir_all(&dir).unwrap();
@@ -256,8 +335,76 @@ mod tests {
         let unset = TargetCache {
             dir: None,
             unset: true,
+            ..TargetCache::default()
         };
         assert!(unset.problem().unwrap().contains("$HOME"));
         std::fs::remove_dir_all(&ok).unwrap();
+    }
+
+    /// An entry whose ratio was edited (x3, 0, 1e308), or whose figures do
+    /// not come back when its ratio is evaluated again, is a miss with a
+    /// warning naming the file, and is replaced by the search's result.
+    #[test]
+    fn an_entry_that_does_not_verify_is_a_miss_with_a_warning() {
+        let dir = scratch("verify");
+        let cache = TargetCache::new(&dir);
+        let search = errp_bci::TargetingParams::default();
+        // The "decoder": accuracy rises with the ratio; the true ratio of
+        // the request is 0.3, which gives 75 %.
+        let evaluate = |ratio: f64| {
+            let mean = (0.5 + ratio / 1.2).min(0.99);
+            if !ratio.is_finite() || ratio > 1e300 {
+                return Err(errp_sim::SimError::Sweep("features not finite".into()));
+            }
+            Ok(Accuracy {
+                correct: mean,
+                error: mean,
+                n_correct: 320,
+                n_error: 80,
+            })
+        };
+        let mut verify = |t: &TargetingResult| Ok(t.inconsistency(evaluate(t.ratio)?, &search));
+        let truth = result(0.3);
+        let mut truth_entry = truth.clone();
+        truth_entry.accuracy = evaluate(0.3).unwrap();
+        let (_, hit) = cache
+            .get_or_search("k", "a", &mut || Ok(truth_entry.clone()), &mut verify)
+            .unwrap();
+        assert!(!hit);
+        let (_, hit) = cache
+            .get_or_search("k", "a", &mut || panic!("a hit"), &mut verify)
+            .unwrap();
+        assert!(hit, "a true entry verifies");
+        assert!(cache.take_warnings().is_empty());
+        let name = entries(&dir).into_iter().next().unwrap();
+        let path = dir.join(&name);
+        let original = std::fs::read_to_string(&path).unwrap();
+        for tampered in ["0.8999999999999999", "0.0", "1e308", "-0.3"] {
+            let text = original.replace("\"ratio\":0.3", &format!("\"ratio\":{tampered}"));
+            assert_ne!(text, original);
+            std::fs::write(&path, text).unwrap();
+            let mut searched = false;
+            let (r, hit) = cache
+                .get_or_search(
+                    "k",
+                    "a",
+                    &mut || {
+                        searched = true;
+                        Ok(truth_entry.clone())
+                    },
+                    &mut verify,
+                )
+                .unwrap();
+            assert!(!hit && searched && r.ratio == 0.3, "ratio {tampered}");
+            let warnings = cache.take_warnings();
+            assert_eq!(warnings.len(), 1, "ratio {tampered}: {warnings:?}");
+            assert!(warnings[0].contains(&name), "{}", warnings[0]);
+            // Replaced: the next lookup is a hit again.
+            let (_, hit) = cache
+                .get_or_search("k", "a", &mut || panic!("replaced"), &mut verify)
+                .unwrap();
+            assert!(hit, "ratio {tampered}: the entry was replaced");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

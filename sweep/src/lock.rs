@@ -22,7 +22,9 @@ use std::thread::JoinHandle;
 use std::time::{Duration, SystemTime};
 
 use errp_sim::host::{host_name, process_gone, process_start, random_suffix};
-use errp_sim::{Result, SimError, forget_if_interrupted, remove_if_interrupted};
+use errp_sim::{
+    Result, SimError, forget_if_interrupted, open_regular, open_regular_with, remove_if_interrupted,
+};
 
 /// The lock file's name in a sweep directory.
 pub const LOCK: &str = "sweep.lock";
@@ -129,16 +131,8 @@ pub struct DirLock {
 fn busy(dir: &Path, holder: Option<&Holder>, silent: Option<Duration>, what: &str) -> SimError {
     let who = match holder {
         Some(h) => {
-            let alive = match silent {
-                Some(s) if h.host != host_name() => format!(
-                    "; alive {} s ago, and taken to be gone once silent for {} s",
-                    s.as_secs(),
-                    STALE_AFTER.as_secs()
-                ),
-                _ => String::new(),
-            };
             format!(
-                "errp on host {}, pid {} ({}){alive}",
+                "errp on host {}, pid {} ({})",
                 h.host,
                 h.pid,
                 if h.command.is_empty() {
@@ -150,9 +144,17 @@ fn busy(dir: &Path, holder: Option<&Holder>, silent: Option<Duration>, what: &st
         }
         None => "another process".to_string(),
     };
+    let alive = match (holder, silent) {
+        (Some(h), Some(s)) if h.host != host_name() => format!(
+            " It was last seen alive {} s ago, and is taken to be gone once silent for {} s.",
+            s.as_secs(),
+            STALE_AFTER.as_secs()
+        ),
+        _ => String::new(),
+    };
     SimError::Sweep(format!(
-        "{} is in use: {who} is writing it ({}). Wait for it to end, or choose another {what}; \
-         a lock left by a process that is gone is taken over by itself",
+        "{} is in use: {who} is writing it ({}).{alive} Wait for it to end, or choose another \
+         {what}; a lock left by a process that is gone is taken over by itself",
         dir.display(),
         dir.join(LOCK).display()
     ))
@@ -184,13 +186,15 @@ impl DirLock {
             source,
         };
         for _ in 0..8 {
-            let mut file = OpenOptions::new()
-                .read(true)
-                .write(true)
-                .create(true)
-                .truncate(false)
-                .open(&path)
-                .map_err(io)?;
+            let mut file = open_regular_with(
+                OpenOptions::new()
+                    .read(true)
+                    .write(true)
+                    .create(true)
+                    .truncate(false),
+                &path,
+            )
+            .map_err(io)?;
             match file.try_lock() {
                 Ok(()) => {}
                 Err(std::fs::TryLockError::WouldBlock) => {
@@ -253,7 +257,7 @@ impl DirLock {
     /// Who holds `dir`'s lock, if a live process does (without taking it).
     pub fn holder(dir: &Path) -> Option<Holder> {
         let path = dir.join(LOCK);
-        let mut file = File::open(&path).ok()?;
+        let mut file = open_regular(&path).ok()?;
         let text = read_small(&mut file);
         let h = Holder::parse(&text)?;
         (!h.gone(silence(&file))).then_some(h)
@@ -278,10 +282,17 @@ impl Drop for DirLock {
     }
 }
 
-/// How long since the holder last touched the lock file.
+/// How long since the holder last touched the lock file. A time ahead of
+/// this host's clock by less than [`STALE_AFTER`] is clock skew between
+/// hosts (silent for no time); one further ahead was not written by a
+/// heartbeat, and counts as silent since ever.
 fn silence(file: &File) -> Option<Duration> {
     let modified = file.metadata().ok()?.modified().ok()?;
-    Some(now().duration_since(modified).unwrap_or(Duration::ZERO))
+    Some(match now().duration_since(modified) {
+        Ok(age) => age,
+        Err(ahead) if ahead.duration() <= STALE_AFTER => Duration::ZERO,
+        Err(_) => Duration::MAX,
+    })
 }
 
 /// The first 4 KiB of the lock file (a record is a few lines).

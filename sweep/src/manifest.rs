@@ -5,7 +5,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use errp_sim::task::DecoderInfo;
-use errp_sim::{Result, SimError, write_atomic};
+use errp_sim::{Result, SimError, truncate, write_atomic};
 
 use crate::spec::{Shard, SweepSpec};
 
@@ -53,7 +53,7 @@ impl Manifest {
             source,
         };
         let mut text = String::new();
-        std::fs::File::open(&path)
+        errp_sim::open_regular(&path)
             .map_err(input)?
             .take(MAX_MANIFEST_BYTES + 1)
             .read_to_string(&mut text)
@@ -84,7 +84,19 @@ impl Manifest {
                 path.display()
             )));
         }
-        serde_json::from_str(&text).map_err(|e| not_ours(e.to_string()))
+        let manifest: Self = serde_json::from_str(&text).map_err(|e| not_ours(e.to_string()))?;
+        let this = env!("CARGO_PKG_VERSION");
+        if manifest.errp_version != this {
+            return Err(SimError::Sweep(format!(
+                "{}: a sweep written by errp {:?}, and this is errp {this}: a sweep is resumed \
+                 and merged by the version that started it (its decoders and rows may differ \
+                 in another); rerun it into a new --out, or use errp {:?}",
+                path.display(),
+                truncate(&manifest.errp_version, 40),
+                truncate(&manifest.errp_version, 40),
+            )));
+        }
+        Ok(manifest)
     }
 
     /// Writes `dir/sweep.json` atomically.

@@ -9,12 +9,13 @@ use errp_sim::PendingFile;
 use errp_sim::epuck::EpuckTask;
 use errp_sim::grid::GridTask;
 use errp_sim::task::Task;
-use errp_sim::{Result, SimError, create_dir, forget_if_interrupted, remove_if_interrupted};
+use errp_sim::{Result, SimError, create_dirs};
 
 use crate::finish::finish_dir;
 use crate::lock::DirLock;
 use crate::manifest::{EPISODES, MANIFEST, Manifest};
 use crate::rows::{RowCheck, episodes_header};
+use crate::run::foreign_files;
 use crate::spec::{Level, SweepSpec, SweepTask};
 use crate::summary::SweepReport;
 use crate::writer::read_row;
@@ -50,7 +51,7 @@ pub fn merge_sweeps(dirs: &[PathBuf], out: &Path) -> Result<SweepReport> {
     let (first, first_dir) = &shards[0];
     let count = first.shard.expect("checked").count;
     for (m, d) in &shards[1..] {
-        if m.spec != first.spec || m.shard.expect("checked").count != count {
+        if !m.spec.same_sweep(&first.spec) || m.shard.expect("checked").count != count {
             return Err(SimError::Sweep(format!(
                 "{} and {} are shards of different sweeps (their {MANIFEST} differ)",
                 first_dir.display(),
@@ -112,13 +113,21 @@ pub fn merge_sweeps(dirs: &[PathBuf], out: &Path) -> Result<SweepReport> {
             out.display()
         )));
     }
-    let levels = spec.levels()?;
-    let created = !out.exists();
-    create_dir(out)?;
-    if created {
-        // Goes if the merge is interrupted before it is written.
-        remove_if_interrupted(out);
+    if out.exists() {
+        let others = foreign_files(out)?;
+        if !others.is_empty() {
+            return Err(SimError::Sweep(format!(
+                "--out {} holds files that are not a sweep's ({}); give a new or empty \
+                 directory",
+                out.display(),
+                others.join(", ")
+            )));
+        }
     }
+    let levels = spec.levels()?;
+    let created = create_dirs(out)?;
+    // Go if the merge is interrupted before it is written.
+    created.remove_if_interrupted();
     let result = DirLock::acquire(out, "--out").and_then(|lock| {
         let report = match spec.task {
             SweepTask::Grid => merge_rows::<GridTask>(&spec, &levels, &inputs, out),
@@ -134,10 +143,10 @@ pub fn merge_sweeps(dirs: &[PathBuf], out: &Path) -> Result<SweepReport> {
         drop(lock);
         report
     });
-    if result.is_err() && created {
-        let _ = std::fs::remove_dir_all(out);
+    if result.is_err() {
+        created.remove();
     }
-    forget_if_interrupted(out);
+    created.forget_if_interrupted();
     result
 }
 
@@ -161,7 +170,7 @@ fn merge_rows<T: Task>(
             path: path.clone(),
             source,
         };
-        let mut reader = BufReader::new(File::open(&path).map_err(input)?);
+        let mut reader = BufReader::new(errp_sim::open_regular(&path).map_err(input)?);
         let whole = read_row(&mut reader, &mut line).map_err(input)?;
         if whole != Some(true) || line != header.as_bytes() {
             return Err(SimError::Sweep(format!(

@@ -12,6 +12,9 @@ pub trait SweepObserver: Sync {
     /// Something the user should know that is not an error (rows dropped
     /// by `--repair`).
     fn note(&self, _text: &str) {}
+    /// Something found wrong that the sweep worked around (a cache entry
+    /// that did not verify, searched again).
+    fn warning(&self, _text: &str) {}
 }
 
 impl SweepObserver for () {}

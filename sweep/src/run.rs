@@ -11,7 +11,7 @@ use std::sync::atomic::AtomicBool;
 use errp_sim::epuck::EpuckTask;
 use errp_sim::grid::GridTask;
 use errp_sim::task::{DecoderInfo, Task};
-use errp_sim::{Result, SimError, create_dir, forget_if_interrupted, remove_if_interrupted};
+use errp_sim::{Result, SimError, create_dirs, forget_if_interrupted};
 
 use crate::cache::TargetCache;
 use crate::finish::finish_dir;
@@ -24,8 +24,10 @@ use crate::spec::{Level, Shard, SweepSpec, SweepTask};
 use crate::summary::SweepReport;
 use crate::writer::{EpisodeJob, Resumed, Slice, resume_rows};
 
-/// The most memory a sweep's decoders may hold, bytes.
-pub const MAX_DECODER_BYTES: usize = 8 << 30;
+/// The most memory a sweep's decoders may hold, bytes: what fits, with
+/// the rest of the process, in the 4 GB that the Slurm job script
+/// (`scripts/slurm/sweep.sbatch`) requests per job.
+pub const MAX_DECODER_BYTES: usize = 3 << 30;
 
 /// How a sweep runs (none of it changes the results).
 #[derive(Debug, Clone)]
@@ -86,28 +88,30 @@ pub fn run_sweep(
 ) -> Result<SweepOutcome> {
     let levels = spec.levels()?;
     let out = &opts.out;
-    let created = !out.exists();
-    create_dir(out)?;
-    // Undo a directory this call created, if it ends before any row.
+    let created = create_dirs(out)?;
+    // Undo the directories this call created, if it ends before any row.
     let undo = |e: SimError| {
-        if created {
-            let _ = std::fs::remove_dir_all(out);
-            forget_if_interrupted(out);
-        }
+        created.remove();
         e
     };
     let lock = DirLock::acquire(out, "--out").map_err(undo)?;
-    let fresh = Manifest::new(spec, opts.shard);
+    let mut fresh = Manifest::new(spec, opts.shard);
     let manifest_path = out.join(MANIFEST);
+    // The decoders the rows on disk were made with, if any.
+    let mut made_with = Vec::new();
     if manifest_path.exists() {
         let old = Manifest::read(out)?;
-        if old.spec != fresh.spec || old.shard != fresh.shard {
+        made_with = old.decoders.clone();
+        if !old.spec.same_sweep(&fresh.spec) || old.shard != fresh.shard {
             return Err(SimError::Sweep(format!(
                 "{} holds a different sweep (its {MANIFEST} has other parameters, scenario or \
                  shard); choose another --out, or delete the directory to start over",
                 out.display()
             )));
         }
+        // The same sweep, its scenario perhaps named by another path: the
+        // directory keeps the first.
+        fresh.spec.scenario_path = old.spec.scenario_path;
     } else {
         let others = foreign_files(out)?;
         if !others.is_empty() {
@@ -122,13 +126,15 @@ pub fn run_sweep(
     }
     // A directory made here goes if the sweep is interrupted before its
     // first row (`sweep.json` is written once the decoders are ready).
-    if created {
-        remove_if_interrupted(out);
-    }
+    created.remove_if_interrupted();
 
     let outcome = match spec.task {
-        SweepTask::Grid => run_levels::<GridTask>(spec, opts, &levels, fresh, cancel, observer),
-        SweepTask::Epuck => run_levels::<EpuckTask>(spec, opts, &levels, fresh, cancel, observer),
+        SweepTask::Grid => {
+            run_levels::<GridTask>(spec, opts, &levels, fresh, &made_with, cancel, observer)
+        }
+        SweepTask::Epuck => {
+            run_levels::<EpuckTask>(spec, opts, &levels, fresh, &made_with, cancel, observer)
+        }
     };
     // A new directory that failed before its first row goes.
     let outcome = match outcome {
@@ -151,7 +157,7 @@ pub fn run_sweep(
 }
 
 /// The entries of `dir` that no sweep writes (the first few, by name).
-fn foreign_files(dir: &Path) -> Result<Vec<String>> {
+pub(crate) fn foreign_files(dir: &Path) -> Result<Vec<String>> {
     let entries = std::fs::read_dir(dir).map_err(|source| SimError::Input {
         path: dir.to_path_buf(),
         source,
@@ -219,7 +225,8 @@ impl<'a, T: Task> Plan<'a, T> {
         if total > MAX_DECODER_BYTES {
             return Err(SimError::Sweep(format!(
                 "the sweep's {} decoders would hold about {:.1} GiB (their epoch banks), more \
-                 than the {} GiB a sweep may take: sweep fewer levels at once, lower \
+                 than the {} GiB a sweep may take (what fits in the 4 GB a Slurm job of \
+                 scripts/slurm/sweep.sbatch requests): sweep fewer levels at once, lower \
                  bank_per_class, or stream the EEG (--eeg stream)",
                 first.len(),
                 total as f64 / (1u64 << 30) as f64,
@@ -297,6 +304,7 @@ fn run_levels<T: Task>(
     opts: &SweepOptions,
     levels: &[Level],
     fresh: Manifest,
+    made_with: &[DecoderInfo],
     cancel: &AtomicBool,
     observer: &dyn SweepObserver,
 ) -> Result<SweepOutcome> {
@@ -308,6 +316,39 @@ fn run_levels<T: Task>(
         .into_iter()
         .map(|(decoder, info)| (Arc::new(decoder), info))
         .unzip();
+    // Rows already on disk were made with the decoders `sweep.json` lists:
+    // the rest must be made with the same (a cache that changed between
+    // the runs, another version) or the file would mix two sweeps.
+    if episodes_path.exists()
+        && !made_with.is_empty()
+        && let Some(i) = (0..infos.len().max(made_with.len())).find(|&i| {
+            let now = infos.get(i).map(|d| DecoderInfo {
+                cached: false,
+                ..d.clone()
+            });
+            made_with.get(i) != now.as_ref()
+        })
+    {
+        let show = |d: Option<&DecoderInfo>| {
+            d.map_or("none".to_string(), |d| {
+                format!(
+                    "accuracy {} at ErrP-to-noise {}",
+                    d.accuracy,
+                    d.errp_to_noise.map_or("-".into(), |r| r.to_string())
+                )
+            })
+        };
+        return Err(SimError::Sweep(format!(
+            "{} holds rows made with other decoders than this run prepared (decoder {}: {} \
+             then, {} now; was the targeting cache changed between the runs?): resuming \
+             would mix them. Resume with the cache the sweep started with, or choose another \
+             --out",
+            out.display(),
+            i + 1,
+            show(made_with.get(i)),
+            show(infos.get(i)),
+        )));
+    }
     let manifest = Manifest {
         decoders: infos,
         ..fresh
@@ -333,22 +374,27 @@ fn run_levels<T: Task>(
         Resumed::Empty => usize::MAX,
         Resumed::Rows { rows, dropped } => {
             if let Some((line, why, n)) = dropped {
+                let after = match n - 1 {
+                    0 => String::new(),
+                    k => format!(" and the {k} row(s) after it"),
+                };
+                let again = if rows < items.len {
+                    ", to run again what the sweep needs"
+                } else {
+                    ""
+                };
                 observer.note(&format!(
-                    "--repair: {} line {line}: {why}; dropped it and the {} row(s) after it, \
-                     to run them again",
+                    "--repair: {} line {line}: {why}; dropped it{after}{again}",
                     episodes_path.display(),
-                    n - 1
                 ));
             }
             rows
         }
     };
     forget_if_interrupted(out);
-    let mut file = OpenOptions::new()
-        .create(true)
-        .append(true)
-        .open(&episodes_path)
-        .map_err(|source| SimError::Output {
+    let mut file =
+        errp_sim::open_regular_with(OpenOptions::new().create(true).append(true), &episodes_path)
+            .map_err(|source| SimError::Output {
             path: episodes_path.clone(),
             source,
         })?;

@@ -189,9 +189,9 @@ pub fn parse_values(text: &str, what: &str) -> Result<Vec<Value>> {
                     "a range start:stop:step needs step > 0 and stop >= start",
                 ));
             }
-            let n = ((b - a) / step + 1) as usize;
+            let n = (i128::from(*b) - i128::from(*a)) / i128::from(*step) + 1;
             if n > 10_000 {
-                return Err(bad("more than 10000 values"));
+                return Err(bad(&format!("it gives {n} values, more than 10000")));
             }
             return Ok((0..n as i64)
                 .map(|k| Value::Integer(a + k * step))
@@ -208,10 +208,15 @@ pub fn parse_values(text: &str, what: &str) -> Result<Vec<Value>> {
                 "a range start:stop:step needs finite numbers, step > 0 and stop >= start",
             ));
         }
-        let n = ((b - a) / step + 1e-9).floor() as usize + 1;
-        if n > 10_000 {
-            return Err(bad("more than 10000 values"));
+        // Counted in floating point: a tiny step gives more values than an
+        // integer holds.
+        let count = ((b - a) / step + 1e-9).floor() + 1.0;
+        if !count.is_finite() || count > 10_000.0 {
+            return Err(bad(&format!(
+                "it gives {count:.3e} values, more than 10000"
+            )));
         }
+        let n = count as usize;
         return Ok((0..n)
             .map(|k| Value::Float(tidy(a + k as f64 * step)))
             .collect());
@@ -437,6 +442,21 @@ pub fn sweep_fixed(
 }
 
 impl SweepSpec {
+    /// True if `self` and `other` are one sweep: the same scenario text
+    /// (wherever the file is, however its path is spelled: only its file
+    /// name, which names a scenario that sets no `name`, must agree), the
+    /// same levels, episodes and seed.
+    pub fn same_sweep(&self, other: &Self) -> bool {
+        let name = |s: &Self| s.scenario_path.file_name().map(|n| n.to_os_string());
+        Self {
+            scenario_path: PathBuf::new(),
+            ..self.clone()
+        } == Self {
+            scenario_path: PathBuf::new(),
+            ..other.clone()
+        } && name(self) == name(other)
+    }
+
     /// Episodes over all levels.
     pub fn total_episodes(&self) -> usize {
         self.n_levels() * self.episodes
@@ -511,11 +531,18 @@ impl SweepSpec {
                 .chain(self.axes.iter().map(|a| a.values.len()))
                 .map(|n| n.to_string())
                 .collect();
+            let n = levels.map_or("more than 2^64".into(), |n| n.to_string());
+            let what = if self.axes.is_empty() {
+                format!("--accuracy gives {n} levels,")
+            } else {
+                format!(
+                    "{n} levels ({} accuracies x {} --param values) are",
+                    sizes[0],
+                    sizes[1..].join(" x ")
+                )
+            };
             return Err(SimError::Sweep(format!(
-                "{} levels ({}) is too many: a sweep has at most {MAX_LEVELS} (accuracies \
-                 times every --param's values); split it into several sweeps",
-                levels.map_or("more than 2^64".into(), |n| n.to_string()),
-                sizes.join(" x ")
+                "{what} too many: a sweep has at most {MAX_LEVELS}; split it into several sweeps"
             )));
         }
         for (i, a) in self.axes.iter().enumerate() {

@@ -4,7 +4,6 @@
 //! not grow with the number of episodes, and a merged sweep is summarised by
 //! the same code as an unsharded one.
 
-use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 
@@ -104,7 +103,7 @@ pub fn summarise_dir(dir: &Path, spec: &SweepSpec) -> Result<SweepReport> {
         path: path.clone(),
         source,
     };
-    let mut lines = BufReader::new(File::open(&path).map_err(io)?).lines();
+    let mut lines = BufReader::new(errp_sim::open_regular(&path).map_err(io)?).lines();
     let header = lines
         .next()
         .transpose()

@@ -1,6 +1,6 @@
 //! Streaming episode rows to `episodes.csv` in sweep order, and resuming a cut file.
 
-use std::fs::{File, OpenOptions};
+use std::fs::File;
 use std::io::{BufRead, BufReader, Read, Write};
 use std::path::Path;
 use std::sync::Mutex;
@@ -216,7 +216,7 @@ pub(crate) fn resume_rows<T: Task>(
         path: path.to_path_buf(),
         source,
     };
-    let file = File::open(path).map_err(input)?;
+    let file = errp_sim::open_regular(path).map_err(input)?;
     let mut reader = BufReader::new(file);
     let mut line = Vec::new();
     let mut good_bytes = 0u64;
@@ -249,12 +249,18 @@ pub(crate) fn resume_rows<T: Task>(
                 value: String::new(),
                 expected: "it is not text (damage on disk)".into(),
             }),
-            Ok(text) => {
-                if rows >= items.len {
-                    return Err(not_ours("it has more rows than the sweep".into()));
-                }
-                check.check(items.episode(rows), text).err()
-            }
+            // A row past the slice's last (a duplicate of the last row,
+            // say) is a fault like any other: --repair drops it.
+            Ok(_) if rows >= items.len => Some(RowFault {
+                column: String::new(),
+                value: String::new(),
+                expected: format!(
+                    "the sweep's rows end at line {} ({} rows), and this one is extra",
+                    items.len + 1,
+                    items.len
+                ),
+            }),
+            Ok(text) => check.check(items.episode(rows), text).err(),
         };
         if let Some(fault) = fault {
             if !repair {
@@ -281,7 +287,7 @@ pub(crate) fn resume_rows<T: Task>(
         path: path.to_path_buf(),
         source,
     };
-    let file = OpenOptions::new().write(true).open(path).map_err(output)?;
+    let file = errp_sim::write_regular(path).map_err(output)?;
     file.set_len(good_bytes).map_err(output)?;
     file.sync_all().map_err(output)?;
     Ok(if first {

@@ -3,6 +3,7 @@
 //! interrupted, run twice at once or given damaged files (`reliability`).
 
 mod commands;
+mod hostile;
 mod reliability;
 
 use std::path::{Path, PathBuf};

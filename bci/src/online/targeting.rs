@@ -186,6 +186,29 @@ pub fn target_online<E: From<crate::error::BciError>>(
                 .total_cmp(&(b.point.hit_rate - target.hit_rate).abs())
         })
         .expect("at least one evaluation");
+    if !close(best.point.hit_rate) && best.point.hit_rate > target.hit_rate {
+        // Every ratio down to almost none catches more: the detector's
+        // chance hits at this threshold (a high false-alarm rate) are
+        // above the target.
+        let fa = target
+            .false_alarms_per_min
+            .map_or(String::new(), |f| format!(" at {f} false alarms a minute"));
+        return Err(crate::error::BciError::InvalidParameter {
+            name: "hit_rate",
+            value: target.hit_rate.to_string(),
+            expected: format!(
+                "a hit rate the detector can reach{fa}: it catches at least {:.1} % of ErrPs \
+                 there, by chance, with almost no ErrP in the EEG; ask for more{}",
+                100.0 * best.point.hit_rate,
+                if target.false_alarms_per_min.is_some() {
+                    ", or for fewer false alarms a minute"
+                } else {
+                    ""
+                }
+            ),
+        }
+        .into());
+    }
     Ok(OnlineTargeting {
         target,
         ratio: best.ratio,

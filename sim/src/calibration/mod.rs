@@ -119,14 +119,21 @@ pub fn calibrate_at(
 /// would find.
 pub trait TargetingCache: Sync {
     /// The targeting of `request` (text naming everything the search
-    /// depends on) of `kind` (the decoder: "grid-lda", "epuck-svm"): from
-    /// the cache if it holds it, else `search`'s result, then kept. The
-    /// flag is true for a cache hit.
+    /// depends on) of `kind` (the decoder: "grid-lda-online",
+    /// "epuck-svm"): from the cache if it holds it and `verify` accepts
+    /// it, else `search`'s result, then kept. The flag is true for a cache
+    /// hit.
+    ///
+    /// `verify` evaluates a cached result again and says why it cannot be
+    /// what the search finds (see
+    /// [`TargetingResult::inconsistency`](errp_bci::TargetingResult::inconsistency)),
+    /// or `None`; an entry it rejects, or that it fails on, is a miss.
     fn get_or_search(
         &self,
         kind: &str,
         request: &str,
         search: &mut dyn FnMut() -> Result<TargetingResult>,
+        verify: &mut dyn FnMut(&TargetingResult) -> Result<Option<String>>,
     ) -> Result<(TargetingResult, bool)>;
 }
 
@@ -140,6 +147,7 @@ impl TargetingCache for NoCache {
         _kind: &str,
         _request: &str,
         search: &mut dyn FnMut() -> Result<TargetingResult>,
+        _verify: &mut dyn FnMut(&TargetingResult) -> Result<Option<String>>,
     ) -> Result<(TargetingResult, bool)> {
         Ok((search()?, false))
     }

@@ -2,7 +2,7 @@
 //! scenario's accuracy, then every run of the episode, each from its own
 //! derived seed (in parallel when no recording watches).
 
-use errp_bci::{Accuracy, OnlineStep, TargetingStep, rng::derive_seed};
+use errp_bci::{Accuracy, OnlineStep, TargetingResult, TargetingStep, rng::derive_seed};
 use rayon::prelude::*;
 
 use crate::calibration::{NoCache, TargetingCache};
@@ -65,9 +65,26 @@ pub fn prepare_epuck_decoder(
     match scenario.online_target {
         None => {
             let mut find = || target_continuous(&request, &mut progress);
-            let (targeting, cached) =
-                cache.get_or_search("epuck-svm", &request.targeting_key(), &mut find)?;
-            let report = calibrate_continuous_at(&request, targeting)?;
+            // A cached ratio is checked by the calibration it leads to (its
+            // cross-validated accuracy is the figure the search found), which
+            // is kept for use.
+            let mut checked = None;
+            let mut verify = |t: &TargetingResult| {
+                let report = calibrate_continuous_at(&request, t.clone())?;
+                let why = t.inconsistency(report.calibrated.accuracy, &request.search);
+                checked = Some(report);
+                Ok(why)
+            };
+            let (targeting, cached) = cache.get_or_search(
+                "epuck-svm",
+                &request.targeting_key(),
+                &mut find,
+                &mut verify,
+            )?;
+            let report = match checked.filter(|_| cached) {
+                Some(report) => report,
+                None => calibrate_continuous_at(&request, targeting)?,
+            };
             let decoder = finish_continuous_decoder(scenario, &report)?;
             Ok(PreparedEpuck {
                 decoder,

@@ -253,17 +253,28 @@ pub fn prepare_grid_decoder(
         request.targeting_key(),
         held_out_key(scenario)
     );
-    let (targeting, cached) = cache.get_or_search("grid-lda-online", &key, &mut || {
-        let built;
-        let held_out = match shared.held_out.get(&held_out_key(scenario)) {
-            Some(h) => h.as_ref(),
-            None => {
-                built = build_held_out(scenario, &request.setup, parts)?;
-                &built
-            }
-        };
-        target_online_accuracy(parts, held_out, &lda, &request, &mut progress)
-    })?;
+    // The held-out epochs, from `shared` or built once (by the search or
+    // by the check of a cached ratio, whichever needs them first).
+    let built = std::cell::OnceCell::new();
+    let held_out = || -> Result<&EpochBankParts> {
+        if let Some(h) = shared.held_out.get(&held_out_key(scenario)) {
+            return Ok(h.as_ref());
+        }
+        if let Some(b) = built.get() {
+            return Ok(b);
+        }
+        let b = build_held_out(scenario, &request.setup, parts)?;
+        Ok(built.get_or_init(|| b))
+    };
+    let (targeting, cached) = cache.get_or_search(
+        "grid-lda-online",
+        &key,
+        &mut || target_online_accuracy(parts, held_out()?, &lda, &request, &mut progress),
+        &mut |t| {
+            let again = online_accuracy_at(parts, held_out()?, &lda, &request, t.ratio)?;
+            Ok(t.inconsistency(again, &request.search))
+        },
+    )?;
     let calibrated = calibrate_session(
         &lda,
         parts.session_at(targeting.ratio),
@@ -307,17 +318,28 @@ pub fn target_online_accuracy(
     request: &CalibrationRequest,
     progress: impl FnMut(&TargetingStep),
 ) -> Result<TargetingResult> {
-    let labels = parts.session_at(0.0).labels;
-    let fit_seed = derive_seed(request.seed, "calibration/fit", 0);
     Ok(search_ratio(
         request.accuracy,
         &request.search,
-        |ratio| {
-            let model = lda.fit(&parts.features_at(ratio), &labels, fit_seed)?;
-            Ok(held_out.score(&model, ratio))
-        },
+        |ratio| online_accuracy_at(parts, held_out, lda, request, ratio),
         progress,
     )?)
+}
+
+/// What [`target_online_accuracy`] evaluates at one ratio: the LDA trained
+/// on the whole session at `ratio`, scored on `held_out`. A ratio that
+/// gives features the LDA cannot take (not finite) is an error.
+pub fn online_accuracy_at(
+    parts: &SessionParts,
+    held_out: &EpochBankParts,
+    lda: &LdaDecoder,
+    request: &CalibrationRequest,
+    ratio: f64,
+) -> errp_bci::Result<Accuracy> {
+    let labels = parts.session_at(0.0).labels;
+    let fit_seed = derive_seed(request.seed, "calibration/fit", 0);
+    let model = lda.fit(&parts.features_at(ratio), &labels, fit_seed)?;
+    Ok(held_out.score(&model, ratio))
 }
 
 /// The streamed EEG decoder of a synthetic user calibrated at `accuracy`

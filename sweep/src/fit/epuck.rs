@@ -16,7 +16,6 @@
 //! Both scenarios use the same seeds, so each calibration drives both, as
 //! the paper's two runs were driven by one subject's decoder.
 
-use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
@@ -351,7 +350,7 @@ fn read_runs(
     calibration: usize,
 ) -> Result<Vec<Vec<SimRun>>> {
     let bad = |what: String| SimError::Sweep(format!("{}: {what}", path.display()));
-    let file = File::open(path).map_err(|source| SimError::Input {
+    let file = errp_sim::open_regular(path).map_err(|source| SimError::Input {
         path: path.to_path_buf(),
         source,
     })?;

@@ -55,11 +55,14 @@ pub(crate) fn check_out(out: &Path, ours: impl Fn(&Path) -> bool, what: &str) ->
         path: out.to_path_buf(),
         source,
     })?;
+    // The fit's file names are a fit's only beside a fit.json that a fit
+    // wrote: a user's own fit.json (or figures) of these names stay.
+    let a_fit = is_fit_json(&out.join(FIT_FILES[0]));
     let mut foreign: Vec<String> = entries
         .flatten()
         .filter(|e| {
             let name = e.file_name().to_string_lossy().into_owned();
-            !(FIT_FILES.contains(&name.as_str())
+            !((a_fit && FIT_FILES.contains(&name.as_str()))
                 || ours(&e.path())
                 || (name.starts_with('.') && name.contains(".partial-")))
         })
@@ -75,6 +78,26 @@ pub(crate) fn check_out(out: &Path, ours: impl Fn(&Path) -> bool, what: &str) ->
         out.display(),
         foreign.join(", ")
     )))
+}
+
+/// True if `path` is a `fit.json` that `errp fit` wrote: a regular file
+/// of at most 64 MiB holding a JSON object with the fit's `format`,
+/// `parameter` and `provenance` (with `errp_version`).
+fn is_fit_json(path: &Path) -> bool {
+    use std::io::Read;
+    const MAX_FIT_JSON: u64 = 64 << 20;
+    let mut text = String::new();
+    let read =
+        errp_sim::open_regular(path).and_then(|f| f.take(MAX_FIT_JSON).read_to_string(&mut text));
+    if read.is_err() {
+        return false;
+    }
+    let Ok(v) = serde_json::from_str::<serde_json::Value>(&text) else {
+        return false;
+    };
+    v["format"].is_u64()
+        && v["parameter"].is_string()
+        && v["provenance"]["errp_version"].is_string()
 }
 
 /// The log-likelihood panel of a fit's figure: each observation's curve
