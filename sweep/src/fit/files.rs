@@ -43,7 +43,7 @@ pub(crate) fn write_fit_files(
 /// the message ("a fit's", "a grid fit's").
 pub(crate) fn check_out(out: &Path, ours: impl Fn(&Path) -> bool, what: &str) -> Result<()> {
     if !out.exists() {
-        return Ok(());
+        return check_writable(out);
     }
     if !out.is_dir() {
         return Err(SimError::Sweep(format!(
@@ -70,7 +70,7 @@ pub(crate) fn check_out(out: &Path, ours: impl Fn(&Path) -> bool, what: &str) ->
         .take(6)
         .collect();
     if foreign.is_empty() {
-        return Ok(());
+        return check_writable(out);
     }
     foreign.sort();
     Err(SimError::Sweep(format!(
@@ -78,6 +78,25 @@ pub(crate) fn check_out(out: &Path, ours: impl Fn(&Path) -> bool, what: &str) ->
         out.display(),
         foreign.join(", ")
     )))
+}
+
+/// Checks, before the work, that the fit's files can be written into
+/// `out`: a temporary is created (and removed) in `out`, or in its nearest
+/// existing parent if `out` is still to be made.
+fn check_writable(out: &Path) -> Result<()> {
+    let mut at = out;
+    while !at.exists() {
+        match at.parent() {
+            Some(p) if !p.as_os_str().is_empty() => at = p,
+            _ => {
+                at = Path::new(".");
+                break;
+            }
+        }
+    }
+    errp_sim::PendingFile::create(at.join("write-probe"))
+        .map(drop)
+        .map_err(|e| SimError::Sweep(format!("--out {}: {e}", out.display())))
 }
 
 /// True if `path` is a `fit.json` that `errp fit` wrote: a regular file
