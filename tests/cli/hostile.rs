@@ -68,29 +68,45 @@ fn mkfifo(path: &Path) {
     assert!(status.success(), "mkfifo {}", path.display());
 }
 
+/// The arguments of shard `k` of 3 of one small oracle sweep, into `sK`.
+fn shard_args(k: usize) -> Vec<&'static str> {
+    const SHARDS: [&str; 3] = ["1/3", "2/3", "3/3"];
+    const OUTS: [&str; 3] = ["s1", "s2", "s3"];
+    vec![
+        "sweep",
+        "--scenario",
+        "go.toml",
+        "--accuracy",
+        "0.6,0.8",
+        "--episodes",
+        "10",
+        "--shard",
+        SHARDS[k - 1],
+        "--out",
+        OUTS[k - 1],
+        "--quiet",
+    ]
+}
+
 /// The three shards `s1 s2 s3` of one small oracle sweep, in `dir`.
 fn shards(dir: &Path) {
     for k in 1..=3 {
-        let shard = format!("{k}/3");
-        let out = format!("s{k}");
-        ok(&errp_within(
-            dir,
-            &[
-                "sweep",
-                "--scenario",
-                "go.toml",
-                "--accuracy",
-                "0.6,0.8",
-                "--episodes",
-                "10",
-                "--shard",
-                &shard,
-                "--out",
-                &out,
-                "--quiet",
-            ],
-            120,
-        ));
+        ok(&errp_within(dir, &shard_args(k), 120));
+    }
+}
+
+/// Writes a user's own `files` (path in `dir`, text), runs `args`, which
+/// must be refused naming every one of `says`, and checks the files are as
+/// they were.
+#[track_caller]
+fn refused_keeping(dir: &Path, files: &[(&str, &str)], args: &[&str], says: &[&str]) {
+    for (name, text) in files {
+        std::fs::write(dir.join(name), text).unwrap();
+    }
+    let e = exit_2(&errp_within(dir, args, 60));
+    assert!(says.iter().all(|s| e.contains(s)), "{e}");
+    for (name, text) in files {
+        assert_eq!(&std::fs::read_to_string(dir.join(name)).unwrap(), text);
     }
 }
 
@@ -121,35 +137,24 @@ fn merge_never_overwrites_a_users_files() {
     shards(&dir);
     let keep = dir.join("keep");
     std::fs::create_dir(&keep).unwrap();
-    std::fs::write(keep.join("episodes.csv"), "my,own,data\n").unwrap();
-    std::fs::write(keep.join("summary.csv"), "mine\n").unwrap();
-    let e = exit_2(&errp_within(
+    refused_keeping(
         &dir,
+        &[
+            ("keep/episodes.csv", "my,own,data\n"),
+            ("keep/summary.csv", "mine\n"),
+        ],
         &["merge", "s1", "s2", "s3", "--out", "keep"],
-        60,
-    ));
-    assert!(
-        e.contains("--out keep") && e.contains("episodes.csv"),
-        "{e}"
-    );
-    assert_eq!(
-        std::fs::read_to_string(keep.join("episodes.csv")).unwrap(),
-        "my,own,data\n"
-    );
-    assert_eq!(
-        std::fs::read_to_string(keep.join("summary.csv")).unwrap(),
-        "mine\n"
+        &["--out keep", "episodes.csv"],
     );
     assert_eq!(files_in(&keep), ["episodes.csv", "summary.csv"]);
     let other = dir.join("other");
     std::fs::create_dir(&other).unwrap();
-    std::fs::write(other.join("a.txt"), "x").unwrap();
-    let e = exit_2(&errp_within(
+    refused_keeping(
         &dir,
+        &[("other/a.txt", "x")],
         &["merge", "s1", "s2", "s3", "--out", "other"],
-        60,
-    ));
-    assert!(e.contains("a.txt"), "{e}");
+        &["a.txt"],
+    );
     assert_eq!(files_in(&other), ["a.txt"]);
     // An empty directory is fine.
     std::fs::create_dir(dir.join("empty")).unwrap();
@@ -515,24 +520,7 @@ fn resume_and_merge_refuse_other_decoders_and_other_versions() {
     ));
     assert!(e.contains("9.9.9") && e.contains("sweep.json"), "{e}");
     assert!(!dir.join("m").exists());
-    let e = exit_2(&errp_within(
-        &dir,
-        &[
-            "sweep",
-            "--scenario",
-            "go.toml",
-            "--accuracy",
-            "0.6,0.8",
-            "--episodes",
-            "10",
-            "--shard",
-            "1/3",
-            "--out",
-            "s1",
-            "--quiet",
-        ],
-        60,
-    ));
+    let e = exit_2(&errp_within(&dir, &shard_args(1), 60));
     assert!(e.contains("9.9.9"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -727,29 +715,17 @@ fn outputs_are_reserved_before_the_work_and_foreign_files_kept() {
             let _ = Command::new("chattr").arg("-i").arg(&theirs).status();
         }
     }
-    std::fs::write(dir.join("notes.rrd"), "my notes\n").unwrap();
-    let e = exit_2(&errp_within(
+    refused_keeping(
         &dir,
+        &[("notes.rrd", "my notes\n")],
         &["run", "go.toml", "--save", "notes.rrd"],
-        60,
-    ));
-    assert!(
-        e.contains("--save notes.rrd") && e.contains("not a Rerun recording"),
-        "{e}"
+        &["--save notes.rrd", "not a Rerun recording"],
     );
-    assert_eq!(
-        std::fs::read_to_string(dir.join("notes.rrd")).unwrap(),
-        "my notes\n"
-    );
-    std::fs::write(dir.join("mine.edf"), "not an EDF file\n").unwrap();
-    let e = exit_2(&errp_within(
+    refused_keeping(
         &dir,
+        &[("mine.edf", "not an EDF file\n")],
         &["calibrate", "--export", "mine.edf"],
-        60,
-    ));
-    assert!(
-        e.contains("--export mine.edf") && e.contains("not an EDF file"),
-        "{e}"
+        &["--export mine.edf", "not an EDF file"],
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -762,45 +738,8 @@ fn is_root() -> bool {
         .is_ok_and(|o| o.stdout.trim_ascii() == b"0")
 }
 
-/// Reproduction 14: SIGTERM while the decoders are prepared removes every directory the
-/// sweep made, parents included.
-#[test]
-fn a_signal_removes_the_parents_the_sweep_made() {
-    let dir = scratch("parents");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_errp"))
-        .args([
-            "sweep",
-            "--task",
-            "grid",
-            "--accuracy",
-            "0.6,0.7,0.8,0.9",
-            "--episodes",
-            "10",
-            "--no-cache",
-            "--out",
-            "newdir/sub",
-        ])
-        .current_dir(&dir)
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let lock = dir.join("newdir/sub/sweep.lock");
-    for waited in 0.. {
-        if lock.exists() {
-            break;
-        }
-        assert!(waited < 1200, "the sweep did not start within a minute");
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    std::thread::sleep(Duration::from_millis(300));
-    let _ = Command::new("kill")
-        .args(["-TERM", &child.id().to_string()])
-        .status();
-    assert_eq!(child.wait().unwrap().code(), Some(130));
-    assert!(!dir.join("newdir").exists(), "{:?}", files_in(&dir));
-    let _ = std::fs::remove_dir_all(&dir);
-}
+// Reproduction 14 (SIGTERM with `--out newdir/sub` left `newdir`) is held
+// by `reliability::a_signal_while_decoders_are_prepared_...`.
 
 /// Reproduction 16: A complete shard whose last row was written twice is mended by
 /// `--repair`, and then merges.
@@ -812,23 +751,10 @@ fn repair_drops_a_duplicated_last_row() {
     let text = std::fs::read_to_string(&csv).unwrap();
     let last = text.lines().last().unwrap().to_string();
     std::fs::write(&csv, format!("{text}{last}\n")).unwrap();
-    let args = [
-        "sweep",
-        "--scenario",
-        "go.toml",
-        "--accuracy",
-        "0.6,0.8",
-        "--episodes",
-        "10",
-        "--shard",
-        "1/3",
-        "--out",
-        "s1",
-        "--quiet",
-    ];
+    let args = shard_args(1);
     let e = exit_2(&errp_within(&dir, &args, 60));
     assert!(e.contains("extra") && e.contains("--repair"), "{e}");
-    let mut repair = args.to_vec();
+    let mut repair = args.clone();
     repair.push("--repair");
     ok(&errp_within(&dir, &repair, 60));
     assert_eq!(std::fs::read_to_string(&csv).unwrap(), text);

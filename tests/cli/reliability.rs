@@ -144,7 +144,8 @@ fn sigterm_stops_a_sweep_between_episodes_and_the_same_command_resumes() {
 #[test]
 fn a_signal_while_decoders_are_prepared_stops_at_once_and_leaves_nothing() {
     let dir = temp_dir("sweep-prepare-signal");
-    let out = dir.join("out");
+    // Two directories to make: both go (a hostile user's reproduction 14).
+    let out = dir.join("newdir").join("sub");
     // The grid's EEG decoders: several seconds of calibration per level.
     let mut child = spawn(&[
         "sweep",
@@ -163,9 +164,9 @@ fn a_signal_while_decoders_are_prepared_stops_at_once_and_leaves_nothing() {
     signal(&child, "INT");
     let status = child.wait().unwrap();
     assert_eq!(status.code(), Some(130));
-    // Stopped before any episode: the directory it made, its lock and its
+    // Stopped before any episode: the directories it made, its lock and its
     // temporaries are gone.
-    assert!(!out.exists(), "{:?}", files_in(&out));
+    assert!(!dir.join("newdir").exists(), "{:?}", files_in(&dir));
     let _ = std::fs::remove_dir_all(&dir);
 }
 
