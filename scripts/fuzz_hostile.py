@@ -351,7 +351,6 @@ def run_case(errp, base, case, gib, limit_memory, signal_at=None):
             p.wait()
             return f"{case.label}: no answer within 120 s: {case.command()}", None
         stderr_text = err_path.read_text() if err_path.exists() else ""
-        p.stdout_text = text
         p.stdout = text  # for the checks
         why = None
         if p.returncode not in case.expect and not (signal_at is not None

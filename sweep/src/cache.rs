@@ -4,7 +4,9 @@
 //!
 //! A cache entry is a small JSON file named by a hash of the full request,
 //! which it also stores and compares on read: an entry for another request
-//! is never used. An unreadable entry is searched again and rewritten.
+//! is never used. An unreadable entry, or one whose ratio does not give
+//! back the accuracy it records when evaluated again, is searched again and
+//! rewritten.
 
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
