@@ -184,3 +184,32 @@ pub(crate) fn calibration_progress(quiet: bool) -> impl FnMut(&TargetingStep) {
         }
     }
 }
+
+/// Arguments of `errp inspect`.
+#[derive(clap::Args)]
+pub(crate) struct InspectArgs {
+    /// Recordings made by `errp run --save` or the Python package's
+    /// `save=`. With two or more, a summary side by side.
+    #[arg(required = true, num_args = 1..=16)]
+    pub(crate) files: Vec<PathBuf>,
+    /// Write the tidy tables (runs, trajectory, detections, belief, errps,
+    /// events; for the grid runs, actions, belief, visits) as CSV files
+    /// into this directory (one subdirectory per file when several).
+    #[arg(long, value_name = "DIR")]
+    pub(crate) csv: Option<PathBuf>,
+    /// Draw the paper's Fig. 5 (e-puck: the arena, every run's path faint,
+    /// one in blue with red marks at its detections) or Fig. 4 (grid: visit
+    /// frequencies and paths) into FILE.png or FILE.svg (one recording).
+    #[arg(long, value_name = "FILE")]
+    pub(crate) figure: Option<PathBuf>,
+    /// The run drawn in full in the figure, from 1.
+    #[arg(long, value_name = "K", default_value_t = 1)]
+    pub(crate) run: usize,
+    /// Print the scenario as it was run (TOML) and nothing else, e.g. to
+    /// run it again: `errp inspect F.rrd --scenario > s.toml`.
+    #[arg(long, conflicts_with_all = ["provenance", "csv", "figure"])]
+    pub(crate) scenario: bool,
+    /// Print the provenance document (JSON) and nothing else.
+    #[arg(long, conflicts_with_all = ["csv", "figure"])]
+    pub(crate) provenance: bool,
+}

@@ -12,7 +12,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use crate::cli::{CalibrateArgs, RunArgs, Table1Args};
+use crate::cli::{CalibrateArgs, InspectArgs, RunArgs, Table1Args};
 use crate::commands::{calibrate, fit, run, sweep, table1};
 use crate::out::errln;
 
@@ -56,6 +56,10 @@ enum Command {
     /// likelihoods.
     #[command(subcommand)]
     Fit(fit::FitCommand),
+    /// Read recordings back: what a `.rrd` holds and how to make it again,
+    /// each run recomputed from it (the table `errp run` printed), tidy CSV
+    /// tables, and the paper's Fig. 5 (e-puck) or Fig. 4 (grid).
+    Inspect(InspectArgs),
 }
 
 fn main() -> ExitCode {
@@ -67,6 +71,14 @@ fn main() -> ExitCode {
         Command::Table1(args) => table1::table1(&args),
         Command::Subjects => calibrate::print_subjects(),
         Command::Merge(args) => sweep::merge(&args),
+        #[cfg(feature = "rerun")]
+        Command::Inspect(args) => commands::inspect::inspect(&args),
+        #[cfg(not(feature = "rerun"))]
+        Command::Inspect(_) => Err(anyhow::anyhow!(
+            "errp inspect reads recordings with the Rerun crates, which this errp was built \
+             without (cargo's --no-default-features); rebuild it with the default features \
+             (`cargo build --release`)"
+        )),
         Command::Fit(cmd) => match fit::fit(&cmd) {
             Ok(true) => Ok(()),
             Ok(false) => return ExitCode::from(interrupt::EXIT_INTERRUPTED),

@@ -95,6 +95,39 @@ impl ScenarioSource {
     }
 }
 
+impl ScenarioSource {
+    /// The scenario's text as run: with `overrides` set (for recordings).
+    pub(crate) fn text_as_run(&self, overrides: &[(String, toml::Value)]) -> PyResult<String> {
+        let pairs: Vec<(&str, toml::Value)> = overrides
+            .iter()
+            .map(|(k, v)| (k.as_str(), v.clone()))
+            .collect();
+        match self {
+            ScenarioSource::File(p) => errp_sim::read_scenario(p)
+                .and_then(|text| errp_sim::scenario_text_with(&text, p, &pairs)),
+            ScenarioSource::BuiltIn(text, name) => {
+                errp_sim::scenario_text_with(text, Path::new(name), &pairs)
+            }
+        }
+        .map_err(py_err)
+    }
+}
+
+/// The text as run of the scenario [`load_any`] loads with the same
+/// arguments.
+pub(crate) fn load_any_text(
+    scenario: Option<PathBuf>,
+    default_epuck: bool,
+    accuracy: Option<f64>,
+    given: Option<&Bound<'_, PyDict>>,
+) -> PyResult<String> {
+    let mut extra = Vec::new();
+    if let Some(a) = accuracy {
+        extra.push(("user.accuracy".to_string(), toml::Value::Float(a)));
+    }
+    ScenarioSource::new(scenario, default_epuck).text_as_run(&overrides(extra, given)?)
+}
+
 /// `overrides={"control.tau": 0.5, ...}` as scenario keys and TOML values,
 /// in the dictionary's order; `extra` (from the keyword arguments) first.
 pub(crate) fn overrides(

@@ -11,6 +11,8 @@
 
 mod convert;
 mod env;
+#[cfg(feature = "rerun")]
+mod inspect;
 mod run;
 mod session;
 mod tasks;
@@ -24,6 +26,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run::run, m)?)?;
     m.add_function(wrap_pyfunction!(run::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(run::episode_columns, m)?)?;
+    #[cfg(feature = "rerun")]
+    m.add_function(wrap_pyfunction!(inspect::read_recording, m)?)?;
     m.add_class::<session::EegGenerator>()?;
     m.add_class::<tasks::GridTask>()?;
     m.add_class::<tasks::EpuckTask>()?;

@@ -20,7 +20,7 @@ use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{load_any, py_err, value_error};
+use crate::convert::{load_any, load_any_text, py_err, value_error};
 
 /// Keyword names in errors.
 const NAMES: InputNames = InputNames {
@@ -101,6 +101,10 @@ pub(crate) fn run<'py>(
     save: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyDict>> {
     check_save(save.as_ref())?;
+    let text = match &save {
+        Some(_) => load_any_text(scenario.clone(), true, accuracy, overrides)?,
+        None => String::new(),
+    };
     let any = load_any(scenario, true, accuracy, overrides)?;
     let out = PyDict::new(py);
     match any {
@@ -114,7 +118,9 @@ pub(crate) fn run<'py>(
             if let Some(seed) = seed {
                 s.seed = seed;
             }
-            let (csv, info) = py.detach(|| run_grid(&s, save.as_ref())).map_err(py_err)?;
+            let (csv, info) = py
+                .detach(|| run_grid(&s, save.as_ref(), text))
+                .map_err(py_err)?;
             out.set_item("task", "grid")?;
             out.set_item("csv", csv)?;
             out.set_item("decoder", info)?;
@@ -140,7 +146,9 @@ pub(crate) fn run<'py>(
                     "at most 100 with save= (each run adds about 2.5 MB to the recording)",
                 ));
             }
-            let (csv, info) = py.detach(|| run_epuck(&s, save.as_ref())).map_err(py_err)?;
+            let (csv, info) = py
+                .detach(|| run_epuck(&s, save.as_ref(), text))
+                .map_err(py_err)?;
             out.set_item("task", "epuck")?;
             out.set_item("csv", csv)?;
             out.set_item("decoder", info)?;
@@ -207,9 +215,24 @@ pub(crate) fn epuck_summary(
     info
 }
 
+/// The provenance of a recording made from Python.
+#[cfg(feature = "rerun")]
+pub(crate) fn provenance(
+    task: &str,
+    name: &str,
+    text: String,
+    seed: u64,
+    call: &str,
+) -> errp_sim::record::data::Provenance {
+    let mut p = errp_sim::record::data::Provenance::new(task, name, text, seed);
+    p.command = vec![format!("python: {call}")];
+    p
+}
+
 fn run_grid(
     s: &GridScenario,
     save: Option<&PathBuf>,
+    text: String,
 ) -> errp_sim::Result<(String, DecoderSummary)> {
     #[cfg(feature = "rerun")]
     let rrd = match save {
@@ -217,7 +240,7 @@ fn run_grid(
         None => None,
     };
     #[cfg(not(feature = "rerun"))]
-    let _ = save;
+    let _ = (save, &text);
     let (decoder, calibration) = prepare_decoder(s, |_| {})?;
     let episodes = run_grid_scenario(s, &decoder, save.is_some(), |_, _| {})?;
     let mut lines = vec![header(&GridTask::INFO)];
@@ -233,7 +256,8 @@ fn run_grid(
             calibration,
             episodes,
         };
-        errp_sim::grid::record_grid_run(file, &report)?;
+        let p = provenance("grid", &s.name, text, s.seed, "errp.run");
+        errp_sim::grid::record_grid_run(file, &report, &p)?;
     }
     Ok((lines.join("\n") + "\n", info))
 }
@@ -241,6 +265,7 @@ fn run_grid(
 fn run_epuck(
     s: &EpuckScenario,
     save: Option<&PathBuf>,
+    text: String,
 ) -> errp_sim::Result<(String, DecoderSummary)> {
     #[cfg(feature = "rerun")]
     let rrd = match save {
@@ -248,11 +273,14 @@ fn run_epuck(
         None => None,
     };
     #[cfg(not(feature = "rerun"))]
-    let _ = save;
+    let _ = (save, &text);
     let (decoder, report) = errp_sim::epuck::prepare_continuous_decoder(s, |_| {})?;
     #[cfg(feature = "rerun")]
     let results = match &rrd {
-        Some(file) => errp_sim::epuck::record_epuck_runs(file, s, &decoder)?,
+        Some(file) => {
+            let p = provenance("epuck", &s.name, text, s.seed, "errp.run");
+            errp_sim::epuck::record_epuck_runs(file, s, &decoder, &p)?
+        }
         None => errp_sim::epuck::run_epuck_batch(s, &decoder, s.runs)?,
     };
     #[cfg(not(feature = "rerun"))]

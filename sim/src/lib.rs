@@ -11,7 +11,9 @@
 //! - [`epuck`]: the continuous e-puck task (sec. 5);
 //! - [`calibration`]: the button-locked calibration session of the grid task
 //!   and `errp calibrate`;
-//! - [`record`]: `.rrd` files and the timelines they share;
+//! - [`record`]: `.rrd` files, the timelines they share, and the data
+//!   tables and provenance every recording carries;
+//! - [`inspect`]: recordings read back, each run recomputed from them;
 //! - [`task`]: what a Monte Carlo driver (the sweep) needs of a task;
 //! - at the top: scenario files of either task, the paper's numbers,
 //!   statistics, atomic output files, the host and process behind files
@@ -25,6 +27,8 @@ mod error;
 mod files;
 pub mod grid;
 pub mod host;
+#[cfg(feature = "rerun")]
+pub mod inspect;
 mod output;
 mod paper;
 #[cfg(feature = "rerun")]
@@ -45,7 +49,7 @@ pub use output::{
 pub use paper::{PAPER, PAPER_EPUCK, PAPER_POOLED};
 pub use scenario::{
     AnyScenario, is_epuck, load_scenario, load_scenario_with, parse_scenario, parse_scenario_table,
-    parse_scenario_with,
+    parse_scenario_with, scenario_text_with,
 };
 pub use scenario_file::{
     MAX_KEY_PARTS, MAX_SCENARIO_BYTES, parse_toml, read_scenario, set_key, table_into, truncate,

@@ -3,6 +3,8 @@
 
 use std::path::Path;
 
+pub mod data;
+
 use rerun::{RecordingStream, RecordingStreamBuilder, blueprint::Blueprint};
 
 use crate::error::{Result, SimError};

@@ -53,6 +53,26 @@ pub fn parse_scenario_with(
     if overrides.is_empty() {
         return parse_scenario(text, path);
     }
+    parse_scenario_table(&overridden(text, path, overrides)?, path)
+}
+
+/// A scenario's text as run: `text` with `overrides` set as
+/// [`parse_scenario_with`] sets them (the text itself when there are none),
+/// for recordings that say how they were made.
+pub fn scenario_text_with(
+    text: &str,
+    path: &Path,
+    overrides: &[(&str, toml::Value)],
+) -> Result<String> {
+    if overrides.is_empty() {
+        return Ok(text.to_string());
+    }
+    toml::to_string(&overridden(text, path, overrides)?)
+        .map_err(|e| SimError::Scenario(format!("{}: {e}", path.display())))
+}
+
+/// The TOML table of `text` with `overrides` set.
+fn overridden(text: &str, path: &Path, overrides: &[(&str, toml::Value)]) -> Result<toml::Table> {
     let mut table: toml::Table = parse_toml(text, path)?;
     for (key, value) in overrides {
         if *key == "user.accuracy"
@@ -65,7 +85,7 @@ pub fn parse_scenario_with(
         set_key(&mut table, key, value.clone())
             .map_err(|e| SimError::Scenario(format!("{}: {key}: {e}", path.display())))?;
     }
-    parse_scenario_table(&table, path)
+    Ok(table)
 }
 
 /// Validates a scenario of either task given as a TOML table (a file's with

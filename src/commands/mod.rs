@@ -2,6 +2,8 @@
 
 pub(crate) mod calibrate;
 pub(crate) mod fit;
+#[cfg(feature = "rerun")]
+pub(crate) mod inspect;
 pub(crate) mod run;
 pub(crate) mod sweep;
 pub(crate) mod table1;

@@ -72,6 +72,15 @@ pub(crate) fn run(args: &RunArgs) -> Result<()> {
     }
     let scenario = load_scenario_with(&args.scenario, &overrides)?;
     check_save(args.save.as_deref())?;
+    // What a recording says it ran: the file with the overrides set.
+    let text = match &args.save {
+        Some(_) => errp_sim::scenario_text_with(
+            &errp_sim::read_scenario(&args.scenario)?,
+            &args.scenario,
+            &overrides,
+        )?,
+        None => String::new(),
+    };
     if let (AnyScenario::Epuck(s), Some(_)) = (&scenario, &args.save) {
         let runs = args.runs.map_or(s.runs, |r| r as usize);
         if runs > MAX_RECORDED_RUNS {
@@ -104,7 +113,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<()> {
                     args.scenario.display()
                 );
             }
-            run_grid(args, *s)
+            run_grid(args, *s, text)
         }
         AnyScenario::Epuck(s) => {
             if args.decoder.is_some() || args.eeg.is_some() {
@@ -113,12 +122,28 @@ pub(crate) fn run(args: &RunArgs) -> Result<()> {
                      the streamed EEG through the sliding-window SVM"
                 );
             }
-            run_epuck(args, *s)
+            run_epuck(args, *s, text)
         }
     }
 }
 
-pub(crate) fn run_grid(args: &RunArgs, mut scenario: GridScenario) -> Result<()> {
+/// The provenance of a recording of `task` by this command.
+#[cfg(feature = "rerun")]
+fn provenance(
+    task: &str,
+    name: &str,
+    text: String,
+    seed: u64,
+    decoder_summary: String,
+) -> errp_sim::record::data::Provenance {
+    let mut p = errp_sim::record::data::Provenance::new(task, name, text, seed);
+    p.commit = crate::commands::fit::COMMIT.to_string();
+    p.command = std::env::args().collect();
+    p.decoder_summary = decoder_summary;
+    p
+}
+
+pub(crate) fn run_grid(args: &RunArgs, mut scenario: GridScenario, text: String) -> Result<()> {
     if let Some(seed) = args.seed {
         scenario.seed = seed;
     }
@@ -144,16 +169,20 @@ pub(crate) fn run_grid(args: &RunArgs, mut scenario: GridScenario) -> Result<()>
     }
     let (decoder, calibration) = prepare_decoder(&scenario, calibration_progress(quiet))
         .context("calibrating the decoder")?;
-    if let Some(c) = &calibration {
-        outln!(
+    let decoder_summary = match &calibration {
+        Some(c) => format!(
             "Decoder calibrated on 400 actions: mean accuracy {:.2} % on held-out epochs (the \
-             target; correct {:.2} %, error {:.2} %), {:.2} % cross-validated",
+             target; correct {:.2} %, error {:.2} %), {:.2} % cross-validated\n",
             100.0 * c.targeting.accuracy.mean(),
             100.0 * c.targeting.accuracy.correct,
             100.0 * c.targeting.accuracy.error,
             100.0 * c.calibrated.accuracy.mean()
-        )?;
-    }
+        ),
+        None => String::new(),
+    };
+    out!("{decoder_summary}")?;
+    #[cfg(not(feature = "rerun"))]
+    let _ = (text, &decoder_summary);
     outln!("{GridEpisodeHeader}")?;
     // A standard output that fails stops nothing here (the episodes run
     // on); the first failure is the command's.
@@ -172,12 +201,19 @@ pub(crate) fn run_grid(args: &RunArgs, mut scenario: GridScenario) -> Result<()>
     out!("{report}")?;
     #[cfg(feature = "rerun")]
     if let Some(file) = rrd {
-        crate::save::wrote(&errp_sim::grid::record_grid_run(file, &report).context("--save")?)?;
+        let p = provenance(
+            "grid",
+            &report.scenario.name,
+            text,
+            report.scenario.seed,
+            decoder_summary,
+        );
+        crate::save::wrote(&errp_sim::grid::record_grid_run(file, &report, &p).context("--save")?)?;
     }
     Ok(())
 }
 
-pub(crate) fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<()> {
+pub(crate) fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario, text: String) -> Result<()> {
     if let Some(seed) = args.seed {
         scenario.reseed(seed);
     }
@@ -223,26 +259,39 @@ pub(crate) fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario) -> Result<(
     )
     .context("calibrating the continuous decoder")?;
     let acc = report.calibrated.accuracy;
-    outln!(
+    let mut decoder_summary = format!(
         "SVM decoder calibrated on {} error + {} correct button-locked examples: correct {:.2} %, \
-         error {:.2} %, mean {:.2} % (cross-validated); {} support vectors",
+         error {:.2} %, mean {:.2} % (cross-validated); {} support vectors\n",
         acc.n_error,
         acc.n_correct,
         100.0 * acc.correct,
         100.0 * acc.error,
         100.0 * acc.mean(),
         decoder.model.n_support()
-    )?;
+    );
     if let Some(online) = &decoder.online {
-        out!("{online}")?;
+        decoder_summary.push_str(&online.to_string());
     }
+    out!("{decoder_summary}")?;
     #[cfg(feature = "rerun")]
     let recorded = match &rrd {
-        Some(file) => Some(record_epuck_runs(file, &scenario, &decoder)?),
+        Some(file) => {
+            let p = provenance(
+                "epuck",
+                &scenario.name,
+                text,
+                scenario.seed,
+                decoder_summary,
+            );
+            Some(record_epuck_runs(file, &scenario, &decoder, &p)?)
+        }
         None => None,
     };
     #[cfg(not(feature = "rerun"))]
-    let recorded = None;
+    let recorded = {
+        let _ = (text, decoder_summary);
+        None
+    };
     let results = match recorded {
         Some(results) => results,
         None => {

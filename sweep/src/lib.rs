@@ -40,8 +40,8 @@ pub use manifest::{EPISODES, FORMAT, MANIFEST, MAX_MANIFEST_BYTES, Manifest};
 pub use merge::merge_sweeps;
 pub use observer::SweepObserver;
 pub use plot::{
-    Curve, CurvePoint, FitPanel, FitPlot, LevelPoint, PaperPoint, PlotError, Series, SweepPlot,
-    fit_png, fit_svg,
+    ArenaPlot, Curve, CurvePoint, FitPanel, FitPlot, GridPlot, LevelPoint, PaperPoint, PlotError,
+    RunPath, Series, SweepPlot, arena_png, arena_svg, fit_png, fit_svg, grid_png, grid_svg,
 };
 pub use rows::{CHECKSUM, episodes_header};
 pub use run::{MAX_DECODER_BYTES, SweepOptions, SweepOutcome, prepare_sweep, run_sweep};

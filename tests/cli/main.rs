@@ -4,6 +4,7 @@
 
 mod commands;
 mod hostile;
+mod inspect;
 mod reliability;
 
 use std::path::{Path, PathBuf};

@@ -91,6 +91,33 @@ pub struct PhysicsFrame {
     pub tracked: Pose,
     /// Wheel speeds actually applied (after avoidance and noise).
     pub wheels: WheelSpeeds,
+    /// What the controller was doing during the step: 0 turning, 1 driving,
+    /// 2 stopped ([`PHASE_NAMES`]).
+    pub phase: usize,
+    /// The goal the robot heads for.
+    pub target: usize,
+}
+
+/// The names of [`WindowFrame::step`], in index order.
+pub const STEP_NAMES: [&str; 4] = ["turn", "linear", "stop-on-goal", "idle"];
+
+/// The names of [`PhysicsFrame::phase`], in index order.
+pub const PHASE_NAMES: [&str; 3] = ["turning", "driving", "stopped"];
+
+/// What an observer learns when an episode starts: what is needed to score
+/// it again from what it observes.
+#[derive(Debug, Clone, Copy)]
+pub struct EpisodeStart {
+    /// The true pose at time 0.
+    pub pose: Pose,
+    /// The user's goal.
+    pub goal: usize,
+    /// The detector's threshold T_e on p(error).
+    pub t_e: f64,
+    /// Lags after an ErrP within which a detection counts as true (s).
+    pub detection_span: (f64, f64),
+    /// Lags after an ErrP within which a window scores as an error window (s).
+    pub window_span: (f64, f64),
 }
 
 /// One decoder window, for observers.
@@ -109,6 +136,10 @@ pub struct WindowFrame {
     /// Whether the detector reported an error that the controller used (in
     /// motion it stops the robot; on a goal it vetoes the goal).
     pub detected: bool,
+    /// The controller's update on this window ([`STEP_NAMES`]): 0 a turn
+    /// step (eq. 6), 1 a linear step (eq. 7), 2 stopped on a goal, 3 idle
+    /// (stopped after a detection: no update, and not error-free time).
+    pub step: usize,
     /// The tracked pose the controller used.
     pub tracked: Pose,
     /// Preprocessed FCz and Cz samples of the last 62.5 ms (uV).
@@ -129,6 +160,14 @@ pub trait EpuckObserver {
     fn on_window(&mut self, _frame: &WindowFrame) {}
     /// A notable event, in words.
     fn on_event(&mut self, _time_secs: f64, _text: &str, _warn: bool) {}
+    /// Before the first step.
+    fn on_start(&mut self, _start: &EpisodeStart) {}
+    /// The user produced an ErrP at `onset_secs`, seen at `time_secs`,
+    /// judging a move in phase `phase` ([`PHASE_NAMES`]).
+    fn on_errp(&mut self, _time_secs: f64, _onset_secs: f64, _phase: usize) {}
+    /// The episode ended at `time_secs`, converged on `committed` or timed
+    /// out (`None`).
+    fn on_end(&mut self, _time_secs: f64, _committed: Option<usize>) {}
 }
 
 impl EpuckObserver for () {
@@ -279,6 +318,13 @@ pub fn run_epuck_episode_with(
 
     let watching = observer.watches();
     if watching {
+        observer.on_start(&EpisodeStart {
+            pose: world.pose(),
+            goal: episode.goal,
+            t_e,
+            detection_span: (span.from_secs, span.to_secs),
+            window_span: (window_span.from_secs, window_span.to_secs),
+        });
         let goal_name = &layout.goals()[episode.goal].name;
         observer.on_event(0.0, &format!("the user wants {goal_name}"), false);
     }
@@ -306,7 +352,11 @@ pub fn run_epuck_episode_with(
         for _ in 0..STEPS_PER_WINDOW {
             if let Some(e) = user.observe(time_secs, &tracked) {
                 if e.kind == AssessmentKind::Error {
-                    errps.push((e.onset_secs, phase_index(controller.phase())));
+                    let phase = phase_index(controller.phase());
+                    errps.push((e.onset_secs, phase));
+                    if watching {
+                        observer.on_errp(time_secs, e.onset_secs, phase);
+                    }
                 }
                 eeg.schedule(e.onset_secs, e.kind);
                 if watching && e.kind == AssessmentKind::Error {
@@ -339,6 +389,8 @@ pub fn run_epuck_episode_with(
                     pose,
                     tracked,
                     wheels: applied,
+                    phase: phase_index(controller.phase()),
+                    target: controller.target(),
                 });
             }
         }
@@ -427,6 +479,12 @@ pub fn run_epuck_episode_with(
                 belief: controller.belief().probabilities(),
                 target: controller.target(),
                 detected,
+                step: match obs.step {
+                    StepKind::Turn { .. } => 0,
+                    StepKind::Linear => 1,
+                    StepKind::StopOnGoal(_) => 2,
+                    StepKind::Idle => 3,
+                },
                 tracked,
                 fcz_cz: [
                     fresh.channel(fcz_cz[0]).to_vec(),
@@ -454,6 +512,9 @@ pub fn run_epuck_episode_with(
     }
     if committed.is_none() {
         observer.on_event(time_secs, "time-out: no convergence", true);
+    }
+    if watching {
+        observer.on_end(time_secs, committed);
     }
 
     // ErrPs whose detection span closed within the episode, and those of

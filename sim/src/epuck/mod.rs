@@ -22,9 +22,9 @@ pub use decoder::{
 };
 pub use environment::{EpuckAction, EpuckEnvironment, EpuckFeedback, MAX_WINDOWS_PER_ACTION};
 pub use episode::{
-    EpuckEpisode, EpuckEpisodeResult, EpuckObserver, EpuckTaskParams, PHYSICS_DT_SECS,
-    PhysicsFrame, WINDOW_STEP_SECS, WindowDecoder, WindowFrame, run_epuck_episode,
-    run_epuck_episode_with,
+    EpisodeStart, EpuckEpisode, EpuckEpisodeResult, EpuckObserver, EpuckTaskParams, PHASE_NAMES,
+    PHYSICS_DT_SECS, PhysicsFrame, STEP_NAMES, WINDOW_STEP_SECS, WindowDecoder, WindowFrame,
+    run_epuck_episode, run_epuck_episode_with,
 };
 pub use errp_robot::AvoidanceParams;
 pub use report::{EpuckRunHeader, EpuckRunRow, EpuckSummaryReport};

@@ -17,11 +17,14 @@ use rerun::{
 };
 
 use crate::epuck::decoder::ContinuousDecoder;
-use crate::epuck::episode::{EpuckEpisodeResult, EpuckObserver, PhysicsFrame, WindowFrame};
+use crate::epuck::episode::{
+    EpisodeStart, EpuckEpisodeResult, EpuckObserver, PhysicsFrame, WindowFrame,
+};
 use crate::epuck::run::run_epuck_once;
 use crate::epuck::scenario::EpuckScenario;
 use crate::epuck::world::{ArenaSpec, Obstacle};
 use crate::error::{Result, SimError};
+use crate::record::data::{self, Column, Provenance, send_table};
 use crate::record::{
     RrdFile, SIM_TIME, eeg_channel, log_decoder_series, paths, record_error, task_blueprint,
 };
@@ -85,6 +88,41 @@ pub struct EpuckRecorder<'a> {
     steps: usize,
     last_secs: f64,
     error: Option<SimError>,
+    /// The run being recorded (from 0) and its seed.
+    run: usize,
+    seed: u64,
+    tables: RunTables,
+}
+
+/// One run's rows of the data tables ([`crate::record::data`]), sent when
+/// the run ends.
+#[derive(Default)]
+struct RunTables {
+    start: Option<EpisodeStart>,
+    end: Option<(f64, Option<usize>)>,
+    // Frames.
+    f_t: Vec<f64>,
+    f_xy: Vec<[f64; 2]>,
+    f_heading: Vec<f64>,
+    f_tracked: Vec<[f64; 2]>,
+    f_phase: Vec<i64>,
+    f_target: Vec<i64>,
+    // Windows.
+    w_t: Vec<f64>,
+    w_p: Vec<f64>,
+    w_evidence: Vec<f64>,
+    w_detected: Vec<bool>,
+    w_step: Vec<i64>,
+    w_target: Vec<i64>,
+    w_belief: Vec<f64>,
+    // ErrPs.
+    e_t: Vec<f64>,
+    e_onset: Vec<f64>,
+    e_phase: Vec<i64>,
+    // Events.
+    v_t: Vec<f64>,
+    v_warn: Vec<bool>,
+    v_text: Vec<String>,
 }
 
 impl<'a> EpuckRecorder<'a> {
@@ -151,15 +189,22 @@ impl<'a> EpuckRecorder<'a> {
             steps: 0,
             last_secs: 0.0,
             error: None,
+            run: 0,
+            seed: 0,
+            tables: RunTables::default(),
         })
     }
 
-    /// Starts the next run after the previous one on the timeline.
-    pub fn next_run(&mut self, start_goal_and_user: &str) {
+    /// Starts the next run, with `seed`, after the previous one on the
+    /// timeline; `start_goal_and_user` opens its log.
+    pub fn next_run(&mut self, start_goal_and_user: &str, seed: u64) {
         if self.steps > 0 {
+            self.send_tables();
             self.offset_secs += self.last_secs + RUN_GAP_SECS;
             self.log_overview();
+            self.run += 1;
         }
+        self.seed = seed;
         self.trajectory.clear();
         self.detections.clear();
         self.steps = 0;
@@ -177,9 +222,134 @@ impl<'a> EpuckRecorder<'a> {
     /// any (logging goes on regardless).
     pub fn finish(mut self) -> Result<()> {
         if self.steps > 0 {
+            self.send_tables();
             self.log_overview();
         }
         self.error.map_or(Ok(()), Err)
+    }
+
+    /// Sends the run's data tables, one chunk each.
+    fn send_tables(&mut self) {
+        let t = std::mem::take(&mut self.tables);
+        let run = self.run as i64;
+        let off = self.offset_secs;
+        let on_timeline = |ts: &[f64]| ts.iter().map(|t| off + t).collect::<Vec<_>>();
+        let runs = |n: usize| Column::I64(vec![run; n]);
+        let cm = |v: f64| 100.0 * v;
+        if let Some(s) = t.start {
+            let r = send_table(
+                self.rec,
+                data::RUNS,
+                &[off],
+                vec![
+                    ("run", runs(1)),
+                    ("seed", Column::I64(vec![self.seed as i64])),
+                    ("goal", Column::I64(vec![s.goal as i64])),
+                    ("start_x", Column::F64(vec![cm(s.pose.x_m)])),
+                    ("start_y", Column::F64(vec![cm(s.pose.y_m)])),
+                    (
+                        "start_heading_deg",
+                        Column::F64(vec![s.pose.heading_rad.to_degrees()]),
+                    ),
+                    ("t_e", Column::F64(vec![s.t_e])),
+                    ("detection_from_s", Column::F64(vec![s.detection_span.0])),
+                    ("detection_to_s", Column::F64(vec![s.detection_span.1])),
+                    ("window_from_s", Column::F64(vec![s.window_span.0])),
+                    ("window_to_s", Column::F64(vec![s.window_span.1])),
+                ],
+            );
+            self.keep(r);
+        }
+        let n = t.f_t.len();
+        let r = send_table(
+            self.rec,
+            data::FRAMES,
+            &on_timeline(&t.f_t),
+            vec![
+                ("run", runs(n)),
+                ("t_s", Column::F64(t.f_t)),
+                (
+                    "x_cm",
+                    Column::F64(t.f_xy.iter().map(|p| cm(p[0])).collect()),
+                ),
+                (
+                    "y_cm",
+                    Column::F64(t.f_xy.iter().map(|p| cm(p[1])).collect()),
+                ),
+                ("heading_deg", Column::F64(t.f_heading)),
+                (
+                    "tracked_x_cm",
+                    Column::F64(t.f_tracked.iter().map(|p| cm(p[0])).collect()),
+                ),
+                (
+                    "tracked_y_cm",
+                    Column::F64(t.f_tracked.iter().map(|p| cm(p[1])).collect()),
+                ),
+                ("phase", Column::I64(t.f_phase)),
+                ("target", Column::I64(t.f_target)),
+            ],
+        );
+        self.keep(r);
+        let n = t.w_t.len();
+        let goals = self.layout.goals().len();
+        let r = send_table(
+            self.rec,
+            data::WINDOWS,
+            &on_timeline(&t.w_t),
+            vec![
+                ("run", runs(n)),
+                ("t_s", Column::F64(t.w_t)),
+                ("p_error", Column::F64(t.w_p)),
+                ("evidence", Column::F64(t.w_evidence)),
+                ("detected", Column::Bool(t.w_detected)),
+                ("step", Column::I64(t.w_step)),
+                ("target", Column::I64(t.w_target)),
+                ("belief", Column::F64Rows(t.w_belief, goals)),
+            ],
+        );
+        self.keep(r);
+        let n = t.e_t.len();
+        let r = send_table(
+            self.rec,
+            data::ERRPS,
+            &on_timeline(&t.e_t),
+            vec![
+                ("run", runs(n)),
+                ("t_s", Column::F64(t.e_t)),
+                ("onset_s", Column::F64(t.e_onset)),
+                ("phase", Column::I64(t.e_phase)),
+            ],
+        );
+        self.keep(r);
+        let n = t.v_t.len();
+        let r = send_table(
+            self.rec,
+            data::EVENTS,
+            &on_timeline(&t.v_t),
+            vec![
+                ("run", runs(n)),
+                ("t_s", Column::F64(t.v_t)),
+                ("warn", Column::Bool(t.v_warn)),
+                ("text", Column::Str(t.v_text)),
+            ],
+        );
+        self.keep(r);
+        if let Some((end, committed)) = t.end {
+            let r = send_table(
+                self.rec,
+                data::ENDS,
+                &[off + end],
+                vec![
+                    ("run", runs(1)),
+                    ("t_s", Column::F64(vec![end])),
+                    (
+                        "committed",
+                        Column::I64(vec![committed.map_or(-1, |c| c as i64)]),
+                    ),
+                ],
+            );
+            self.keep(r);
+        }
     }
 
     /// Adds the run that just ended to the static layer: its trajectory in
@@ -220,9 +390,31 @@ impl<'a> EpuckRecorder<'a> {
 }
 
 impl EpuckObserver for EpuckRecorder<'_> {
+    fn on_start(&mut self, start: &EpisodeStart) {
+        self.tables.start = Some(*start);
+    }
+
+    fn on_errp(&mut self, time_secs: f64, onset_secs: f64, phase: usize) {
+        let t = &mut self.tables;
+        t.e_t.push(time_secs);
+        t.e_onset.push(onset_secs);
+        t.e_phase.push(phase as i64);
+    }
+
+    fn on_end(&mut self, time_secs: f64, committed: Option<usize>) {
+        self.tables.end = Some((time_secs, committed));
+    }
+
     fn on_physics(&mut self, f: &PhysicsFrame) {
         self.steps += 1;
         self.last_secs = f.time_secs;
+        let t = &mut self.tables;
+        t.f_t.push(f.time_secs);
+        t.f_xy.push([f.pose.x_m, f.pose.y_m]);
+        t.f_heading.push(f.pose.heading_rad.to_degrees());
+        t.f_tracked.push([f.tracked.x_m, f.tracked.y_m]);
+        t.f_phase.push(f.phase as i64);
+        t.f_target.push(f.target as i64);
         if self.steps % TRAJECTORY_EVERY != 1 && self.steps > 1 {
             return;
         }
@@ -254,6 +446,14 @@ impl EpuckObserver for EpuckRecorder<'_> {
     }
 
     fn on_window(&mut self, f: &WindowFrame) {
+        let t = &mut self.tables;
+        t.w_t.push(f.time_secs);
+        t.w_p.push(f.p_error);
+        t.w_evidence.push(f.evidence);
+        t.w_detected.push(f.detected);
+        t.w_step.push(f.step as i64);
+        t.w_target.push(f.target as i64);
+        t.w_belief.extend_from_slice(&f.belief);
         self.at(f.time_secs);
         let r = self.rec.log(
             "arena/goals",
@@ -315,6 +515,10 @@ impl EpuckObserver for EpuckRecorder<'_> {
     }
 
     fn on_event(&mut self, time_secs: f64, text: &str, warn: bool) {
+        let t = &mut self.tables;
+        t.v_t.push(time_secs);
+        t.v_warn.push(warn);
+        t.v_text.push(text.to_string());
         self.at(time_secs);
         let r = self.rec.log(
             paths::LOG,
@@ -325,12 +529,18 @@ impl EpuckObserver for EpuckRecorder<'_> {
 }
 
 /// The runs of `scenario` one after another, each recorded into `file` as
-/// `errp run --save` records them.
+/// `errp run --save` records them, with `provenance` (its `runs` set here).
 pub fn record_epuck_runs(
     file: &RrdFile,
     scenario: &EpuckScenario,
     decoder: &ContinuousDecoder,
+    provenance: &Provenance,
 ) -> Result<Vec<EpuckEpisodeResult>> {
+    let mut provenance = provenance.clone();
+    provenance.runs = scenario.runs;
+    provenance
+        .log(file.stream())
+        .map_err(record_error(file.path()))?;
     let layout = &scenario.layout;
     let goal = &layout.goals()[scenario.episode.goal].name;
     let decoder_text = scenario.decoder_text();
@@ -342,10 +552,10 @@ pub fn record_epuck_runs(
     )?;
     let mut out = Vec::with_capacity(scenario.runs);
     for k in 0..scenario.runs {
-        recorder.next_run(&format!(
-            "run {}: the user wants {goal} ({decoder_text})",
-            k + 1
-        ));
+        recorder.next_run(
+            &format!("run {}: the user wants {goal} ({decoder_text})", k + 1),
+            crate::epuck::epuck_run_seed(scenario.seed, k),
+        );
         out.push(run_epuck_once(scenario, decoder, k, &mut recorder)?);
     }
     recorder.finish()?;

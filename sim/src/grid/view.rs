@@ -8,6 +8,7 @@ use rerun::{Boxes2D, Color, Image, Points2D, Scalars, SeriesLines, TextLog};
 
 use crate::error::Result;
 use crate::grid::run::GridRunReport;
+use crate::record::data::{self, Column, Provenance, send_table};
 use crate::record::{
     RrdFile, SIM_TIME, eeg_channel, log_decoder_series, paths, record_error, task_blueprint,
 };
@@ -57,11 +58,19 @@ fn heat_map(grid: &Grid, values: &[f64]) -> Image {
     Image::from_rgb24(rgb, [grid.width as u32, grid.height as u32])
 }
 
-/// Writes every episode of `report` (run with `record_steps`) to `file`.
-pub fn record_grid_run(file: RrdFile, report: &GridRunReport) -> Result<PathBuf> {
+/// Writes every episode of `report` (run with `record_steps`) to `file`,
+/// with `provenance` (its `runs` set here).
+pub fn record_grid_run(
+    file: RrdFile,
+    report: &GridRunReport,
+    provenance: &Provenance,
+) -> Result<PathBuf> {
     let path = file.path().to_path_buf();
     let rec = file.stream();
     let err = record_error(&path);
+    let mut provenance = provenance.clone();
+    provenance.runs = report.episodes.len();
+    provenance.log(rec).map_err(&err)?;
     let grid = Grid::paper();
     let fs = 256.0;
 
@@ -86,6 +95,7 @@ pub fn record_grid_run(file: RrdFile, report: &GridRunReport) -> Result<PathBuf>
 
     let mut t0 = 0.0;
     for (k, ep) in report.episodes.iter().enumerate() {
+        send_episode_tables(rec, &grid, k, t0, ep, &report.scenario).map_err(&err)?;
         rec.set_duration_secs(SIM_TIME, t0);
         rec.log(
             paths::LOG,
@@ -196,4 +206,95 @@ pub fn record_grid_run(file: RrdFile, report: &GridRunReport) -> Result<PathBuf>
         t0 = end + EPISODE_GAP_SECS;
     }
     file.finish()
+}
+
+/// Sends episode `k`'s data tables ([`crate::record::data`]), starting at
+/// `t0` on the timeline.
+fn send_episode_tables(
+    rec: &rerun::RecordingStream,
+    grid: &Grid,
+    k: usize,
+    t0: f64,
+    ep: &crate::grid::GridEpisodeResult,
+    scenario: &crate::grid::GridScenario,
+) -> std::result::Result<(), rerun::RecordingStreamError> {
+    let run = k as i64;
+    let runs = |n: usize| Column::I64(vec![run; n]);
+    let seed = errp_bci::rng::derive_seed(scenario.seed, "grid/episode", k as u64);
+    send_table(
+        rec,
+        data::RUNS,
+        &[t0],
+        vec![
+            ("run", runs(1)),
+            ("seed", Column::I64(vec![seed as i64])),
+            ("goal", Column::I64(vec![grid.index(ep.goal) as i64])),
+            ("start_x", Column::I64(vec![ep.start.x as i64])),
+            ("start_y", Column::I64(vec![ep.start.y as i64])),
+            ("goal_x", Column::I64(vec![ep.goal.x as i64])),
+            ("goal_y", Column::I64(vec![ep.goal.y as i64])),
+            ("epoch_s", Column::F64(vec![scenario.params.epoch_secs])),
+        ],
+    )?;
+    let steps = &ep.steps;
+    let n = steps.len();
+    let times: Vec<f64> = steps.iter().map(|s| t0 + s.onset_secs).collect();
+    let int = |f: &dyn Fn(&crate::grid::GridStep) -> usize| {
+        Column::I64(steps.iter().map(|s| f(s) as i64).collect())
+    };
+    send_table(
+        rec,
+        data::ACTIONS,
+        &times,
+        vec![
+            ("run", runs(n)),
+            (
+                "t_s",
+                Column::F64(steps.iter().map(|s| s.onset_secs).collect()),
+            ),
+            ("from_x", int(&|s| s.from.x)),
+            ("from_y", int(&|s| s.from.y)),
+            (
+                "action",
+                Column::Str(steps.iter().map(|s| s.action.name().to_string()).collect()),
+            ),
+            ("to_x", int(&|s| s.to.x)),
+            ("to_y", int(&|s| s.to.y)),
+            (
+                "error",
+                Column::Bool(steps.iter().map(|s| s.error).collect()),
+            ),
+            (
+                "p_error",
+                Column::F64(steps.iter().map(|s| s.p_error).collect()),
+            ),
+            (
+                "decoded_error",
+                Column::Bool(steps.iter().map(|s| s.decoded_error).collect()),
+            ),
+            (
+                "belief",
+                Column::F64Rows(
+                    steps
+                        .iter()
+                        .flat_map(|s| s.belief.iter().copied())
+                        .collect(),
+                    grid.n_cells(),
+                ),
+            ),
+        ],
+    )?;
+    send_table(
+        rec,
+        data::ENDS,
+        &[t0 + ep.total_secs],
+        vec![
+            ("run", runs(1)),
+            ("t_s", Column::F64(vec![ep.total_secs])),
+            (
+                "committed",
+                Column::I64(vec![ep.committed.map_or(-1, |c| grid.index(c) as i64)]),
+            ),
+        ],
+    )
 }

@@ -111,6 +111,8 @@ fn walls_never_let_the_robot_out_even_driven_blindly() {
             pose: world.pose(),
             tracked: world.pose(),
             wheels: Default::default(),
+            phase: 1,
+            target: 0,
         });
     }
     assert!(

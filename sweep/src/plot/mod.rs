@@ -26,6 +26,7 @@ mod fit;
 mod glyph_text;
 mod legend;
 mod panels;
+mod recording;
 mod series;
 
 use glyph_text::*;
@@ -36,6 +37,7 @@ pub use errp_sim::task::PaperPoint;
 pub use fit::{Curve, CurvePoint, FitPanel, FitPlot, fit_png, fit_svg};
 use legend::*;
 use panels::*;
+pub use recording::{ArenaPlot, GridPlot, RunPath, arena_png, arena_svg, grid_png, grid_svg};
 use series::*;
 
 /// DejaVu Sans (Bitstream Vera licence), used for every piece of text.

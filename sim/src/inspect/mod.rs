@@ -1,0 +1,562 @@
+//! Recordings read back: [`Recording::open`] decodes an `.rrd` that
+//! `errp run --save` (or the Python package) wrote, checks it, and
+//! recomputes every run's result from its data tables
+//! ([`crate::record::data`]): the same result types, so the same tables,
+//! as the run printed.
+
+use std::path::{Path, PathBuf};
+
+use errp_bci::Accuracy;
+use errp_robot::{Cell, Grid, GridAction};
+
+use crate::epuck::{EpuckEpisodeResult, EpuckScenario, PHYSICS_DT_SECS, WINDOW_STEP_SECS};
+use crate::grid::{GridEpisodeResult, GridScenario, GridStep};
+use crate::record::data::{self, Column, Provenance};
+use crate::scenario::AnyScenario;
+
+mod read;
+mod tables;
+
+pub use read::{MAX_RECORDING_BYTES, Table};
+pub use tables::{CsvTable, csv_tables};
+
+/// Why a recording cannot be read.
+#[derive(Debug, thiserror::Error)]
+pub enum InspectError {
+    /// The file cannot be opened or read.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The file is not a whole recording of errp of this format.
+    #[error("{}: {why}", path.display())]
+    Bad {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong, in words.
+        why: String,
+    },
+}
+
+/// The runs a recording holds, as the task's result types.
+#[derive(Debug, Clone)]
+pub enum Runs {
+    /// E-puck runs.
+    Epuck {
+        /// The scenario as run.
+        scenario: Box<EpuckScenario>,
+        /// One result per run.
+        results: Vec<EpuckEpisodeResult>,
+    },
+    /// Grid episodes (each with its steps, without EEG).
+    Grid {
+        /// The scenario as run.
+        scenario: Box<GridScenario>,
+        /// One result per episode.
+        results: Vec<GridEpisodeResult>,
+    },
+}
+
+/// A recording read back.
+#[derive(Debug, Clone)]
+pub struct Recording {
+    /// The file.
+    pub path: PathBuf,
+    /// How it was made.
+    pub provenance: Provenance,
+    /// Its data tables by entity path ([`crate::record::data`]).
+    pub tables: std::collections::BTreeMap<String, Table>,
+    /// Every run, recomputed from the tables.
+    pub runs: Runs,
+}
+
+impl Recording {
+    /// Reads and checks `path`, and recomputes its runs.
+    pub fn open(path: impl AsRef<Path>) -> Result<Self, InspectError> {
+        let path = path.as_ref();
+        let raw = read::read_raw(path)?;
+        let provenance = read::parse_provenance(path, &raw)?;
+        let bad = |why: String| InspectError::Bad {
+            path: path.to_path_buf(),
+            why,
+        };
+        let scenario = crate::parse_scenario(&provenance.scenario_text, Path::new("scenario"))
+            .map_err(|e| bad(format!("its scenario does not load: {e}")))?;
+        let tables = raw.tables;
+        let runs = match scenario {
+            AnyScenario::Epuck(s) => {
+                let results = epuck_results(&tables, &s).map_err(&bad)?;
+                Runs::Epuck {
+                    scenario: s,
+                    results,
+                }
+            }
+            AnyScenario::Grid(s) => {
+                let results = grid_results(&tables).map_err(&bad)?;
+                Runs::Grid {
+                    scenario: s,
+                    results,
+                }
+            }
+        };
+        let n = match &runs {
+            Runs::Epuck { results, .. } => results.len(),
+            Runs::Grid { results, .. } => results.len(),
+        };
+        if n != provenance.runs {
+            return Err(bad(format!(
+                "it holds {n} whole run(s) of the {} it was made with: it is truncated",
+                provenance.runs
+            )));
+        }
+        Ok(Self {
+            path: path.to_path_buf(),
+            provenance,
+            tables,
+            runs,
+        })
+    }
+
+    /// The number of runs.
+    pub fn n_runs(&self) -> usize {
+        self.provenance.runs
+    }
+}
+
+/// Typed access to a table's columns, with errors naming what is missing.
+struct View<'a> {
+    name: &'a str,
+    table: &'a Table,
+}
+
+impl<'a> View<'a> {
+    fn of(
+        tables: &'a std::collections::BTreeMap<String, Table>,
+        name: &'a str,
+    ) -> Result<Self, String> {
+        tables
+            .get(name)
+            .map(|table| Self { name, table })
+            .ok_or_else(|| format!("it has no table {name}"))
+    }
+
+    fn col(&self, c: &str) -> Result<&'a Column, String> {
+        let col = self
+            .table
+            .column(c)
+            .ok_or_else(|| format!("its table {} has no column `{c}`", self.name))?;
+        if col.len() != self.table.rows() {
+            return Err(format!(
+                "its table {} has columns of different lengths",
+                self.name
+            ));
+        }
+        Ok(col)
+    }
+
+    fn f64(&self, c: &str) -> Result<&'a [f64], String> {
+        match self.col(c)? {
+            Column::F64(v) => Ok(v),
+            _ => Err(format!("column `{c}` of {} is not numbers", self.name)),
+        }
+    }
+
+    fn i64(&self, c: &str) -> Result<&'a [i64], String> {
+        match self.col(c)? {
+            Column::I64(v) => Ok(v),
+            _ => Err(format!("column `{c}` of {} is not integers", self.name)),
+        }
+    }
+
+    fn bool(&self, c: &str) -> Result<&'a [bool], String> {
+        match self.col(c)? {
+            Column::Bool(v) => Ok(v),
+            _ => Err(format!("column `{c}` of {} is not flags", self.name)),
+        }
+    }
+
+    fn rows(&self, c: &str) -> Result<(&'a [f64], usize), String> {
+        match self.col(c)? {
+            Column::F64Rows(v, w) => Ok((v, *w)),
+            _ => Err(format!(
+                "column `{c}` of {} is not rows of numbers",
+                self.name
+            )),
+        }
+    }
+
+    /// The row indices of run `r` (runs are written in order).
+    fn run_rows(&self, runs: &[i64], r: usize) -> std::ops::Range<usize> {
+        let lo = runs.partition_point(|&x| x < r as i64);
+        let hi = runs.partition_point(|&x| x <= r as i64);
+        lo..hi
+    }
+}
+
+/// Checks that `runs` counts 0, 1, ... in order (each run's rows together).
+fn check_run_order(name: &str, runs: &[i64]) -> Result<(), String> {
+    if runs.windows(2).any(|w| w[1] < w[0]) || runs.first().is_some_and(|&r| r < 0) {
+        return Err(format!("its table {name} is not in run order"));
+    }
+    Ok(())
+}
+
+/// An index in `0..n`, or an error naming the column.
+fn index(v: i64, n: usize, what: &str) -> Result<usize, String> {
+    usize::try_from(v)
+        .ok()
+        .filter(|&i| i < n)
+        .ok_or_else(|| format!("{what} {v} is out of range (0 to {})", n.saturating_sub(1)))
+}
+
+/// The e-puck runs recomputed as `run_epuck_episode` scores them.
+fn epuck_results(
+    tables: &std::collections::BTreeMap<String, Table>,
+    scenario: &EpuckScenario,
+) -> Result<Vec<EpuckEpisodeResult>, String> {
+    let n_goals = scenario.layout.goals().len();
+    let runs = View::of(tables, data::RUNS)?;
+    let frames = View::of(tables, data::FRAMES)?;
+    let windows = View::of(tables, data::WINDOWS)?;
+    let ends = View::of(tables, data::ENDS)?;
+    let empty = Table::default();
+    let errps = tables.get(data::ERRPS).map_or(
+        View {
+            name: data::ERRPS,
+            table: &empty,
+        },
+        |table| View {
+            name: data::ERRPS,
+            table,
+        },
+    );
+    let run_col = runs.i64("run")?;
+    let f_run = frames.i64("run")?;
+    let w_run = windows.i64("run")?;
+    let e_run = if errps.table.rows() == 0 {
+        &[][..]
+    } else {
+        errps.i64("run")?
+    };
+    let end_run = ends.i64("run")?;
+    for (name, r) in [
+        (data::RUNS, run_col),
+        (data::FRAMES, f_run),
+        (data::WINDOWS, w_run),
+        (data::ERRPS, e_run),
+        (data::ENDS, end_run),
+    ] {
+        check_run_order(name, r)?;
+    }
+    let (f_t, f_x, f_y, f_h) = (
+        frames.f64("t_s")?,
+        frames.f64("x_cm")?,
+        frames.f64("y_cm")?,
+        frames.f64("heading_deg")?,
+    );
+    let (w_t, w_p, w_detected, w_step) = (
+        windows.f64("t_s")?,
+        windows.f64("p_error")?,
+        windows.bool("detected")?,
+        windows.i64("step")?,
+    );
+    let (belief, width) = windows.rows("belief")?;
+    if width != n_goals {
+        return Err(format!(
+            "its beliefs have {width} values, but the scenario has {n_goals} goals"
+        ));
+    }
+    let _ = belief;
+    let (e_t, e_onset, e_phase) = if errps.table.rows() == 0 {
+        (&[][..], &[][..], &[][..])
+    } else {
+        (
+            errps.f64("t_s")?,
+            errps.f64("onset_s")?,
+            errps.i64("phase")?,
+        )
+    };
+    let (end_t, end_committed) = (ends.f64("t_s")?, ends.i64("committed")?);
+    let goal = runs.i64("goal")?;
+    let (sx, sy, sh) = (
+        runs.f64("start_x")?,
+        runs.f64("start_y")?,
+        runs.f64("start_heading_deg")?,
+    );
+    let t_e = runs.f64("t_e")?;
+    let (d_from, d_to) = (runs.f64("detection_from_s")?, runs.f64("detection_to_s")?);
+    let (w_from, w_to) = (runs.f64("window_from_s")?, runs.f64("window_to_s")?);
+
+    let mut out = Vec::new();
+    for (k, &r) in run_col.iter().enumerate() {
+        if r != k as i64 {
+            return Err(format!("its table {} skips run {k}", data::RUNS));
+        }
+        let Some(e) = end_run.iter().position(|&x| x == r) else {
+            // A run without its end: the recording stopped in it.
+            break;
+        };
+        let span = errp_bci::ResponseSpan {
+            from_secs: d_from[k],
+            to_secs: d_to[k],
+        };
+        let window_span = errp_bci::ResponseSpan {
+            from_secs: w_from[k],
+            to_secs: w_to[k],
+        };
+        let fr = frames.run_rows(f_run, k);
+        let wr = windows.run_rows(w_run, k);
+        let er = errps.run_rows(e_run, k);
+        let time_secs = end_t[e];
+        let errps_run: Vec<(f64, f64, usize)> = er
+            .clone()
+            .map(|i| Ok((e_t[i], e_onset[i], index(e_phase[i], 3, "ErrP phase")?)))
+            .collect::<Result<_, String>>()?;
+
+        // The true pose at each frame (m, rad), from the start.
+        let mut pose = (sx[k] / 100.0, sy[k] / 100.0, sh[k].to_radians());
+        let mut path_m = 0.0;
+        let mut max_lateral: f64 = 0.0;
+        let mut frame_at = Vec::with_capacity(fr.len());
+        for i in fr.clone() {
+            let next = (f_x[i] / 100.0, f_y[i] / 100.0, f_h[i].to_radians());
+            let (dx, dy) = (next.0 - pose.0, next.1 - pose.1);
+            let mid = pose.2 + 0.5 * errp_robot::wrap_angle(next.2 - pose.2);
+            let lateral = (-mid.sin() * dx + mid.cos() * dy) / PHYSICS_DT_SECS;
+            max_lateral = max_lateral.max(lateral.abs());
+            path_m += (dx * dx + dy * dy).sqrt();
+            pose = next;
+            frame_at.push((f_t[i], [pose.0, pose.1]));
+        }
+
+        let mut detections = Vec::new();
+        let mut detected_at = Vec::new();
+        let mut by_phase = [0usize; 3];
+        let mut by_judged = [0usize; 3];
+        let mut false_detections = 0usize;
+        let (mut hits, mut n_err, mut false_alarms, mut n_clean) = (0usize, 0usize, 0, 0);
+        let mut clean_windows = 0usize;
+        let mut frame = 0usize;
+        for i in wr {
+            let t = w_t[i];
+            // The ErrPs the episode knew of at this window: seen before it.
+            let known: Vec<(f64, usize)> = errps_run
+                .iter()
+                .filter(|&&(seen, _, _)| seen < t)
+                .map(|&(_, o, p)| (o, p))
+                .collect();
+            let says_error = w_p[i] >= t_e[k];
+            let in_window_span = known.iter().any(|&(o, _)| window_span.contains(o, t));
+            let near = known
+                .iter()
+                .any(|&(o, _)| o <= t && t - o <= window_span.to_secs + WINDOW_STEP_SECS);
+            if in_window_span {
+                n_err += 1;
+                hits += usize::from(says_error);
+            } else if !near {
+                n_clean += 1;
+                false_alarms += usize::from(says_error);
+            }
+            let judged = known
+                .iter()
+                .rev()
+                .find(|&&(o, _)| span.contains(o, t))
+                .map(|&(_, p)| p);
+            let step = index(w_step[i], 4, "window step")?;
+            if step != 3 && judged.is_none() {
+                clean_windows += 1;
+            }
+            if w_detected[i] {
+                detections.push(t);
+                while frame + 1 < frame_at.len() && frame_at[frame + 1].0 <= t {
+                    frame += 1;
+                }
+                if let Some(&(_, xy)) = frame_at.get(frame) {
+                    detected_at.push(xy);
+                }
+                by_phase[step.min(2)] += 1;
+                match judged {
+                    Some(p) => by_judged[p] += 1,
+                    None => false_detections += 1,
+                }
+            }
+        }
+        let scored: Vec<f64> = errps_run
+            .iter()
+            .map(|&(_, o, _)| o)
+            .filter(|&o| o + span.to_secs <= time_secs)
+            .collect();
+        let missed_errors = scored
+            .iter()
+            .filter(|&&o| !detections.iter().any(|&t| span.contains(o, t)))
+            .count();
+        let committed = match end_committed[e] {
+            -1 => None,
+            c => Some(index(c, n_goals, "committed goal")?),
+        };
+        out.push(EpuckEpisodeResult {
+            goal: index(goal[k], n_goals, "goal")?,
+            committed,
+            time_secs,
+            detected_errors: detections.len(),
+            detected_by_phase: by_phase,
+            true_by_judged_phase: by_judged,
+            false_detections,
+            missed_errors,
+            errps: errps_run.len(),
+            errps_scored: scored.len(),
+            clean_secs: clean_windows as f64 * WINDOW_STEP_SECS,
+            online: Accuracy {
+                correct: 1.0 - false_alarms as f64 / n_clean.max(1) as f64,
+                error: hits as f64 / n_err.max(1) as f64,
+                n_correct: n_clean,
+                n_error: n_err,
+            },
+            path_m,
+            max_lateral_m_per_s: max_lateral,
+            detections: detected_at,
+        });
+    }
+    Ok(out)
+}
+
+/// The grid episodes recomputed from their actions.
+fn grid_results(
+    tables: &std::collections::BTreeMap<String, Table>,
+) -> Result<Vec<GridEpisodeResult>, String> {
+    let grid = Grid::paper();
+    let runs = View::of(tables, data::RUNS)?;
+    let ends = View::of(tables, data::ENDS)?;
+    let empty = Table::default();
+    let actions = View {
+        name: data::ACTIONS,
+        table: tables.get(data::ACTIONS).unwrap_or(&empty),
+    };
+    let run_col = runs.i64("run")?;
+    let end_run = ends.i64("run")?;
+    let a_run = if actions.table.rows() == 0 {
+        &[][..]
+    } else {
+        actions.i64("run")?
+    };
+    for (name, r) in [
+        (data::RUNS, run_col),
+        (data::ACTIONS, a_run),
+        (data::ENDS, end_run),
+    ] {
+        check_run_order(name, r)?;
+    }
+    let cell = |x: i64, y: i64| -> Result<Cell, String> {
+        Ok(Cell::new(
+            index(x, grid.width, "cell column")?,
+            index(y, grid.height, "cell row")?,
+        ))
+    };
+    let (sx, sy, gx, gy, epoch) = (
+        runs.i64("start_x")?,
+        runs.i64("start_y")?,
+        runs.i64("goal_x")?,
+        runs.i64("goal_y")?,
+        runs.f64("epoch_s")?,
+    );
+    let (end_t, end_committed) = (ends.f64("t_s")?, ends.i64("committed")?);
+    let n_actions = actions.table.rows();
+    let (a_t, fx, fy, tx, ty, err, p, dec) = if n_actions == 0 {
+        (
+            &[][..],
+            &[][..],
+            &[][..],
+            &[][..],
+            &[][..],
+            &[][..],
+            &[][..],
+            &[][..],
+        )
+    } else {
+        (
+            actions.f64("t_s")?,
+            actions.i64("from_x")?,
+            actions.i64("from_y")?,
+            actions.i64("to_x")?,
+            actions.i64("to_y")?,
+            actions.bool("error")?,
+            actions.f64("p_error")?,
+            actions.bool("decoded_error")?,
+        )
+    };
+    let names: &[String] = match actions.table.column("action") {
+        Some(Column::Str(v)) => v,
+        _ if n_actions == 0 => &[],
+        _ => {
+            return Err(format!(
+                "its table {} has no column `action`",
+                data::ACTIONS
+            ));
+        }
+    };
+    let (belief, width) = if n_actions == 0 {
+        (&[][..], grid.n_cells())
+    } else {
+        actions.rows("belief")?
+    };
+    if width != grid.n_cells() {
+        return Err(format!(
+            "its beliefs have {width} values, not one per cell ({})",
+            grid.n_cells()
+        ));
+    }
+    let mut out = Vec::new();
+    for (k, &r) in run_col.iter().enumerate() {
+        if r != k as i64 {
+            return Err(format!("its table {} skips run {k}", data::RUNS));
+        }
+        let Some(e) = end_run.iter().position(|&x| x == r) else {
+            break;
+        };
+        let start = cell(sx[k], sy[k])?;
+        let goal = cell(gx[k], gy[k])?;
+        let mut visits = vec![0u32; grid.n_cells()];
+        visits[grid.index(start)] += 1;
+        let mut steps = Vec::new();
+        for i in actions.run_rows(a_run, k) {
+            let to = cell(tx[i], ty[i])?;
+            visits[grid.index(to)] += 1;
+            let action = GridAction::ALL
+                .into_iter()
+                .find(|a| a.name() == names[i])
+                .ok_or_else(|| format!("`{}` is not an action of the grid", names[i]))?;
+            steps.push(GridStep {
+                onset_secs: a_t[i],
+                from: cell(fx[i], fy[i])?,
+                action,
+                to,
+                error: err[i],
+                p_error: p[i],
+                decoded_error: dec[i],
+                belief: belief[i * width..(i + 1) * width].to_vec(),
+                fcz: Vec::new(),
+            });
+        }
+        let labels: Vec<bool> = steps.iter().map(|s| s.error).collect();
+        let decoded: Vec<bool> = steps.iter().map(|s| s.decoded_error).collect();
+        let committed = match end_committed[e] {
+            -1 => None,
+            c => Some(grid.cell(index(c, grid.n_cells(), "committed cell")?)),
+        };
+        out.push(GridEpisodeResult {
+            start,
+            goal,
+            committed,
+            actions: steps.len(),
+            net_secs: steps.len() as f64 * epoch[k],
+            total_secs: end_t[e],
+            online: Accuracy::score(&labels, &decoded),
+            visits,
+            steps,
+        });
+    }
+    Ok(out)
+}

@@ -1,0 +1,548 @@
+//! The tidy tables of a recording, one row per observation with a `run`
+//! column (runs from 1, as `errp run` numbers them): what `errp inspect
+//! --csv` writes and `errp.read_recording` returns as DataFrames.
+
+use std::fmt::Write as _;
+
+use errp_robot::Grid;
+
+use crate::epuck::{EpuckEpisodeResult, PHASE_NAMES, PHYSICS_DT_SECS, STEP_NAMES};
+use crate::inspect::{Recording, Runs};
+use crate::record::data::{self, Column};
+
+/// One tidy table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CsvTable {
+    /// Its name (the file is `NAME.csv`).
+    pub name: &'static str,
+    /// Named columns of equal length.
+    pub columns: Vec<(&'static str, Column)>,
+}
+
+impl CsvTable {
+    /// Rows.
+    pub fn rows(&self) -> usize {
+        self.columns.first().map_or(0, |(_, c)| c.len())
+    }
+
+    /// The table as CSV text: a header, then one line per row. Numbers are
+    /// written exactly (the shortest text that reads back to the same
+    /// value); a missing number is an empty field.
+    pub fn to_csv(&self) -> String {
+        let mut out = String::new();
+        let names: Vec<&str> = self.columns.iter().map(|(n, _)| *n).collect();
+        out.push_str(&names.join(","));
+        out.push('\n');
+        for i in 0..self.rows() {
+            for (k, (_, c)) in self.columns.iter().enumerate() {
+                if k > 0 {
+                    out.push(',');
+                }
+                match c {
+                    Column::F64(v) if v[i].is_nan() => {}
+                    Column::F64(v) => {
+                        let _ = write!(out, "{:?}", v[i]);
+                    }
+                    Column::I64(v) => {
+                        let _ = write!(out, "{}", v[i]);
+                    }
+                    Column::Bool(v) => out.push_str(if v[i] { "True" } else { "False" }),
+                    Column::Str(v) => out.push_str(&quote(&v[i])),
+                    Column::F64Rows(..) => {}
+                }
+            }
+            out.push('\n');
+        }
+        out
+    }
+}
+
+/// A CSV field: quoted when it holds a comma, a quote or a line break.
+fn quote(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+fn get<'a>(rec: &'a Recording, entity: &str) -> Option<&'a crate::inspect::Table> {
+    rec.tables.get(entity)
+}
+
+fn f64s<'a>(t: &'a crate::inspect::Table, c: &str) -> &'a [f64] {
+    match t.column(c) {
+        Some(Column::F64(v)) => v,
+        _ => &[],
+    }
+}
+
+fn i64s<'a>(t: &'a crate::inspect::Table, c: &str) -> &'a [i64] {
+    match t.column(c) {
+        Some(Column::I64(v)) => v,
+        _ => &[],
+    }
+}
+
+fn bools<'a>(t: &'a crate::inspect::Table, c: &str) -> &'a [bool] {
+    match t.column(c) {
+        Some(Column::Bool(v)) => v,
+        _ => &[],
+    }
+}
+
+/// The seconds of a run spent turning, driving and stopped, from its frames.
+pub(crate) fn phase_secs(rec: &Recording, run: usize) -> [f64; 3] {
+    let mut out = [0.0; 3];
+    if let Some(t) = get(rec, data::FRAMES) {
+        for (r, p) in i64s(t, "run").iter().zip(i64s(t, "phase")) {
+            if *r == run as i64
+                && let Some(slot) = usize::try_from(*p).ok().and_then(|p| out.get_mut(p))
+            {
+                *slot += PHYSICS_DT_SECS;
+            }
+        }
+    }
+    out
+}
+
+/// Every tidy table of `rec`.
+pub fn csv_tables(rec: &Recording) -> Vec<CsvTable> {
+    match &rec.runs {
+        Runs::Epuck { scenario, results } => {
+            let names: Vec<String> = scenario
+                .layout
+                .goals()
+                .iter()
+                .map(|g| g.name.clone())
+                .collect();
+            epuck_tables(rec, results, &names)
+        }
+        Runs::Grid { results, .. } => grid_tables(results),
+    }
+}
+
+fn name_of(names: &[String], i: i64) -> String {
+    usize::try_from(i)
+        .ok()
+        .and_then(|i| names.get(i))
+        .cloned()
+        .unwrap_or_default()
+}
+
+fn epuck_tables(
+    rec: &Recording,
+    results: &[EpuckEpisodeResult],
+    names: &[String],
+) -> Vec<CsvTable> {
+    let n = results.len();
+    let run1 = |v: &[i64]| Column::I64(v.iter().map(|r| r + 1).collect());
+    let phases: Vec<[f64; 3]> = (0..n).map(|k| phase_secs(rec, k)).collect();
+    let runs = CsvTable {
+        name: "runs",
+        columns: vec![
+            ("run", Column::I64((1..=n as i64).collect())),
+            (
+                "goal",
+                Column::Str(results.iter().map(|r| names[r.goal].clone()).collect()),
+            ),
+            (
+                "converged_on",
+                Column::Str(
+                    results
+                        .iter()
+                        .map(|r| r.committed.map_or(String::new(), |c| names[c].clone()))
+                        .collect(),
+                ),
+            ),
+            (
+                "reached",
+                Column::Bool(results.iter().map(EpuckEpisodeResult::reached).collect()),
+            ),
+            (
+                "time_s",
+                Column::F64(results.iter().map(|r| r.time_secs).collect()),
+            ),
+            (
+                "detected",
+                Column::I64(results.iter().map(|r| r.detected_errors as i64).collect()),
+            ),
+            (
+                "false",
+                Column::I64(results.iter().map(|r| r.false_detections as i64).collect()),
+            ),
+            (
+                "missed",
+                Column::I64(results.iter().map(|r| r.missed_errors as i64).collect()),
+            ),
+            (
+                "errps",
+                Column::I64(results.iter().map(|r| r.errps as i64).collect()),
+            ),
+            (
+                "acc_correct",
+                Column::F64(results.iter().map(|r| r.online.correct).collect()),
+            ),
+            (
+                "acc_error",
+                Column::F64(results.iter().map(|r| r.online.error).collect()),
+            ),
+            (
+                "hit_rate",
+                Column::F64(results.iter().map(EpuckEpisodeResult::hit_rate).collect()),
+            ),
+            (
+                "false_alarms_per_min",
+                Column::F64(
+                    results
+                        .iter()
+                        .map(EpuckEpisodeResult::false_alarms_per_min)
+                        .collect(),
+                ),
+            ),
+            (
+                "path_m",
+                Column::F64(results.iter().map(|r| r.path_m).collect()),
+            ),
+            (
+                "turning_s",
+                Column::F64(phases.iter().map(|p| p[0]).collect()),
+            ),
+            (
+                "driving_s",
+                Column::F64(phases.iter().map(|p| p[1]).collect()),
+            ),
+            (
+                "stopped_s",
+                Column::F64(phases.iter().map(|p| p[2]).collect()),
+            ),
+        ],
+    };
+    let mut out = vec![runs];
+    let empty = crate::inspect::Table::default();
+    let frames = get(rec, data::FRAMES).unwrap_or(&empty);
+    let windows = get(rec, data::WINDOWS).unwrap_or(&empty);
+    // p(error) and the evidence of the latest window at each frame.
+    let (w_run, w_t) = (i64s(windows, "run"), f64s(windows, "t_s"));
+    let (w_p, w_ev) = (f64s(windows, "p_error"), f64s(windows, "evidence"));
+    let (f_run, f_t) = (i64s(frames, "run"), f64s(frames, "t_s"));
+    let mut p = Vec::with_capacity(f_t.len());
+    let mut ev = Vec::with_capacity(f_t.len());
+    let mut w = 0usize;
+    let mut latest: Option<usize> = None;
+    for (r, t) in f_run.iter().zip(f_t) {
+        while w < w_t.len() && (w_run[w] < *r || (w_run[w] == *r && w_t[w] <= *t)) {
+            latest = (w_run[w] == *r).then_some(w);
+            w += 1;
+        }
+        if latest.is_some_and(|l| w_run[l] != *r) {
+            latest = None;
+        }
+        p.push(latest.map_or(f64::NAN, |l| w_p[l]));
+        ev.push(latest.map_or(f64::NAN, |l| w_ev[l]));
+    }
+    out.push(CsvTable {
+        name: "trajectory",
+        columns: vec![
+            ("run", run1(f_run)),
+            ("t_s", Column::F64(f_t.to_vec())),
+            ("x_cm", Column::F64(f64s(frames, "x_cm").to_vec())),
+            ("y_cm", Column::F64(f64s(frames, "y_cm").to_vec())),
+            (
+                "heading_deg",
+                Column::F64(f64s(frames, "heading_deg").to_vec()),
+            ),
+            (
+                "tracked_x_cm",
+                Column::F64(f64s(frames, "tracked_x_cm").to_vec()),
+            ),
+            (
+                "tracked_y_cm",
+                Column::F64(f64s(frames, "tracked_y_cm").to_vec()),
+            ),
+            (
+                "phase",
+                Column::Str(
+                    i64s(frames, "phase")
+                        .iter()
+                        .map(|&k| {
+                            PHASE_NAMES
+                                .get(k as usize)
+                                .map_or(String::new(), |s| s.to_string())
+                        })
+                        .collect(),
+                ),
+            ),
+            (
+                "current_goal",
+                Column::Str(
+                    i64s(frames, "target")
+                        .iter()
+                        .map(|&k| name_of(names, k))
+                        .collect(),
+                ),
+            ),
+            ("p_error", Column::F64(p)),
+            ("evidence", Column::F64(ev)),
+        ],
+    });
+    // Detections, with where the robot was and whether an ErrP explains it.
+    let mut d = (
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+    );
+    let detected = bools(windows, "detected");
+    let steps = i64s(windows, "step");
+    let mut per_run = vec![0usize; results.len()];
+    for i in 0..w_t.len() {
+        if !detected.get(i).copied().unwrap_or(false) {
+            continue;
+        }
+        let r = w_run[i];
+        let Some(result) = usize::try_from(r).ok().and_then(|k| results.get(k)) else {
+            continue;
+        };
+        let j = per_run[r as usize];
+        per_run[r as usize] += 1;
+        let xy = result.detections.get(j).copied().unwrap_or([f64::NAN; 2]);
+        d.0.push(r + 1);
+        d.1.push(w_t[i]);
+        d.2.push(100.0 * xy[0]);
+        d.3.push(100.0 * xy[1]);
+        d.4.push(w_p[i]);
+        d.5.push(w_ev[i]);
+        d.6.push(
+            STEP_NAMES
+                .get(steps[i] as usize)
+                .map_or(String::new(), |s| s.to_string()),
+        );
+    }
+    out.push(CsvTable {
+        name: "detections",
+        columns: vec![
+            ("run", Column::I64(d.0)),
+            ("t_s", Column::F64(d.1)),
+            ("x_cm", Column::F64(d.2)),
+            ("y_cm", Column::F64(d.3)),
+            ("p_error", Column::F64(d.4)),
+            ("evidence", Column::F64(d.5)),
+            ("step", Column::Str(d.6)),
+        ],
+    });
+    // Belief per goal, long.
+    let (belief, width) = match windows.column("belief") {
+        Some(Column::F64Rows(v, w)) => (&v[..], *w),
+        _ => (&[][..], 0),
+    };
+    let rows = w_t.len() * width;
+    let mut b = (
+        Vec::with_capacity(rows),
+        Vec::with_capacity(rows),
+        Vec::with_capacity(rows),
+        Vec::with_capacity(rows),
+    );
+    for i in 0..w_t.len() {
+        for g in 0..width {
+            b.0.push(w_run[i] + 1);
+            b.1.push(w_t[i]);
+            b.2.push(name_of(names, g as i64));
+            b.3.push(belief[i * width + g]);
+        }
+    }
+    out.push(CsvTable {
+        name: "belief",
+        columns: vec![
+            ("run", Column::I64(b.0)),
+            ("t_s", Column::F64(b.1)),
+            ("goal", Column::Str(b.2)),
+            ("p", Column::F64(b.3)),
+        ],
+    });
+    let errps = get(rec, data::ERRPS).unwrap_or(&empty);
+    out.push(CsvTable {
+        name: "errps",
+        columns: vec![
+            ("run", run1(i64s(errps, "run"))),
+            ("t_s", Column::F64(f64s(errps, "t_s").to_vec())),
+            ("onset_s", Column::F64(f64s(errps, "onset_s").to_vec())),
+            (
+                "judged_phase",
+                Column::Str(
+                    i64s(errps, "phase")
+                        .iter()
+                        .map(|&k| {
+                            PHASE_NAMES
+                                .get(k as usize)
+                                .map_or(String::new(), |s| s.to_string())
+                        })
+                        .collect(),
+                ),
+            ),
+        ],
+    });
+    let events = get(rec, data::EVENTS).unwrap_or(&empty);
+    out.push(CsvTable {
+        name: "events",
+        columns: vec![
+            ("run", run1(i64s(events, "run"))),
+            ("t_s", Column::F64(f64s(events, "t_s").to_vec())),
+            (
+                "level",
+                Column::Str(
+                    bools(events, "warn")
+                        .iter()
+                        .map(|&w| if w { "WARN" } else { "INFO" }.to_string())
+                        .collect(),
+                ),
+            ),
+            (
+                "text",
+                match events.column("text") {
+                    Some(Column::Str(v)) => Column::Str(v.clone()),
+                    _ => Column::Str(Vec::new()),
+                },
+            ),
+        ],
+    });
+    out
+}
+
+fn grid_tables(results: &[crate::grid::GridEpisodeResult]) -> Vec<CsvTable> {
+    let grid = Grid::paper();
+    let n = results.len() as i64;
+    let cell_text = |c: errp_robot::Cell| c.to_string();
+    let runs = CsvTable {
+        name: "runs",
+        columns: vec![
+            ("run", Column::I64((1..=n).collect())),
+            (
+                "start",
+                Column::Str(results.iter().map(|r| cell_text(r.start)).collect()),
+            ),
+            (
+                "goal",
+                Column::Str(results.iter().map(|r| cell_text(r.goal)).collect()),
+            ),
+            (
+                "committed",
+                Column::Str(
+                    results
+                        .iter()
+                        .map(|r| r.committed.map_or(String::new(), cell_text))
+                        .collect(),
+                ),
+            ),
+            (
+                "reached",
+                Column::Bool(results.iter().map(|r| r.reached()).collect()),
+            ),
+            (
+                "actions",
+                Column::I64(results.iter().map(|r| r.actions as i64).collect()),
+            ),
+            (
+                "net_s",
+                Column::F64(results.iter().map(|r| r.net_secs).collect()),
+            ),
+            (
+                "total_s",
+                Column::F64(results.iter().map(|r| r.total_secs).collect()),
+            ),
+            (
+                "acc_correct",
+                Column::F64(results.iter().map(|r| r.online.correct).collect()),
+            ),
+            (
+                "acc_error",
+                Column::F64(results.iter().map(|r| r.online.error).collect()),
+            ),
+        ],
+    };
+    let mut a: (Vec<i64>, Vec<i64>, Vec<f64>) = Default::default();
+    let mut cells: [Vec<i64>; 4] = Default::default();
+    let mut act = Vec::new();
+    let mut flags: [Vec<bool>; 2] = Default::default();
+    let mut p = Vec::new();
+    // Belief per cell: run, step, time, x, y, p.
+    let mut b: (Vec<i64>, Vec<i64>, Vec<f64>) = Default::default();
+    let mut b_cell: (Vec<i64>, Vec<i64>, Vec<f64>) = Default::default();
+    let mut v: (Vec<i64>, Vec<i64>, Vec<i64>, Vec<i64>) = Default::default();
+    for (k, r) in results.iter().enumerate() {
+        let run = k as i64 + 1;
+        for (j, s) in r.steps.iter().enumerate() {
+            a.0.push(run);
+            a.1.push(j as i64 + 1);
+            a.2.push(s.onset_secs);
+            cells[0].push(s.from.x as i64);
+            cells[1].push(s.from.y as i64);
+            act.push(s.action.name().to_string());
+            cells[2].push(s.to.x as i64);
+            cells[3].push(s.to.y as i64);
+            flags[0].push(s.error);
+            p.push(s.p_error);
+            flags[1].push(s.decoded_error);
+            for (i, &q) in s.belief.iter().enumerate() {
+                let c = grid.cell(i);
+                b.0.push(run);
+                b.1.push(j as i64 + 1);
+                b.2.push(s.onset_secs);
+                b_cell.0.push(c.x as i64);
+                b_cell.1.push(c.y as i64);
+                b_cell.2.push(q);
+            }
+        }
+        for (i, &count) in r.visits.iter().enumerate() {
+            let c = grid.cell(i);
+            v.0.push(run);
+            v.1.push(c.x as i64);
+            v.2.push(c.y as i64);
+            v.3.push(i64::from(count));
+        }
+    }
+    let [fx, fy, tx, ty] = cells;
+    let [err, dec] = flags;
+    vec![
+        runs,
+        CsvTable {
+            name: "actions",
+            columns: vec![
+                ("run", Column::I64(a.0)),
+                ("step", Column::I64(a.1)),
+                ("t_s", Column::F64(a.2)),
+                ("from_x", Column::I64(fx)),
+                ("from_y", Column::I64(fy)),
+                ("action", Column::Str(act)),
+                ("to_x", Column::I64(tx)),
+                ("to_y", Column::I64(ty)),
+                ("error", Column::Bool(err)),
+                ("p_error", Column::F64(p)),
+                ("decoded_error", Column::Bool(dec)),
+            ],
+        },
+        CsvTable {
+            name: "belief",
+            columns: vec![
+                ("run", Column::I64(b.0)),
+                ("step", Column::I64(b.1)),
+                ("t_s", Column::F64(b.2)),
+                ("x", Column::I64(b_cell.0)),
+                ("y", Column::I64(b_cell.1)),
+                ("p", Column::F64(b_cell.2)),
+            ],
+        },
+        CsvTable {
+            name: "visits",
+            columns: vec![
+                ("run", Column::I64(v.0)),
+                ("x", Column::I64(v.1)),
+                ("y", Column::I64(v.2)),
+                ("visits", Column::I64(v.3)),
+            ],
+        },
+    ]
+}

@@ -1,0 +1,516 @@
+//! `errp inspect FILE.rrd...`: what a recording holds, its runs recomputed
+//! from its data tables, tidy CSV tables, and the paper's Fig. 5 / Fig. 4.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use errp_sim::epuck::{EpuckRunHeader, EpuckRunRow, EpuckSummaryReport, summarise};
+use errp_sim::grid::{GridEpisodeHeader, GridEpisodeRow, GridRunReport};
+use errp_sim::inspect::{CsvTable, Recording, Runs, csv_tables};
+use errp_sim::{PendingFile, create_dirs};
+use errp_sweep::{ArenaPlot, GridPlot, RunPath};
+
+use crate::cli::{InspectArgs, check_extension};
+use crate::out::{out, outln};
+
+pub(crate) fn inspect(args: &InspectArgs) -> Result<()> {
+    if args.scenario || args.provenance {
+        if args.files.len() != 1 {
+            bail!("--scenario and --provenance print one recording's; give one file");
+        }
+        let rec = Recording::open(&args.files[0])?;
+        if args.scenario {
+            out!("{}", rec.provenance.scenario_text)?;
+        } else {
+            let json = serde_json::to_string_pretty(&rec.provenance)
+                .context("writing the provenance as JSON")?;
+            outln!("{json}")?;
+        }
+        return Ok(());
+    }
+    for f in &args.files {
+        check_extension(f, "rrd", "FILE")?;
+    }
+    if args.figure.is_some() && args.files.len() != 1 {
+        bail!("--figure draws one recording; give one file");
+    }
+    let figure_kind = match &args.figure {
+        Some(f) => Some(match f.extension().and_then(|e| e.to_str()) {
+            Some("png") => FigureKind::Png,
+            Some("svg") => FigureKind::Svg,
+            _ => bail!(
+                "--figure {}: the file name must end in .png or .svg",
+                f.display()
+            ),
+        }),
+        None => None,
+    };
+    let started = crate::commands::sweep::wall_clock();
+    let recs: Vec<Recording> = args
+        .files
+        .iter()
+        .map(Recording::open)
+        .collect::<Result<_, _>>()?;
+    if args.run == 0 || args.run > recs[0].n_runs().max(1) {
+        bail!(
+            "--run {}: {} holds runs 1 to {}",
+            args.run,
+            args.files[0].display(),
+            recs[0].n_runs()
+        );
+    }
+    // Outputs are checked, then written whole, after every file was read.
+    if let Some(dir) = &args.csv {
+        write_csv(dir, &args.files, &recs)?;
+    }
+    if let (Some(path), Some(kind)) = (&args.figure, figure_kind) {
+        let bytes = draw(&recs[0], args.run - 1, kind)?;
+        let (pending, mut file) = PendingFile::create(path).context("--figure")?;
+        std::io::Write::write_all(&mut file, &bytes)
+            .and_then(|()| file.sync_all())
+            .with_context(|| format!("--figure: cannot write {}", path.display()))?;
+        pending.commit().context("--figure")?;
+    }
+    if recs.len() == 1 {
+        describe(&recs[0])?;
+    } else {
+        for r in &recs {
+            outln!("{}", headline(r))?;
+        }
+        outln!()?;
+        compare(&recs)?;
+    }
+    if let Some(dir) = &args.csv {
+        outln!("Wrote the tables to {}", dir.display())?;
+    }
+    if let Some(path) = &args.figure {
+        outln!("Wrote {}", path.display())?;
+    }
+    crate::out::errln!(
+        "read {} recording(s) in {:.2} s",
+        recs.len(),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+#[derive(Clone, Copy)]
+enum FigureKind {
+    Png,
+    Svg,
+}
+
+/// One line on a recording: its file, task, scenario, runs and maker.
+fn headline(r: &Recording) -> String {
+    let p = &r.provenance;
+    format!(
+        "{}: {} recording of `{}`, {} run(s), seed {}, by errp {} (commit {})",
+        r.path.display(),
+        if p.task == "epuck" { "e-puck" } else { "grid" },
+        p.scenario_name,
+        p.runs,
+        p.seed,
+        p.errp_version,
+        p.commit
+    )
+}
+
+/// The full description of one recording: provenance, how to run it again,
+/// and what `errp run` printed, recomputed from the recording.
+fn describe(r: &Recording) -> Result<()> {
+    let p = &r.provenance;
+    outln!("{}", headline(r))?;
+    outln!("  made by:  {}", p.command.join(" "))?;
+    let runs = if p.task == "epuck" {
+        format!(" --runs {}", p.runs)
+    } else {
+        String::new()
+    };
+    outln!(
+        "  run again: errp inspect {} --scenario > scenario.toml && errp run scenario.toml \
+         --seed {}{runs}",
+        r.path.display(),
+        p.seed
+    )?;
+    outln!("Recomputed from the recording:")?;
+    out!("{}", p.decoder_summary)?;
+    match &r.runs {
+        Runs::Epuck { scenario, results } => {
+            let layout = &scenario.layout;
+            outln!("{EpuckRunHeader}")?;
+            for (index, result) in results.iter().enumerate() {
+                outln!(
+                    "{}",
+                    EpuckRunRow {
+                        index,
+                        result,
+                        layout
+                    }
+                )?;
+            }
+            let summary = summarise(results);
+            let t_e = r
+                .tables
+                .get(errp_sim::record::data::RUNS)
+                .and_then(|t| match t.column("t_e") {
+                    Some(errp_sim::record::data::Column::F64(v)) => v.first().copied(),
+                    _ => None,
+                })
+                .unwrap_or(f64::NAN);
+            out!(
+                "{}",
+                EpuckSummaryReport {
+                    summary: &summary,
+                    scenario: &scenario.name,
+                    goal: &layout.goals()[scenario.episode.goal].name,
+                    t_e,
+                }
+            )?;
+            let tables = csv_tables(r);
+            let runs = &tables[0];
+            outln!()?;
+            outln!(
+                "{:>4}  {:>8}  {:>11} {:>11} {:>11}",
+                "run",
+                "path (m)",
+                "turning (s)",
+                "driving (s)",
+                "stopped (s)"
+            )?;
+            let col = |name: &str| match runs.columns.iter().find(|(n, _)| *n == name) {
+                Some((_, errp_sim::record::data::Column::F64(v))) => v.clone(),
+                _ => Vec::new(),
+            };
+            let (path, turning, driving, stopped) = (
+                col("path_m"),
+                col("turning_s"),
+                col("driving_s"),
+                col("stopped_s"),
+            );
+            for k in 0..path.len() {
+                outln!(
+                    "{:>4}  {:>8.2}  {:>11.1} {:>11.1} {:>11.1}",
+                    k + 1,
+                    path[k],
+                    turning[k],
+                    driving[k],
+                    stopped[k]
+                )?;
+            }
+        }
+        Runs::Grid { scenario, results } => {
+            outln!("{GridEpisodeHeader}")?;
+            for (k, e) in results.iter().enumerate() {
+                outln!("{}", GridEpisodeRow(k, e))?;
+            }
+            let report = GridRunReport {
+                scenario: (**scenario).clone(),
+                calibration: None,
+                episodes: results.clone(),
+            };
+            out!("{report}")?;
+        }
+    }
+    Ok(())
+}
+
+/// The recordings' summaries side by side.
+fn compare(recs: &[Recording]) -> Result<()> {
+    let name = |r: &Recording| {
+        r.path.file_name().map_or_else(
+            || r.path.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        )
+    };
+    let mut rows: Vec<(String, Vec<String>)> = Vec::new();
+    let mut add = |label: &str, values: Vec<String>| rows.push((label.to_string(), values));
+    add(
+        "scenario",
+        recs.iter()
+            .map(|r| r.provenance.scenario_name.clone())
+            .collect(),
+    );
+    add(
+        "runs",
+        recs.iter().map(|r| r.n_runs().to_string()).collect(),
+    );
+    let stat = |f: &dyn Fn(&Recording) -> Option<String>| {
+        recs.iter()
+            .map(|r| f(r).unwrap_or_else(|| "-".into()))
+            .collect::<Vec<_>>()
+    };
+    add(
+        "goals reached",
+        stat(&|r| match &r.runs {
+            Runs::Epuck { results, .. } => Some(format!(
+                "{} / {}",
+                results.iter().filter(|x| x.reached()).count(),
+                results.len()
+            )),
+            Runs::Grid { results, .. } => Some(format!(
+                "{} / {}",
+                results.iter().filter(|x| x.reached()).count(),
+                results.len()
+            )),
+        }),
+    );
+    add(
+        "median time (s)",
+        stat(&|r| match &r.runs {
+            Runs::Epuck { results, .. } => Some(format!("{:.1}", summarise(results).median_secs)),
+            Runs::Grid { results, .. } => Some(format!(
+                "{:.1}",
+                errp_sim::median(&results.iter().map(|e| e.total_secs).collect::<Vec<_>>())
+            )),
+        }),
+    );
+    add(
+        "median detections",
+        stat(&|r| match &r.runs {
+            Runs::Epuck { results, .. } => {
+                Some(format!("{:.1}", summarise(results).median_detected))
+            }
+            Runs::Grid { .. } => None,
+        }),
+    );
+    add(
+        "median false",
+        stat(&|r| match &r.runs {
+            Runs::Epuck { results, .. } => Some(format!("{:.1}", summarise(results).median_false)),
+            Runs::Grid { .. } => None,
+        }),
+    );
+    add(
+        "hit rate (%)",
+        stat(&|r| match &r.runs {
+            Runs::Epuck { results, .. } => {
+                Some(format!("{:.1}", 100.0 * summarise(results).hit_rate))
+            }
+            Runs::Grid { .. } => None,
+        }),
+    );
+    add(
+        "false alarms/min",
+        stat(&|r| match &r.runs {
+            Runs::Epuck { results, .. } => {
+                Some(format!("{:.2}", summarise(results).false_alarms_per_min))
+            }
+            Runs::Grid { .. } => None,
+        }),
+    );
+    add(
+        "median actions",
+        stat(&|r| match &r.runs {
+            Runs::Grid { results, .. } => Some(format!(
+                "{:.1}",
+                errp_sim::median(&results.iter().map(|e| e.actions as f64).collect::<Vec<_>>())
+            )),
+            Runs::Epuck { .. } => None,
+        }),
+    );
+    let widths: Vec<usize> = recs
+        .iter()
+        .enumerate()
+        .map(|(k, r)| {
+            rows.iter()
+                .map(|(_, v)| v[k].len())
+                .chain([name(r).len()])
+                .max()
+                .unwrap_or(8)
+        })
+        .collect();
+    let mut line = format!("{:<18}", "");
+    for (k, r) in recs.iter().enumerate() {
+        line.push_str(&format!("  {:>w$}", name(r), w = widths[k]));
+    }
+    outln!("{line}")?;
+    for (label, values) in &rows {
+        let mut line = format!("{label:<18}");
+        for (k, v) in values.iter().enumerate() {
+            line.push_str(&format!("  {:>w$}", v, w = widths[k]));
+        }
+        outln!("{line}")?;
+    }
+    Ok(())
+}
+
+/// Writes every table of every recording into `dir` (a subdirectory per
+/// file when several). Existing files are replaced only if they are tables
+/// of ours (the same header); the directories made are removed on failure.
+fn write_csv(dir: &Path, files: &[PathBuf], recs: &[Recording]) -> Result<()> {
+    let mut plan: Vec<(PathBuf, CsvTable)> = Vec::new();
+    for (f, r) in files.iter().zip(recs) {
+        let base = if recs.len() == 1 {
+            dir.to_path_buf()
+        } else {
+            dir.join(f.file_stem().unwrap_or_default())
+        };
+        for t in csv_tables(r) {
+            plan.push((base.join(format!("{}.csv", t.name)), t));
+        }
+    }
+    for (path, t) in &plan {
+        if let Ok(mut file) = errp_sim::open_regular(path) {
+            use std::io::Read;
+            let mut head = vec![0u8; 4096];
+            let n = file.read(&mut head).unwrap_or(0);
+            let header: Vec<&str> = t.columns.iter().map(|(n, _)| *n).collect();
+            let ours = header.join(",") + "\n";
+            if n > 0 && !head[..n].starts_with(ours.as_bytes()) {
+                bail!(
+                    "--csv {}: {} exists and is not a table errp wrote; errp replaces only its \
+                     own files: move it away or give another directory",
+                    dir.display(),
+                    path.display()
+                );
+            }
+        } else if path.exists() {
+            bail!(
+                "--csv {}: {} exists and is not a regular file",
+                dir.display(),
+                path.display()
+            );
+        }
+    }
+    let mut made = Vec::new();
+    let result = (|| -> Result<()> {
+        for (path, t) in &plan {
+            if let Some(parent) = path.parent() {
+                made.push(create_dirs(parent).context("--csv")?);
+            }
+            let (pending, mut file) = PendingFile::create(path).context("--csv")?;
+            std::io::Write::write_all(&mut file, t.to_csv().as_bytes())
+                .and_then(|()| file.sync_all())
+                .with_context(|| format!("--csv: cannot write {}", path.display()))?;
+            pending.commit().context("--csv")?;
+        }
+        Ok(())
+    })();
+    if result.is_err() {
+        for d in made.iter().rev() {
+            d.remove();
+        }
+    }
+    result
+}
+
+/// The figure of `rec` with run `highlight` (from 0) drawn in full.
+fn draw(rec: &Recording, highlight: usize, kind: FigureKind) -> Result<Vec<u8>> {
+    let runs_title = |n: usize| {
+        if n == 1 {
+            String::new()
+        } else {
+            format!(", run {} of {n}", highlight + 1)
+        }
+    };
+    let bytes = match &rec.runs {
+        Runs::Epuck { scenario, results } => {
+            let frames = rec.tables.get(errp_sim::record::data::FRAMES);
+            let col = |name: &str| match frames.and_then(|t| t.column(name)) {
+                Some(errp_sim::record::data::Column::F64(v)) => v.as_slice(),
+                _ => &[],
+            };
+            let runs_col: &[i64] = match frames.and_then(|t| t.column("run")) {
+                Some(errp_sim::record::data::Column::I64(v)) => v,
+                _ => &[],
+            };
+            let (xs, ys) = (col("x_cm"), col("y_cm"));
+            let mut paths: Vec<RunPath> = results
+                .iter()
+                .map(|r| RunPath {
+                    points: Vec::new(),
+                    detections: r
+                        .detections
+                        .iter()
+                        .map(|d| [100.0 * d[0], 100.0 * d[1]])
+                        .collect(),
+                })
+                .collect();
+            for (i, &run) in runs_col.iter().enumerate() {
+                // 8 points a second, as the viewer draws the trajectory.
+                if let Some(p) = usize::try_from(run).ok().and_then(|k| paths.get_mut(k))
+                    && (i % 8 == 0 || p.points.is_empty())
+                {
+                    p.points.push([xs[i], ys[i]]);
+                }
+            }
+            let layout = &scenario.layout;
+            let plot = ArenaPlot {
+                title: format!(
+                    "{}{}: {} detections",
+                    scenario.name,
+                    runs_title(results.len()),
+                    results[highlight].detected_errors
+                ),
+                size_cm: 100.0 * scenario.arena.size_m,
+                obstacles: scenario
+                    .arena
+                    .obstacles
+                    .iter()
+                    .map(|o| {
+                        o.outline()
+                            .into_iter()
+                            .map(|(x, y)| [100.0 * x, 100.0 * y])
+                            .collect()
+                    })
+                    .collect(),
+                cities: layout
+                    .goals()
+                    .iter()
+                    .map(|g| (g.name.clone(), [100.0 * g.x_m, 100.0 * g.y_m]))
+                    .collect(),
+                goal: scenario.episode.goal,
+                runs: paths,
+                highlight,
+            };
+            match kind {
+                FigureKind::Png => errp_sweep::arena_png(&plot)?,
+                FigureKind::Svg => errp_sweep::arena_svg(&plot)?.into_bytes(),
+            }
+        }
+        Runs::Grid { scenario, results } => {
+            let grid = errp_robot::Grid::paper();
+            let mut visits = vec![0.0; grid.n_cells()];
+            for r in results {
+                for (v, &c) in visits.iter_mut().zip(&r.visits) {
+                    *v += f64::from(c);
+                }
+            }
+            let most = visits.iter().copied().fold(0.0, f64::max).max(1.0);
+            visits.iter_mut().for_each(|v| *v /= most);
+            let xy = |c: errp_robot::Cell| [c.x as f64, c.y as f64];
+            let runs: Vec<RunPath> = results
+                .iter()
+                .map(|r| RunPath {
+                    points: std::iter::once(xy(r.start))
+                        .chain(r.steps.iter().map(|s| xy(s.to)))
+                        .collect(),
+                    detections: r
+                        .steps
+                        .iter()
+                        .filter(|s| s.decoded_error)
+                        .map(|s| {
+                            let (a, b) = (xy(s.from), xy(s.to));
+                            [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])]
+                        })
+                        .collect(),
+                })
+                .collect();
+            let h = &results[highlight];
+            let plot = GridPlot {
+                title: format!("{}: visits{}", scenario.name, runs_title(results.len())),
+                size: (grid.width, grid.height),
+                visits,
+                runs,
+                highlight,
+                start: xy(h.start),
+                goal: xy(h.goal),
+            };
+            match kind {
+                FigureKind::Png => errp_sweep::grid_png(&plot)?,
+                FigureKind::Svg => errp_sweep::grid_svg(&plot)?.into_bytes(),
+            }
+        }
+    };
+    Ok(bytes)
+}
