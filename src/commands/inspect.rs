@@ -4,9 +4,9 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use errp_sim::epuck::{EpuckRunHeader, EpuckRunRow, EpuckSummaryReport, summarise};
+use errp_sim::epuck::{EpuckSummaryReport, summarise};
 use errp_sim::grid::{GridEpisodeHeader, GridEpisodeRow, GridRunReport};
-use errp_sim::inspect::{CsvTable, Recording, Runs, csv_tables};
+use errp_sim::inspect::{CsvTable, Recording, Runs, csv_tables, phase_secs};
 use errp_sim::{PendingFile, create_dirs};
 use errp_sweep::{ArenaPlot, GridPlot, RunPath};
 
@@ -45,6 +45,13 @@ pub(crate) fn inspect(args: &InspectArgs) -> Result<()> {
         }),
         None => None,
     };
+    if let (Some(path), Some(kind)) = (&args.figure, figure_kind) {
+        let (magic, what): (&[u8], &str) = match kind {
+            FigureKind::Png => (b"\x89PNG", "a PNG image"),
+            FigureKind::Svg => (b"<svg", "an SVG drawing"),
+        };
+        crate::save::check_ours(path, magic, what, "--figure")?;
+    }
     let started = crate::commands::sweep::wall_clock();
     let recs: Vec<Recording> = args
         .files
@@ -59,16 +66,24 @@ pub(crate) fn inspect(args: &InspectArgs) -> Result<()> {
             recs[0].n_runs()
         );
     }
-    // Outputs are checked, then written whole, after every file was read.
+    // The figure is drawn and written to its temporary (made before any
+    // work, so an unwritable path fails first) before the tables, and
+    // renamed into place after them: a failure leaves neither.
+    let figure = match (&args.figure, figure_kind) {
+        (Some(path), Some(kind)) => {
+            let (pending, mut file) = PendingFile::create(path).context("--figure")?;
+            let bytes = draw(&recs[0], args.run - 1, kind)?;
+            std::io::Write::write_all(&mut file, &bytes)
+                .and_then(|()| file.sync_all())
+                .with_context(|| format!("--figure: cannot write {}", path.display()))?;
+            Some(pending)
+        }
+        _ => None,
+    };
     if let Some(dir) = &args.csv {
         write_csv(dir, &args.files, &recs)?;
     }
-    if let (Some(path), Some(kind)) = (&args.figure, figure_kind) {
-        let bytes = draw(&recs[0], args.run - 1, kind)?;
-        let (pending, mut file) = PendingFile::create(path).context("--figure")?;
-        std::io::Write::write_all(&mut file, &bytes)
-            .and_then(|()| file.sync_all())
-            .with_context(|| format!("--figure: cannot write {}", path.display()))?;
+    if let Some(pending) = figure {
         pending.commit().context("--figure")?;
     }
     if recs.len() == 1 {
@@ -137,17 +152,7 @@ fn describe(r: &Recording) -> Result<()> {
     match &r.runs {
         Runs::Epuck { scenario, results } => {
             let layout = &scenario.layout;
-            outln!("{EpuckRunHeader}")?;
-            for (index, result) in results.iter().enumerate() {
-                outln!(
-                    "{}",
-                    EpuckRunRow {
-                        index,
-                        result,
-                        layout
-                    }
-                )?;
-            }
+            crate::commands::run::print_epuck_runs(results, layout)?;
             let summary = summarise(results);
             let t_e = r
                 .tables
@@ -166,8 +171,6 @@ fn describe(r: &Recording) -> Result<()> {
                     t_e,
                 }
             )?;
-            let tables = csv_tables(r);
-            let runs = &tables[0];
             outln!()?;
             outln!(
                 "{:>4}  {:>8}  {:>11} {:>11} {:>11}",
@@ -177,24 +180,16 @@ fn describe(r: &Recording) -> Result<()> {
                 "driving (s)",
                 "stopped (s)"
             )?;
-            let col = |name: &str| match runs.columns.iter().find(|(n, _)| *n == name) {
-                Some((_, errp_sim::record::data::Column::F64(v))) => v.clone(),
-                _ => Vec::new(),
-            };
-            let (path, turning, driving, stopped) = (
-                col("path_m"),
-                col("turning_s"),
-                col("driving_s"),
-                col("stopped_s"),
-            );
-            for k in 0..path.len() {
+            for (k, (result, [turning, driving, stopped])) in
+                results.iter().zip(phase_secs(r)).enumerate()
+            {
                 outln!(
                     "{:>4}  {:>8.2}  {:>11.1} {:>11.1} {:>11.1}",
                     k + 1,
-                    path[k],
-                    turning[k],
-                    driving[k],
-                    stopped[k]
+                    result.path_m,
+                    turning,
+                    driving,
+                    stopped
                 )?;
             }
         }
@@ -372,17 +367,23 @@ fn write_csv(dir: &Path, files: &[PathBuf], recs: &[Recording]) -> Result<()> {
             );
         }
     }
+    // Every file is written to its temporary first and renamed into place
+    // only when all are, so a failure leaves none of them half-replaced.
     let mut made = Vec::new();
     let result = (|| -> Result<()> {
+        let mut pending = Vec::with_capacity(plan.len());
         for (path, t) in &plan {
             if let Some(parent) = path.parent() {
                 made.push(create_dirs(parent).context("--csv")?);
             }
-            let (pending, mut file) = PendingFile::create(path).context("--csv")?;
+            let (file_pending, mut file) = PendingFile::create(path).context("--csv")?;
             std::io::Write::write_all(&mut file, t.to_csv().as_bytes())
                 .and_then(|()| file.sync_all())
                 .with_context(|| format!("--csv: cannot write {}", path.display()))?;
-            pending.commit().context("--csv")?;
+            pending.push(file_pending);
+        }
+        for p in pending {
+            p.commit().context("--csv")?;
         }
         Ok(())
     })();

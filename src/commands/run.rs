@@ -301,17 +301,7 @@ pub(crate) fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario, text: Strin
             run_epuck_batch(&scenario, &decoder, scenario.runs)?
         }
     };
-    outln!("{EpuckRunHeader}")?;
-    for (index, result) in results.iter().enumerate() {
-        outln!(
-            "{}",
-            EpuckRunRow {
-                index,
-                result,
-                layout
-            }
-        )?;
-    }
+    print_epuck_runs(&results, layout)?;
     let summary = summarise(&results);
     out!(
         "{}",
@@ -340,4 +330,24 @@ fn open_recording<T>(
         Some(path) => Ok(Some(open(path).context("--save")?)),
         None => Ok(None),
     }
+}
+
+/// Prints the per-run table of e-puck `results` (`errp run`, and `errp
+/// inspect` from a recording).
+pub(crate) fn print_epuck_runs(
+    results: &[errp_sim::epuck::EpuckEpisodeResult],
+    layout: &errp_robot::GoalLayout,
+) -> Result<()> {
+    outln!("{EpuckRunHeader}")?;
+    for (index, result) in results.iter().enumerate() {
+        outln!(
+            "{}",
+            EpuckRunRow {
+                index,
+                result,
+                layout
+            }
+        )?;
+    }
+    Ok(())
 }

@@ -255,6 +255,20 @@ fn damaged_or_foreign_recordings_are_refused_and_nothing_is_written() {
     assert!(c.status.success(), "{}", stderr(&c));
     let e = refused(&["inspect", cal.to_str().unwrap()]);
     assert!(e.contains("calibration recording"), "{e}");
+    // A figure in place of a file errp did not write is refused and kept.
+    let mine = dir.join("mine.png");
+    std::fs::write(&mine, "my drawing").unwrap();
+    let e = refused(&[
+        "inspect",
+        good.to_str().unwrap(),
+        "--figure",
+        mine.to_str().unwrap(),
+    ]);
+    assert!(
+        e.contains("--figure") && e.contains("not a PNG image"),
+        "{e}"
+    );
+    assert_eq!(std::fs::read_to_string(&mine).unwrap(), "my drawing");
     // A run number the file does not hold.
     let e = refused(&["inspect", good.to_str().unwrap(), "--run", "3"]);
     assert!(e.contains("runs 1 to 2"), "{e}");

@@ -91,13 +91,16 @@ fn bools<'a>(t: &'a crate::inspect::Table, c: &str) -> &'a [bool] {
     }
 }
 
-/// The seconds of a run spent turning, driving and stopped, from its frames.
-pub(crate) fn phase_secs(rec: &Recording, run: usize) -> [f64; 3] {
-    let mut out = [0.0; 3];
+/// The seconds each run spent turning, driving and stopped, from its
+/// frames (one pass over them).
+pub fn phase_secs(rec: &Recording) -> Vec<[f64; 3]> {
+    let mut out = vec![[0.0; 3]; rec.n_runs()];
     if let Some(t) = get(rec, data::FRAMES) {
         for (r, p) in i64s(t, "run").iter().zip(i64s(t, "phase")) {
-            if *r == run as i64
-                && let Some(slot) = usize::try_from(*p).ok().and_then(|p| out.get_mut(p))
+            if let Some(slot) = usize::try_from(*r)
+                .ok()
+                .and_then(|r| out.get_mut(r))
+                .and_then(|run| usize::try_from(*p).ok().and_then(|p| run.get_mut(p)))
             {
                 *slot += PHYSICS_DT_SECS;
             }
@@ -137,7 +140,7 @@ fn epuck_tables(
 ) -> Vec<CsvTable> {
     let n = results.len();
     let run1 = |v: &[i64]| Column::I64(v.iter().map(|r| r + 1).collect());
-    let phases: Vec<[f64; 3]> = (0..n).map(|k| phase_secs(rec, k)).collect();
+    let phases = phase_secs(rec);
     let runs = CsvTable {
         name: "runs",
         columns: vec![
