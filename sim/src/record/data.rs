@@ -3,7 +3,7 @@
 //! every run, tables of what happened (one Rerun chunk per table and run,
 //! sent with `send_columns` on the `sim_time` timeline, each row also
 //! holding its `run` and its time `t_s` within the run). `errp inspect` and
-//! `errp.read_recording` read them back ([`crate::inspect`]) and recompute
+//! `errp.read_recording` read them back (the `inspect` module) and recompute
 //! each run's result from them.
 //!
 //! The tables, by entity path (columns in the order written):
