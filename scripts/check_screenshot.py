@@ -1,7 +1,7 @@
 """Checks a screenshot of a recording in the Rerun viewer: not blank, and no
 view of the shipped layout empty.
 
-usage: python check_screenshot.py {calibration,grid,epuck} SHOT.png [--self-test]
+usage: python check_screenshot.py {calibration,grid,epuck,agent} SHOT.png [--self-test]
 
 The layouts are the recordings' default blueprints with the side panels
 folded (sim/src/record.rs): every view is a cell of a known grid. Inside
@@ -33,6 +33,11 @@ LAYOUTS = {
     "epuck": [
         (0.0, 0.6, [("arena", 1), ("events", 1)]),
         (0.6, 1.0, [("belief per city", 1), ("p(error) and T_e", 1), ("EEG", 1)]),
+    ],
+    # Episodes of errp.gym.EpuckEnv: an agent drives, so no belief view.
+    "agent": [
+        (0.0, 0.6, [("arena", 1), ("events", 1)]),
+        (0.6, 1.0, [("p(error) and T_e", 1), ("EEG", 1)]),
     ],
 }
 

@@ -23,6 +23,7 @@ FIGURES=(
   "epuck_lisbon_optimistic|cheap|run scenarios/variants/lisbon_to_tokyo_optimistic.toml --runs 200 --quiet"
   "epuck_mexico_literal|cheap|run scenarios/variants/mexico_to_pisa_literal.toml --runs 200 --quiet"
   "epuck_lisbon_literal|cheap|run scenarios/variants/lisbon_to_tokyo_literal.toml --runs 200 --quiet"
+  "inspect_equals_run|cheap|sh: python3 scripts/inspect_equals_run.py scenarios/mexico_to_pisa.toml 100 5"
   "epuck_user_seed4|cheap|run scenarios/lisbon_to_tokyo.toml --seed 4 --runs 1 --quiet"
   "sweep_epuck|slow|sweep --task epuck --accuracy 0.55:0.95:0.05 --param strategy=greedy,info_gain --episodes 100 --seed 1 --out OUT_DIR --quiet"
   "fit_epuck|slow|fit epuck --out OUT_DIR --quiet"

@@ -5,8 +5,9 @@
 #
 #   scripts/screenshots.sh OUT_DIR [ERRP]
 #       records the calibration, a grid run and the Mexico -> Pisa run with
-#       ERRP (default target/debug/errp), renders each to OUT_DIR/*.png and
-#       checks them (scripts/check_screenshot.py)
+#       ERRP (default target/debug/errp), and two episodes of the Gymnasium
+#       e-puck with $PYTHON's errp package (save=), renders each to
+#       OUT_DIR/*.png and checks them (scripts/check_screenshot.py)
 #
 # Needs: `rerun` 0.36.3 on PATH (pip install rerun-sdk==0.36.3), Pillow,
 # and Debian's xvfb, xdotool and mesa-vulkan-drivers. The viewer exits with 102 once
@@ -23,8 +24,30 @@ trap 'rm -rf "$tmp"' EXIT
 "$errp" calibrate --accuracy 0.7438 --seed 1 --quiet --save "$tmp/calibration.rrd" > /dev/null
 "$errp" run scenarios/grid_fixed_goals.toml --seed 1 --quiet --save "$tmp/grid.rrd" > /dev/null
 "$errp" run scenarios/mexico_to_pisa.toml --seed 1 --quiet --save "$tmp/epuck.rrd" > /dev/null
+# Two episodes of the Gymnasium e-puck driven by a seeded random agent,
+# recorded with save= (needs the errp Python package), and read back.
+"${PYTHON:-python3}" - "$tmp/agent.rrd" <<'EOF'
+import sys
 
-for name in calibration grid epuck; do
+import gymnasium as gym
+import numpy as np
+
+import errp.gym  # noqa: F401  (registers the environments)
+
+env = gym.make("errp/Epuck-v0", save=sys.argv[1], max_episode_steps=120)
+rng = np.random.default_rng(1)
+for episode in range(2):
+    env.reset(seed=episode)
+    done = False
+    while not done:
+        a = 0 if rng.random() < 0.7 else int(rng.integers(1, 3))
+        _, _, term, trunc, _ = env.step(a)
+        done = term or trunc
+env.close()
+EOF
+"$errp" inspect "$tmp/agent.rrd" > /dev/null
+
+for name in calibration grid epuck agent; do
   status=0
   # The window opens in the middle of a larger screen, and the pointer is
   # moved to the screen's corner, off the window, so that no tooltip shows;

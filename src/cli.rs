@@ -197,6 +197,10 @@ pub(crate) struct InspectArgs {
     /// into this directory (one subdirectory per file when several).
     #[arg(long, value_name = "DIR")]
     pub(crate) csv: Option<PathBuf>,
+    /// Write the same tables as Parquet files (typed columns, Snappy) into
+    /// this directory, for pandas, Polars or DuckDB.
+    #[arg(long, value_name = "DIR")]
+    pub(crate) parquet: Option<PathBuf>,
     /// Draw the paper's Fig. 5 (e-puck: the arena, every run's path faint,
     /// one in blue with red marks at its detections) or Fig. 4 (grid: visit
     /// frequencies and paths) into FILE.png or FILE.svg (one recording).
@@ -207,9 +211,9 @@ pub(crate) struct InspectArgs {
     pub(crate) run: usize,
     /// Print the scenario as it was run (TOML) and nothing else, e.g. to
     /// run it again: `errp inspect F.rrd --scenario > s.toml`.
-    #[arg(long, conflicts_with_all = ["provenance", "csv", "figure"])]
+    #[arg(long, conflicts_with_all = ["provenance", "csv", "parquet", "figure"])]
     pub(crate) scenario: bool,
     /// Print the provenance document (JSON) and nothing else.
-    #[arg(long, conflicts_with_all = ["csv", "figure"])]
+    #[arg(long, conflicts_with_all = ["csv", "parquet", "figure"])]
     pub(crate) provenance: bool,
 }

@@ -18,7 +18,60 @@ use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{block_to_numpy, load_epuck, load_grid, py_err, value_error};
+use crate::convert::{block_to_numpy, load_any_text, load_epuck, load_grid, py_err, value_error};
+use crate::run::check_save;
+
+/// The most episodes a grid environment records (as `errp run --save`).
+#[cfg(feature = "rerun")]
+const MAX_SAVED_GRID_EPISODES: usize = 5_000;
+/// The most episodes an e-puck environment records (as `errp.run(save=)`:
+/// each adds about 2.5 MB).
+#[cfg(feature = "rerun")]
+const MAX_SAVED_EPUCK_EPISODES: usize = 100;
+
+/// The provenance of an environment's recording.
+#[cfg(feature = "rerun")]
+fn env_provenance(
+    task: &str,
+    name: &str,
+    text: String,
+    seed: u64,
+    class: &str,
+    id: &str,
+) -> errp_sim::record::data::Provenance {
+    let mut p = crate::run::provenance(task, name, text, seed, &format!("errp.gym.{class}"));
+    p.agent = Some(format!(
+        "an agent of the caller's own in errp.gym.{class} ({id}), not the shared control"
+    ));
+    p
+}
+
+/// A grid environment's recording: each episode written when it ends.
+#[cfg(feature = "rerun")]
+struct GridSave {
+    recorder: errp_sim::grid::GridRecorder,
+    provenance: errp_sim::record::data::Provenance,
+    /// The episode being stepped is recorded (under the cap) and not yet
+    /// written.
+    open: bool,
+}
+
+/// An e-puck environment's recording: each episode streamed as it runs.
+#[cfg(feature = "rerun")]
+struct EpuckSave {
+    file: errp_sim::record::RrdFile,
+    recorder: errp_sim::epuck::EpuckRecorder,
+    provenance: errp_sim::record::data::Provenance,
+    /// Episodes recorded to their end.
+    runs: usize,
+    /// The episode being stepped is recorded and has not ended.
+    open: bool,
+}
+
+/// What `close()` says of a recording: the path written, or why not.
+fn closed(out: errp_sim::Result<Option<PathBuf>>) -> PyResult<Option<PathBuf>> {
+    out.map_err(py_err)
+}
 
 /// How many calibrated decoders of each task a process keeps, so that
 /// environments of one scenario (made again by `gym.make`, vectorised
@@ -54,6 +107,10 @@ pub(crate) struct GridEnvCore {
     scenario: GridScenario,
     decoder: Arc<AssessmentDecoder>,
     episode: Option<GridEnvironment>,
+    /// The seed of the episode being stepped.
+    seed: u64,
+    #[cfg(feature = "rerun")]
+    save: Option<GridSave>,
 }
 
 /// A cell from `(x, y)`.
@@ -75,15 +132,44 @@ fn cell(name: &str, c: Option<(i64, i64)>) -> PyResult<Option<Cell>> {
 impl GridEnvCore {
     /// Loads the scenario (the built-in fixed-goals one by default) and
     /// calibrates its decoder.
+    /// With `save`, every episode (up to 5000) is recorded into that `.rrd`
+    /// when it ends, and the file is moved into place by `close()`.
     #[new]
-    #[pyo3(signature = (scenario=None, *, accuracy=None, overrides=None))]
+    #[pyo3(signature = (scenario=None, *, accuracy=None, overrides=None, save=None))]
     fn new(
         py: Python<'_>,
         scenario: Option<PathBuf>,
         accuracy: Option<f64>,
         overrides: Option<&Bound<'_, PyDict>>,
+        save: Option<PathBuf>,
     ) -> PyResult<Self> {
+        check_save(save.as_ref())?;
+        let text = match &save {
+            Some(_) => load_any_text(scenario.clone(), false, accuracy, overrides)?,
+            None => String::new(),
+        };
         let s = load_grid(scenario, accuracy, overrides, "the grid environment")?;
+        #[cfg(feature = "rerun")]
+        let save = match save {
+            Some(path) => {
+                let file = errp_sim::grid::grid_recording(&path).map_err(py_err)?;
+                Some(GridSave {
+                    recorder: errp_sim::grid::GridRecorder::new(file).map_err(py_err)?,
+                    provenance: env_provenance(
+                        "grid",
+                        &s.name,
+                        text,
+                        s.seed,
+                        "GridEnv",
+                        "errp/Grid-v0",
+                    ),
+                    open: false,
+                })
+            }
+            None => None,
+        };
+        #[cfg(not(feature = "rerun"))]
+        let _ = (save, text);
         let key = GridInfo::decoder_key(&s);
         let decoder = match cached(&GRID_DECODERS, &key) {
             Some(d) => d,
@@ -96,11 +182,15 @@ impl GridEnvCore {
             scenario: s,
             decoder,
             episode: None,
+            seed: 0,
+            #[cfg(feature = "rerun")]
+            save,
         })
     }
 
     /// Starts an episode from `start` towards `goal` (each drawn from `seed`
-    /// when not given) and returns (cursor, goal).
+    /// when not given) and returns (cursor, goal). A recorded episode in
+    /// progress is written first.
     #[pyo3(signature = (seed, start=None, goal=None))]
     fn reset(
         &mut self,
@@ -108,17 +198,46 @@ impl GridEnvCore {
         start: Option<(i64, i64)>,
         goal: Option<(i64, i64)>,
     ) -> PyResult<((usize, usize), (usize, usize))> {
-        let env = GridEnvironment::new(
+        let (start, goal) = (cell("start", start)?, cell("goal", goal)?);
+        self.write_episode().map_err(py_err)?;
+        #[allow(unused_mut)]
+        let mut env = GridEnvironment::new(
             self.decoder.clone(),
             self.scenario.params,
-            cell("start", start)?,
-            cell("goal", goal)?,
+            start,
+            goal,
             seed,
         )
         .map_err(py_err)?;
+        #[cfg(feature = "rerun")]
+        if let Some(save) = self.save.as_mut() {
+            save.open = save.recorder.episodes() < MAX_SAVED_GRID_EPISODES;
+            if save.open {
+                env.keep_steps();
+            }
+        }
         let (c, g) = (env.cell(), env.goal());
         self.episode = Some(env);
+        self.seed = seed;
         Ok(((c.x, c.y), (g.x, g.y)))
+    }
+
+    /// Writes the episode in progress (if it took an action) and moves the
+    /// recording into place; returns its path, or None when there is no
+    /// recording or no episode in it. The environment records no more.
+    fn close(&mut self) -> PyResult<Option<PathBuf>> {
+        closed(self.finish())
+    }
+
+    /// True when `save=` was given and no more episodes will be recorded
+    /// (5000 are).
+    #[getter]
+    fn recording_full(&self) -> bool {
+        #[cfg(feature = "rerun")]
+        if let Some(save) = &self.save {
+            return save.recorder.episodes() >= MAX_SAVED_GRID_EPISODES;
+        }
+        false
     }
 
     /// Takes action 0-4 (up, down, left, right, goal reached) and returns
@@ -147,6 +266,9 @@ impl GridEnvCore {
             }
         };
         let f = py.detach(|| env.step(a, keep_epoch)).map_err(py_err)?;
+        if env.ended() {
+            self.write_episode().map_err(py_err)?;
+        }
         let d = PyDict::new(py);
         d.set_item("cursor", (f.cell.x, f.cell.y))?;
         d.set_item("p_error", f.p_error)?;
@@ -196,26 +318,73 @@ impl GridEnvCore {
     }
 }
 
+impl GridEnvCore {
+    /// Records the episode in progress, if it is recorded, took an action
+    /// and is not written yet.
+    fn write_episode(&mut self) -> errp_sim::Result<()> {
+        #[cfg(feature = "rerun")]
+        if let (Some(save), Some(env)) = (self.save.as_mut(), self.episode.as_ref())
+            && save.open
+            && env.actions() > 0
+        {
+            save.open = false;
+            save.recorder
+                .episode(self.seed, self.scenario.params.epoch_secs, &env.result())?;
+        }
+        Ok(())
+    }
+
+    /// Writes what is left and moves the recording into place.
+    fn finish(&mut self) -> errp_sim::Result<Option<PathBuf>> {
+        self.write_episode()?;
+        #[cfg(feature = "rerun")]
+        if let Some(save) = self.save.take()
+            && save.recorder.episodes() > 0
+        {
+            return save.recorder.finish(&save.provenance).map(Some);
+        }
+        Ok(None)
+    }
+}
+
+impl Drop for GridEnvCore {
+    fn drop(&mut self) {
+        if let Err(e) = self.finish() {
+            eprintln!("errp.gym.GridEnv: the recording was not written: {e}");
+        }
+    }
+}
+
 /// An e-puck scenario's decoder and the episode being stepped.
 #[pyclass(module = "errp._core")]
 pub(crate) struct EpuckEnvCore {
     scenario: EpuckScenario,
     decoder: Arc<ContinuousDecoder>,
     episode: Option<EpuckEnvironment>,
+    #[cfg(feature = "rerun")]
+    save: Option<EpuckSave>,
 }
 
 #[pymethods]
 impl EpuckEnvCore {
     /// Loads the scenario (the built-in Mexico-to-Pisa one by default) and
     /// calibrates its continuous decoder.
+    /// With `save`, every episode (up to 100) is recorded into that `.rrd`
+    /// as it runs, and the file is moved into place by `close()`.
     #[new]
-    #[pyo3(signature = (scenario=None, *, accuracy=None, overrides=None))]
+    #[pyo3(signature = (scenario=None, *, accuracy=None, overrides=None, save=None))]
     fn new(
         py: Python<'_>,
         scenario: Option<PathBuf>,
         accuracy: Option<f64>,
         overrides: Option<&Bound<'_, PyDict>>,
+        save: Option<PathBuf>,
     ) -> PyResult<Self> {
+        check_save(save.as_ref())?;
+        let text = match &save {
+            Some(_) => load_any_text(scenario.clone(), true, accuracy, overrides)?,
+            None => String::new(),
+        };
         let s = load_epuck(scenario, accuracy, overrides, "the e-puck environment")?;
         let key = EpuckInfo::decoder_key(&s);
         let decoder = match cached(&EPUCK_DECODERS, &key) {
@@ -227,24 +396,92 @@ impl EpuckEnvCore {
                 keep(&EPUCK_DECODERS, key, Arc::new(d))
             }
         };
+        #[cfg(feature = "rerun")]
+        let save = match save {
+            Some(path) => {
+                let file = errp_sim::epuck::epuck_agent_recording(&path).map_err(py_err)?;
+                let t_e = decoder.t_e(s.params.control.t_e);
+                let recorder = errp_sim::epuck::EpuckRecorder::new(&file, &s.arena, &s.layout, t_e)
+                    .map_err(py_err)?;
+                Some(EpuckSave {
+                    file,
+                    recorder,
+                    provenance: env_provenance(
+                        "epuck",
+                        &s.name,
+                        text,
+                        s.seed,
+                        "EpuckEnv",
+                        "errp/Epuck-v0",
+                    ),
+                    runs: 0,
+                    open: false,
+                })
+            }
+            None => None,
+        };
+        #[cfg(not(feature = "rerun"))]
+        let _ = (save, text);
         Ok(Self {
             scenario: s,
             decoder,
             episode: None,
+            #[cfg(feature = "rerun")]
+            save,
         })
     }
 
     /// Starts an episode from the scenario's start, the user wanting `goal`
     /// (the scenario's by default), and returns (x_m, y_m, heading_rad) as
-    /// the camera sees it and the goal.
+    /// the camera sees it and the goal. A recorded episode in progress ends
+    /// first, without a commitment.
     #[pyo3(signature = (seed, goal=None))]
     fn reset(&mut self, seed: u64, goal: Option<usize>) -> PyResult<((f64, f64, f64), usize)> {
         let env = EpuckEnvironment::new(self.decoder.clone(), &self.scenario, goal, seed)
             .map_err(py_err)?;
+        self.end_episode();
+        #[cfg(feature = "rerun")]
+        if let Some(save) = self.save.as_mut() {
+            save.open = save.runs < MAX_SAVED_EPUCK_EPISODES;
+            if save.open {
+                use errp_sim::epuck::EpuckObserver;
+                let layout = &self.scenario.layout;
+                let name = &layout.goals()[env.goal()].name;
+                save.recorder.next_run(
+                    &format!(
+                        "episode {}: the user wants {name} (an agent drives)",
+                        save.runs + 1
+                    ),
+                    seed,
+                );
+                save.recorder.on_start(&env.start());
+                save.recorder
+                    .on_event(0.0, &format!("the user wants {name}"), false);
+            }
+        }
         let p = env.tracked();
         let g = env.goal();
         self.episode = Some(env);
         Ok(((p.x_m, p.y_m, p.heading_rad), g))
+    }
+
+    /// Ends the episode in progress (without a commitment, if it took an
+    /// action) and moves the recording into place; returns its path, or
+    /// None when there is no recording or no episode in it. The environment
+    /// records no more.
+    fn close(&mut self) -> PyResult<Option<PathBuf>> {
+        closed(self.finish())
+    }
+
+    /// True when `save=` was given and no more episodes will be recorded
+    /// (100 are).
+    #[getter]
+    fn recording_full(&self) -> bool {
+        #[cfg(feature = "rerun")]
+        if let Some(save) = &self.save {
+            return save.runs >= MAX_SAVED_EPUCK_EPISODES;
+        }
+        false
     }
 
     /// Runs action 0-3 (forward, turn left, turn right, stop) for
@@ -274,6 +511,23 @@ impl EpuckEnvCore {
                 ));
             }
         };
+        #[cfg(feature = "rerun")]
+        let f = match self.save.as_mut() {
+            Some(save) if save.open => {
+                let f = py
+                    .detach(|| env.step_observed(a, windows, keep_window, &mut save.recorder))
+                    .map_err(py_err)?;
+                if env.ended() {
+                    save.open = false;
+                    save.runs += 1;
+                }
+                f
+            }
+            _ => py
+                .detach(|| env.step(a, windows, keep_window))
+                .map_err(py_err)?,
+        };
+        #[cfg(not(feature = "rerun"))]
         let f = py
             .detach(|| env.step(a, windows, keep_window))
             .map_err(py_err)?;
@@ -332,6 +586,17 @@ impl EpuckEnvCore {
         self.scenario.params.control.goal_radius_m
     }
 
+    /// The obstacles' outlines: one list of (x_m, y_m) per obstacle.
+    #[getter]
+    fn obstacles(&self) -> Vec<Vec<(f64, f64)>> {
+        self.scenario
+            .arena
+            .obstacles
+            .iter()
+            .map(|o| o.outline())
+            .collect()
+    }
+
     /// The arena's side (m).
     #[getter]
     fn arena_size_m(&self) -> f64 {
@@ -354,5 +619,51 @@ impl EpuckEnvCore {
     #[getter]
     fn name(&self) -> String {
         self.scenario.name.clone()
+    }
+}
+
+impl EpuckEnvCore {
+    /// Ends the recorded episode in progress, if it took a step.
+    fn end_episode(&mut self) {
+        #[cfg(feature = "rerun")]
+        if let (Some(save), Some(env)) = (self.save.as_mut(), self.episode.as_mut())
+            && save.open
+        {
+            save.open = false;
+            if env.time_secs() > 0.0 {
+                env.end(&mut save.recorder);
+                save.runs += 1;
+            }
+        }
+    }
+
+    /// Ends what is in progress and moves the recording into place.
+    fn finish(&mut self) -> errp_sim::Result<Option<PathBuf>> {
+        self.end_episode();
+        #[cfg(feature = "rerun")]
+        if let Some(save) = self.save.take() {
+            save.recorder.finish()?;
+            if save.runs == 0 {
+                return Ok(None);
+            }
+            let mut provenance = save.provenance;
+            provenance.runs = save.runs;
+            provenance
+                .log(save.file.stream())
+                .map_err(|e| errp_sim::SimError::Record {
+                    path: save.file.path().to_path_buf(),
+                    message: e.to_string(),
+                })?;
+            return save.file.finish().map(Some);
+        }
+        Ok(None)
+    }
+}
+
+impl Drop for EpuckEnvCore {
+    fn drop(&mut self) {
+        if let Err(e) = self.finish() {
+            eprintln!("errp.gym.EpuckEnv: the recording was not written: {e}");
+        }
     }
 }

@@ -23,10 +23,28 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::{
-    PyDecoder, blocks_to_array3, channel_names, check_callable, load_epuck, load_grid, py_err,
-    value_error,
+    PyDecoder, blocks_to_array3, channel_names, check_callable, load_any_text, load_epuck,
+    load_grid, py_err, value_error,
 };
-use crate::run::{DecoderSummary, epuck_summary, grid_summary, header, line, summary_dict};
+use crate::run::{
+    DecoderSummary, check_save, epuck_summary, grid_summary, header, line, summary_dict,
+};
+
+/// The most grid episodes `GridTask.run(save=)` records (as `errp run
+/// --save`).
+const MAX_SAVED_GRID_EPISODES: usize = 5_000;
+/// The most e-puck runs `EpuckTask.run(save=)` records (as `errp.run`).
+const MAX_SAVED_EPUCK_RUNS: usize = 100;
+
+/// The command a task's recording names.
+#[cfg(feature = "rerun")]
+fn task_call(class: &str, own_decoder: bool) -> String {
+    if own_decoder {
+        format!("errp.{class}(decoder=...).run (a decoder of the caller's own)")
+    } else {
+        format!("errp.{class}.run")
+    }
+}
 
 /// The EEG pipeline behind a grid decoder, if it reads EEG.
 fn eeg_of(d: &AssessmentDecoder) -> Option<&EegDecoder> {
@@ -43,6 +61,8 @@ fn eeg_of(d: &AssessmentDecoder) -> Option<&EegDecoder> {
 #[pyclass(module = "errp._core")]
 pub(crate) struct GridTask {
     scenario: GridScenario,
+    /// The scenario file as run (overrides set), for a recording.
+    text: String,
     builtin: Arc<AssessmentDecoder>,
     decoder: Option<Py<PyAny>>,
     scores: Option<(Vec<f64>, Vec<f64>)>,
@@ -66,6 +86,7 @@ impl GridTask {
         accuracy: Option<f64>,
         overrides: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
+        let text = load_any_text(scenario.clone(), false, accuracy, overrides)?;
         let mut s = load_grid(scenario, accuracy, overrides, "errp.GridTask")?;
         if let Some(seed) = seed {
             s.seed = seed;
@@ -87,6 +108,7 @@ impl GridTask {
         }
         let mut task = Self {
             scenario: s,
+            text,
             builtin: Arc::new(builtin),
             decoder,
             scores: None,
@@ -100,16 +122,33 @@ impl GridTask {
     }
 
     /// Runs every episode of the scenario (episode k from the seed `errp
-    /// run` gives it) and returns the rows as CSV text.
-    fn run(&self, py: Python<'_>) -> PyResult<String> {
+    /// run` gives it) and returns the rows as CSV text; with `save`, records
+    /// them into that `.rrd` as `errp run --save` does.
+    #[pyo3(signature = (save=None))]
+    fn run(&self, py: Python<'_>, save: Option<PathBuf>) -> PyResult<String> {
+        check_save(save.as_ref())?;
         let s = &self.scenario;
+        if save.is_some() && s.episodes.len() > MAX_SAVED_GRID_EPISODES {
+            return Err(value_error(
+                "save",
+                format!("a scenario of {} episodes", s.episodes.len()),
+                &format!("at most {MAX_SAVED_GRID_EPISODES} episodes in a recording"),
+            ));
+        }
+        #[cfg(feature = "rerun")]
+        let file = save
+            .as_ref()
+            .map(|p| errp_sim::grid::grid_recording(p))
+            .transpose()
+            .map_err(py_err)?;
+        let record = save.is_some();
         let builtin = &self.builtin;
         let mut lines = vec![header(&GridInfo::INFO)];
         let mut push = |k: usize, r: &errp_sim::grid::GridEpisodeResult| {
             let seed = derive_seed(s.seed, "grid/episode", k as u64);
             lines.push(line(s.accuracy, k, seed, grid_row(r)));
         };
-        match (&self.decoder, &self.scores) {
+        let episodes = match (&self.decoder, &self.scores) {
             (Some(f), _) => {
                 let mut dec = PyDecoder::new(f.clone_ref(py));
                 let eeg = eeg_of(builtin).expect("checked: an EEG decoder");
@@ -119,22 +158,36 @@ impl GridTask {
                         source: eeg.source(),
                         decode: &mut call,
                     };
-                    run_grid_scenario_with(s, decoding, false, &mut push)
+                    run_grid_scenario_with(s, decoding, record, &mut push)
                 });
                 self.calls.fetch_add(dec.calls, Ordering::Relaxed);
-                result.map_err(|e| dec.error(e))?;
+                result.map_err(|e| dec.error(e))?
             }
             (None, Some((error, correct))) => {
                 let decoding = GridDecoding::Scores { error, correct };
-                py.detach(|| run_grid_scenario_with(s, decoding, false, &mut push))
-                    .map_err(py_err)?;
+                py.detach(|| run_grid_scenario_with(s, decoding, record, &mut push))
+                    .map_err(py_err)?
             }
             (None, None) => {
                 let decoding = GridDecoding::Builtin(builtin);
-                py.detach(|| run_grid_scenario_with(s, decoding, false, &mut push))
-                    .map_err(py_err)?;
+                py.detach(|| run_grid_scenario_with(s, decoding, record, &mut push))
+                    .map_err(py_err)?
             }
+        };
+        #[cfg(feature = "rerun")]
+        if let Some(file) = file {
+            let call = task_call("GridTask", self.decoder.is_some() || self.scores.is_some());
+            let p = crate::run::provenance("grid", &s.name, self.text.clone(), s.seed, &call);
+            let report = errp_sim::grid::GridRunReport {
+                scenario: s.clone(),
+                calibration: None,
+                episodes,
+            };
+            py.detach(|| errp_sim::grid::record_grid_run(file, &report, &p))
+                .map_err(py_err)?;
         }
+        #[cfg(not(feature = "rerun"))]
+        let _ = (episodes, &self.text);
         Ok(lines.join("\n") + "\n")
     }
 
@@ -234,6 +287,8 @@ impl GridTask {
 #[pyclass(module = "errp._core")]
 pub(crate) struct EpuckTask {
     scenario: EpuckScenario,
+    /// The scenario file as run (overrides set), for a recording.
+    text: String,
     builtin: Arc<ContinuousDecoder>,
     decoder: Option<Py<PyAny>>,
     calibration: DecoderSummary,
@@ -254,6 +309,7 @@ impl EpuckTask {
         accuracy: Option<f64>,
         overrides: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
+        let text = load_any_text(scenario.clone(), true, accuracy, overrides)?;
         let mut s = load_epuck(scenario, accuracy, overrides, "errp.EpuckTask")?;
         if let Some(seed) = seed {
             s.reseed(seed);
@@ -265,6 +321,7 @@ impl EpuckTask {
         let info = epuck_summary(&s, &builtin, &report);
         Ok(Self {
             scenario: s,
+            text,
             builtin: Arc::new(builtin),
             decoder,
             calibration: info,
@@ -275,9 +332,12 @@ impl EpuckTask {
     /// Runs `runs` runs (the scenario's by default; run k from the seed
     /// `errp run` gives it) and returns the rows as CSV text. With the
     /// testbed's decoder they run in parallel; a decoder of the caller's own
-    /// runs them one after another.
-    #[pyo3(signature = (runs=None))]
-    fn run(&self, py: Python<'_>, runs: Option<usize>) -> PyResult<String> {
+    /// runs them one after another. With `save` (at most 100 runs), the
+    /// runs are recorded into that `.rrd` as `errp run --save` records
+    /// them, one after another.
+    #[pyo3(signature = (runs=None, *, save=None))]
+    fn run(&self, py: Python<'_>, runs: Option<usize>, save: Option<PathBuf>) -> PyResult<String> {
+        check_save(save.as_ref())?;
         let max = errp_sim::epuck::MAX_RUNS as usize;
         let runs = runs.unwrap_or(self.scenario.runs);
         if !(1..=max).contains(&runs) {
@@ -287,8 +347,49 @@ impl EpuckTask {
                 &format!("a whole number from 1 to {max}"),
             ));
         }
+        if save.is_some() && runs > MAX_SAVED_EPUCK_RUNS {
+            return Err(value_error(
+                "runs",
+                runs,
+                &format!(
+                    "at most {MAX_SAVED_EPUCK_RUNS} with save= (each run adds about 2.5 MB to \
+                     the recording)"
+                ),
+            ));
+        }
         let s = &self.scenario;
         let d = &self.builtin;
+        #[cfg(feature = "rerun")]
+        if let Some(path) = &save {
+            let file = errp_sim::epuck::epuck_recording(path).map_err(py_err)?;
+            let call = task_call("EpuckTask", self.decoder.is_some());
+            let p = crate::run::provenance("epuck", &s.name, self.text.clone(), s.seed, &call);
+            let results = match &self.decoder {
+                None => py
+                    .detach(|| errp_sim::epuck::record_epuck_runs_with(&file, s, d, &p, runs, None))
+                    .map_err(py_err)?,
+                Some(f) => {
+                    let mut dec = PyDecoder::new(f.clone_ref(py));
+                    let result = py.detach(|| {
+                        let mut call = |b: &EegBlock| dec.call(b);
+                        errp_sim::epuck::record_epuck_runs_with(
+                            &file,
+                            s,
+                            d,
+                            &p,
+                            runs,
+                            Some(&mut call),
+                        )
+                    });
+                    self.calls.fetch_add(dec.calls, Ordering::Relaxed);
+                    result.map_err(|e| dec.error(e))?
+                }
+            };
+            py.detach(|| file.finish()).map_err(py_err)?;
+            return Ok(self.rows(&results));
+        }
+        #[cfg(not(feature = "rerun"))]
+        let _ = &self.text;
         let results = match &self.decoder {
             None => py.detach(|| run_epuck_batch(s, d, runs)).map_err(py_err)?,
             Some(f) => {
@@ -314,12 +415,7 @@ impl EpuckTask {
                 result.map_err(|e| dec.error(e))?
             }
         };
-        let mut lines = vec![header(&EpuckInfo::INFO)];
-        for (k, r) in results.iter().enumerate() {
-            let seed = epuck_run_seed(s.seed, k);
-            lines.push(line(s.accuracy.get(), k, seed, epuck_row(&s.layout, r)));
-        }
-        Ok(lines.join("\n") + "\n")
+        Ok(self.rows(&results))
     }
 
     /// What the calibration found (accuracy, ErrP-to-noise ratio,
@@ -371,5 +467,18 @@ impl EpuckTask {
     #[getter]
     fn seed(&self) -> u64 {
         self.scenario.seed
+    }
+}
+
+impl EpuckTask {
+    /// The runs' rows as CSV text.
+    fn rows(&self, results: &[errp_sim::epuck::EpuckEpisodeResult]) -> String {
+        let s = &self.scenario;
+        let mut lines = vec![header(&EpuckInfo::INFO)];
+        for (k, r) in results.iter().enumerate() {
+            let seed = epuck_run_seed(s.seed, k);
+            lines.push(line(s.accuracy.get(), k, seed, epuck_row(&s.layout, r)));
+        }
+        lines.join("\n") + "\n"
     }
 }

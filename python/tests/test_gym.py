@@ -17,11 +17,14 @@ import errp.gym  # noqa: E402,F401  (registers the environments)
         ("errp/Grid-v0", {"observe_epoch": True, "goal": (3, 1)}),
         ("errp/Epuck-v0", {}),
         ("errp/Epuck-v0", {"observe_window": True, "goal": "Tokyo"}),
+        ("errp/Grid-v0", {"render_mode": "rgb_array"}),
+        ("errp/Epuck-v0", {"render_mode": "rgb_array"}),
     ],
 )
 def test_check_env(env_id, kwargs):
     env = gym.make(env_id, **kwargs)
-    check_env(env.unwrapped, skip_render_check=True)
+    # The render check only where there is something to render with.
+    check_env(env.unwrapped, skip_render_check="render_mode" not in kwargs)
     obs, _ = env.reset(seed=0)
     assert env.observation_space.contains(obs)
 
@@ -130,5 +133,7 @@ def test_bad_arguments_name_the_field():
         env.step(9)
     with pytest.raises(ValueError, match="options"):
         env.reset(seed=0, options={"gaol": (1, 1)})
-    with pytest.raises(ValueError, match="render_mode"):
-        gym.make("errp/Grid-v0", render_mode="human")
+    with pytest.raises(ValueError, match="render_mode = 'human' is invalid"):
+        errp.gym.GridEnv(render_mode="human")
+    with pytest.raises(ValueError, match="'ansi' or 'rgb_array'"):
+        errp.gym.EpuckEnv(render_mode="rgb")

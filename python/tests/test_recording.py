@@ -37,6 +37,23 @@ def test_epuck_recording_tables_match_the_program(root, tmp_path):
                 assert np.array_equal(a.astype(float), b.astype(float), equal_nan=True), (name, c)
             else:
                 assert [str(x) for x in a] == ["" if pd.isna(x) else str(x) for x in b], (name, c)
+    # The same tables as Parquet files (`--parquet`), typed, value for value.
+    pq = tmp_path / "parquet"
+    cli("inspect", str(rrd), "--parquet", str(pq))
+    assert sorted(p.stem for p in pq.glob("*.parquet")) == sorted(rec.tables)
+    for name, frame in rec.tables.items():
+        from_pq = pd.read_parquet(pq / f"{name}.parquet")
+        assert list(from_pq.columns) == list(frame.columns), name
+        for c in frame.columns:
+            a, b = frame[c], from_pq[c]
+            if pd.api.types.is_bool_dtype(frame[c]):
+                assert pd.api.types.is_bool_dtype(b) and list(a) == list(b), (name, c)
+            elif pd.api.types.is_numeric_dtype(frame[c]):
+                assert np.array_equal(
+                    a.to_numpy(float), b.to_numpy(float, na_value=np.nan), equal_nan=True
+                ), (name, c)
+            else:
+                assert [str(x) for x in a] == [str(x) for x in b], (name, c)
     # One trajectory row per physics step.
     assert len(rec.trajectory) == pytest.approx(64 * runs.time_s.sum(), abs=6 * 1.5)
     ax = rec.plot(run=2)

@@ -80,9 +80,14 @@ pub(crate) fn inspect(args: &InspectArgs) -> Result<()> {
         }
         _ => None,
     };
+    let mut outputs = Vec::new();
     if let Some(dir) = &args.csv {
-        write_csv(dir, &args.files, &recs)?;
+        outputs.push((dir.as_path(), TableFormat::Csv));
     }
+    if let Some(dir) = &args.parquet {
+        outputs.push((dir.as_path(), TableFormat::Parquet));
+    }
+    write_tables(&outputs, &args.files, &recs)?;
     if let Some(pending) = figure {
         pending.commit().context("--figure")?;
     }
@@ -95,8 +100,8 @@ pub(crate) fn inspect(args: &InspectArgs) -> Result<()> {
         outln!()?;
         compare(&recs)?;
     }
-    if let Some(dir) = &args.csv {
-        outln!("Wrote the tables to {}", dir.display())?;
+    for (dir, format) in &outputs {
+        outln!("Wrote the tables to {} ({})", dir.display(), format.name())?;
     }
     if let Some(path) = &args.figure {
         outln!("Wrote {}", path.display())?;
@@ -141,12 +146,18 @@ fn describe(r: &Recording) -> Result<()> {
     } else {
         String::new()
     };
-    outln!(
-        "  run again: errp inspect {} --scenario > scenario.toml && errp run scenario.toml \
-         --seed {}{runs}",
-        r.path.display(),
-        p.seed
-    )?;
+    match &p.agent {
+        Some(agent) => outln!(
+            "  driven by: {agent}; each episode's seed is in the runs table \
+             (--csv), the actions in the trajectory"
+        )?,
+        None => outln!(
+            "  run again: errp inspect {} --scenario > scenario.toml && errp run scenario.toml \
+             --seed {}{runs}",
+            r.path.display(),
+            p.seed
+        )?,
+    }
     outln!("Recomputed from the recording:")?;
     out!("{}", p.decoder_summary)?;
     match &r.runs {
@@ -329,61 +340,142 @@ fn compare(recs: &[Recording]) -> Result<()> {
     Ok(())
 }
 
-/// Writes every table of every recording into `dir` (a subdirectory per
-/// file when several). Existing files are replaced only if they are tables
-/// of ours (the same header); the directories made are removed on failure.
-fn write_csv(dir: &Path, files: &[PathBuf], recs: &[Recording]) -> Result<()> {
-    let mut plan: Vec<(PathBuf, CsvTable)> = Vec::new();
-    for (f, r) in files.iter().zip(recs) {
-        let base = if recs.len() == 1 {
-            dir.to_path_buf()
-        } else {
-            dir.join(f.file_stem().unwrap_or_default())
-        };
-        for t in csv_tables(r) {
-            plan.push((base.join(format!("{}.csv", t.name)), t));
+/// A format of the tidy tables.
+#[derive(Clone, Copy)]
+enum TableFormat {
+    Csv,
+    Parquet,
+}
+
+impl TableFormat {
+    fn name(self) -> &'static str {
+        match self {
+            TableFormat::Csv => "CSV",
+            TableFormat::Parquet => "Parquet",
         }
     }
-    for (path, t) in &plan {
-        if let Ok(mut file) = errp_sim::open_regular(path) {
-            use std::io::Read;
-            let mut head = vec![0u8; 4096];
-            let n = file.read(&mut head).unwrap_or(0);
-            let header: Vec<&str> = t.columns.iter().map(|(n, _)| *n).collect();
-            let ours = header.join(",") + "\n";
-            if n > 0 && !head[..n].starts_with(ours.as_bytes()) {
+
+    fn flag(self) -> &'static str {
+        match self {
+            TableFormat::Csv => "--csv",
+            TableFormat::Parquet => "--parquet",
+        }
+    }
+
+    fn extension(self) -> &'static str {
+        match self {
+            TableFormat::Csv => "csv",
+            TableFormat::Parquet => "parquet",
+        }
+    }
+
+    /// True if `head` (the file's first bytes) and `tail` (its last 64 KiB)
+    /// are those of table `t` as errp writes it: a CSV file with the same
+    /// header, or a Parquet file whose metadata names an errp table.
+    fn ours(self, t: &CsvTable, head: &[u8], tail: &[u8]) -> bool {
+        match self {
+            TableFormat::Csv => {
+                let header: Vec<&str> = t.columns.iter().map(|(n, _)| *n).collect();
+                head.starts_with((header.join(",") + "\n").as_bytes())
+            }
+            TableFormat::Parquet => {
+                let key = errp_sim::inspect::PARQUET_TABLE_KEY.as_bytes();
+                head.starts_with(b"PAR1")
+                    && tail.ends_with(b"PAR1")
+                    && tail.windows(key.len()).any(|w| w == key)
+            }
+        }
+    }
+
+    fn bytes(self, t: &CsvTable) -> Result<Vec<u8>> {
+        match self {
+            TableFormat::Csv => Ok(t.to_csv().into_bytes()),
+            TableFormat::Parquet => t
+                .to_parquet()
+                .map_err(|e| anyhow::anyhow!("--parquet: cannot encode {}: {e}", t.name)),
+        }
+    }
+}
+
+/// The first 4 KiB and the last 64 KiB of the regular file `path`, if it
+/// is one and can be read.
+fn head_and_tail(path: &Path) -> Option<(Vec<u8>, Vec<u8>)> {
+    use std::io::{Read, Seek, SeekFrom};
+    let mut file = errp_sim::open_regular(path).ok()?;
+    let len = file.metadata().ok()?.len();
+    let mut head = vec![0u8; 4096];
+    let n = file.read(&mut head).ok()?;
+    head.truncate(n);
+    let from = len.saturating_sub(64 * 1024);
+    file.seek(SeekFrom::Start(from)).ok()?;
+    let mut tail = Vec::new();
+    file.take(64 * 1024).read_to_end(&mut tail).ok()?;
+    Some((head, tail))
+}
+
+/// Writes every table of every recording into each directory of `outputs`
+/// in its format (a subdirectory per file when several). Existing files
+/// are replaced only if they are tables of ours; every file is written to
+/// its temporary and all are renamed into place together, and the
+/// directories made are removed on failure.
+fn write_tables(
+    outputs: &[(&Path, TableFormat)],
+    files: &[PathBuf],
+    recs: &[Recording],
+) -> Result<()> {
+    if outputs.is_empty() {
+        return Ok(());
+    }
+    let mut plan: Vec<(PathBuf, TableFormat, &Path, CsvTable)> = Vec::new();
+    for &(dir, format) in outputs {
+        for (f, r) in files.iter().zip(recs) {
+            let base = if recs.len() == 1 {
+                dir.to_path_buf()
+            } else {
+                dir.join(f.file_stem().unwrap_or_default())
+            };
+            for t in csv_tables(r) {
+                let name = format!("{}.{}", t.name, format.extension());
+                plan.push((base.join(name), format, dir, t));
+            }
+        }
+    }
+    for (path, format, dir, t) in &plan {
+        if let Some((head, tail)) = head_and_tail(path) {
+            if !head.is_empty() && !format.ours(t, &head, &tail) {
                 bail!(
-                    "--csv {}: {} exists and is not a table errp wrote; errp replaces only its \
+                    "{} {}: {} exists and is not a table errp wrote; errp replaces only its \
                      own files: move it away or give another directory",
+                    format.flag(),
                     dir.display(),
                     path.display()
                 );
             }
         } else if path.exists() {
             bail!(
-                "--csv {}: {} exists and is not a regular file",
+                "{} {}: {} exists and is not a regular file",
+                format.flag(),
                 dir.display(),
                 path.display()
             );
         }
     }
-    // Every file is written to its temporary first and renamed into place
-    // only when all are, so a failure leaves none of them half-replaced.
     let mut made = Vec::new();
     let result = (|| -> Result<()> {
         let mut pending = Vec::with_capacity(plan.len());
-        for (path, t) in &plan {
+        for (path, format, _, t) in &plan {
             if let Some(parent) = path.parent() {
-                made.push(create_dirs(parent).context("--csv")?);
+                made.push(create_dirs(parent).context(format.flag())?);
             }
-            let (file_pending, mut file) = PendingFile::create(path).context("--csv")?;
-            std::io::Write::write_all(&mut file, t.to_csv().as_bytes())
+            let bytes = format.bytes(t)?;
+            let (file_pending, mut file) = PendingFile::create(path).context(format.flag())?;
+            std::io::Write::write_all(&mut file, &bytes)
                 .and_then(|()| file.sync_all())
-                .with_context(|| format!("--csv: cannot write {}", path.display()))?;
+                .with_context(|| format!("{}: cannot write {}", format.flag(), path.display()))?;
             pending.push(file_pending);
         }
         for p in pending {
-            p.commit().context("--csv")?;
+            p.commit().context("the tables")?;
         }
         Ok(())
     })();

@@ -142,6 +142,49 @@ fn epuck_runs_recomputed_from_the_recording_are_what_run_printed() {
         "{e}"
     );
     assert_eq!(std::fs::read(csv.join("runs.csv")).unwrap(), before);
+
+    // The same tables as Parquet, with the CSV tables in one call: all are
+    // written, or none (a foreign Parquet file stops both).
+    let pq = dir.join("parquet");
+    let csv2 = dir.join("tables2");
+    let o = errp(&[
+        "inspect",
+        rrd_s,
+        "--parquet",
+        pq.to_str().unwrap(),
+        "--csv",
+        csv2.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(files_in(&pq).len(), 6);
+    for f in files_in(&pq) {
+        assert!(f.ends_with(".parquet"), "{f}");
+        let bytes = std::fs::read(pq.join(&f)).unwrap();
+        assert!(
+            bytes.starts_with(b"PAR1") && bytes.ends_with(b"PAR1"),
+            "{f}"
+        );
+    }
+    // Snappy makes the trajectory smaller than its CSV text.
+    let size = |p: std::path::PathBuf| std::fs::metadata(p).unwrap().len();
+    assert!(size(pq.join("trajectory.parquet")) < size(csv2.join("trajectory.csv")) / 2);
+    let again = errp(&["inspect", rrd_s, "--parquet", pq.to_str().unwrap()]);
+    assert!(again.status.success(), "{}", stderr(&again));
+    std::fs::write(pq.join("errps.parquet"), "PAR1 not really PAR1").unwrap();
+    let csv3 = dir.join("tables3");
+    let e = refused(&[
+        "inspect",
+        rrd_s,
+        "--csv",
+        csv3.to_str().unwrap(),
+        "--parquet",
+        pq.to_str().unwrap(),
+    ]);
+    assert!(
+        e.contains("--parquet") && e.contains("errps.parquet exists and is not a table errp wrote"),
+        "{e}"
+    );
+    assert!(!csv3.exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
 

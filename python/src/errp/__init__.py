@@ -249,7 +249,8 @@ class Recording:
     provenance : dict
         How it was made: ``scenario_text`` (the scenario as run, TOML),
         ``seed``, ``runs``, ``command``, ``errp_version``, ``commit``,
-        ``decoder_summary``.
+        ``decoder_summary`` and, when an agent of your own chose the
+        actions (``errp.gym``), ``agent``.
     tables : dict of pandas.DataFrame
         The tidy tables, each with a ``run`` column (from 1), identical to
         the CSV files of ``errp inspect --csv``. E-puck: ``runs`` (one row
@@ -590,10 +591,13 @@ class GridTask(_Task):
             overrides=None if overrides is None else dict(overrides),
         )
 
-    def run(self):
+    def run(self, *, save: Optional[PathLike] = None):
         """Runs every episode of the scenario and returns one row per
-        episode (the columns of :func:`run`)."""
-        df = _frame(self._core.run())
+        episode (the columns of :func:`run`). With ``save``, the episodes
+        (at most 5000) are recorded into that ``.rrd`` as ``errp run
+        --save`` records them, with the decoder in the loop (yours, if
+        given)."""
+        df = _frame(self._core.run(_path(save)))
         df.attrs["task"] = "grid"
         df.attrs["decoder"] = self.calibration
         return df
@@ -637,10 +641,12 @@ class EpuckTask(_Task):
             overrides=None if overrides is None else dict(overrides),
         )
 
-    def run(self, runs: Optional[int] = None):
+    def run(self, runs: Optional[int] = None, *, save: Optional[PathLike] = None):
         """Runs ``runs`` runs (the scenario's by default) and returns one row
-        per run (the columns of :func:`run`)."""
-        df = _frame(self._core.run(runs))
+        per run (the columns of :func:`run`). With ``save``, the runs (at
+        most 100) are recorded into that ``.rrd`` as ``errp run --save``
+        records them, with the decoder in the loop (yours, if given)."""
+        df = _frame(self._core.run(runs, save=_path(save)))
         df.attrs["task"] = "epuck"
         df.attrs["decoder"] = self.calibration
         return df

@@ -16,6 +16,12 @@ Importing this module registers:
   agent says "goal reached" (``info["success"]`` says whether it was the
   goal) or after ``max_episode_steps`` actions (100).
 
+``save="file.rrd"`` records every episode of an environment (each a run)
+into one Rerun recording, written when the environment is closed; ``errp
+inspect file.rrd``, :func:`errp.read_recording` and the Rerun viewer read it.
+``render_mode="rgb_array"`` draws a top-down frame (the arena or the grid)
+for Gymnasium's ``RecordVideo``.
+
 With ``observe_epoch=True`` the observation also holds the action's epoch of
 preprocessed EEG, ``(n_channels, n_samples)`` float32 in uV, for agents that
 decode the EEG themselves (the scenario's EEG must be streamed: the default
@@ -32,6 +38,7 @@ here).
 from __future__ import annotations
 
 import os
+import warnings
 from typing import Any, Optional, Tuple
 
 import numpy as np
@@ -72,11 +79,18 @@ class GridEnv(gym.Env):
         them for one episode).
     observe_epoch : bool
         Add the action's preprocessed EEG epoch to the observation.
-    render_mode : {"ansi"}, optional
-        ``render()`` returns the grid as text.
+    render_mode : {"ansi", "rgb_array"}, optional
+        ``render()`` returns the grid as text, or as an RGB frame
+        ``(340, 320, 3)`` uint8: the cells shaded by this episode's visits,
+        the goal outlined in red, the cursor in black, p(error) as a bar.
+    save : path, optional
+        Record every episode (up to 5000) into this ``.rrd``, written by
+        :meth:`close`: the actions, p(error) and the user's judgements, as
+        ``errp run --save`` records the grid (no belief: the agent's is its
+        own).
     """
 
-    metadata = {"render_modes": ["ansi"]}
+    metadata = {"render_modes": ["ansi", "rgb_array"], "render_fps": 2}
 
     def __init__(
         self,
@@ -88,11 +102,9 @@ class GridEnv(gym.Env):
         start: Optional[Tuple[int, int]] = None,
         observe_epoch: bool = False,
         render_mode: Optional[str] = None,
+        save: Optional[str] = None,
     ) -> None:
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(
-                f"render_mode = {render_mode!r} is invalid: expected None or 'ansi'"
-            )
+        _check_render_mode(render_mode, self.metadata["render_modes"])
         fields = {"eeg": "stream"}
         if overrides:
             fields.update(overrides)
@@ -100,7 +112,10 @@ class GridEnv(gym.Env):
             None if scenario is None else os.fspath(scenario),
             accuracy=accuracy,
             overrides=fields,
+            save=None if save is None else os.fspath(save),
         )
+        self.save = save
+        self._full_warned = False
         self.goal = _cell("goal", goal)
         self.start = _cell("start", start)
         self.observe_epoch = bool(observe_epoch)
@@ -124,6 +139,7 @@ class GridEnv(gym.Env):
         self._cursor = (0, 0)
         self._goal = (0, 0)
         self._last: dict = {}
+        self._visits = np.zeros((5, 5), dtype=np.int64)
 
     @property
     def ch_names(self) -> list:
@@ -165,6 +181,9 @@ class GridEnv(gym.Env):
         core_seed = int(self.np_random.integers(0, 2**63 - 1))
         self._cursor, self._goal = self._core.reset(core_seed, start, goal)
         self._last = {}
+        self._visits[:] = 0
+        self._visits[self._cursor] += 1
+        _warn_full(self, 5000)
         return self._obs(0.5, None), {"goal": self._goal, "actions": 0}
 
     def step(self, action: Any):
@@ -181,6 +200,7 @@ class GridEnv(gym.Env):
             )
         d = self._core.step(a, self.observe_epoch)
         self._cursor = tuple(d["cursor"])
+        self._visits[self._cursor] += 1
         p = float(d["p_error"])
         self._last = d
         terminated = a == 4
@@ -194,8 +214,16 @@ class GridEnv(gym.Env):
         }
         return self._obs(p, d.get("epoch")), 1.0 - 2.0 * p, terminated, False, info
 
-    def render(self) -> Optional[str]:
-        """The grid as text (row 4 on top): C the cursor, G the goal."""
+    def close(self) -> None:
+        """Writes the recording (``save=``); the environment records no more."""
+        self._core.close()
+        super().close()
+
+    def render(self):
+        """The grid as text (row 4 on top: C the cursor, G the goal) or as
+        an RGB frame, by ``render_mode``."""
+        if self.render_mode == "rgb_array":
+            return _grid_frame(self._cursor, self._goal, self._visits, self._last.get("p_error"))
         if self.render_mode != "ansi":
             return None
         rows = []
@@ -244,9 +272,21 @@ class EpuckEnv(gym.Env):
     observe_window : bool
         Add the last window of preprocessed EEG, ``(n_channels,
         n_samples)`` float32 in uV, to the observation.
+    render_mode : {"ansi", "rgb_array"}, optional
+        ``render()`` returns the pose as text, or a top-down RGB frame of
+        the arena ``(400, 400, 3)`` uint8, 0.5 cm per pixel: the cities in
+        grey with the user's goal ringed in red, the path in blue, red
+        marks where the detector reported an error, the e-puck in black with
+        its heading in orange. ``metadata["render_fps"]`` is real time (4
+        frames a second at 4 windows per action).
+    save : path, optional
+        Record every episode (up to 100, each a run) into this ``.rrd`` as
+        ``errp run --save`` records the e-puck, written by :meth:`close`;
+        an episode cut short (a time limit, a reset) is a run without a
+        commitment.
     """
 
-    metadata = {"render_modes": ["ansi"]}
+    metadata = {"render_modes": ["ansi", "rgb_array"], "render_fps": 4}
 
     def __init__(
         self,
@@ -258,11 +298,9 @@ class EpuckEnv(gym.Env):
         windows_per_action: int = 4,
         observe_window: bool = False,
         render_mode: Optional[str] = None,
+        save: Optional[str] = None,
     ) -> None:
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(
-                f"render_mode = {render_mode!r} is invalid: expected None or 'ansi'"
-            )
+        _check_render_mode(render_mode, self.metadata["render_modes"])
         if not (isinstance(windows_per_action, int) and 1 <= windows_per_action <= 64):
             raise ValueError(
                 f"windows_per_action = {windows_per_action!r} is invalid: expected a "
@@ -272,7 +310,14 @@ class EpuckEnv(gym.Env):
             None if scenario is None else os.fspath(scenario),
             accuracy=accuracy,
             overrides=None if overrides is None else dict(overrides),
+            save=None if save is None else os.fspath(save),
         )
+        self.save = save
+        self._full_warned = False
+        self.metadata = {
+            **type(self).metadata,
+            "render_fps": 1.0 / (0.0625 * windows_per_action),
+        }
         self.goal_names = list(self._core.goal_names)
         #: The goals as (name, x_m, y_m): where the cities are is no secret;
         #: which one the user wants is.
@@ -304,6 +349,9 @@ class EpuckEnv(gym.Env):
         self._pose = (0.0, 0.0, 0.0)
         self._goal = 0
         self._time = 0.0
+        self._path: list = []
+        self._detections: list = []
+        self._obstacles = [np.asarray(o, dtype=np.float64) for o in self._core.obstacles]
 
     @property
     def ch_names(self) -> list:
@@ -369,6 +417,9 @@ class EpuckEnv(gym.Env):
         core_seed = int(self.np_random.integers(0, 2**63 - 1))
         self._pose, self._goal = self._core.reset(core_seed, goal)
         self._time = 0.0
+        self._path = [self._pose[:2]]
+        self._detections = []
+        _warn_full(self, 100)
         p = np.full(self.windows_per_action, 0.5, dtype=np.float32)
         return self._obs(p, False, None), {"goal": self.goal_names[self._goal], "time_secs": 0.0}
 
@@ -387,6 +438,9 @@ class EpuckEnv(gym.Env):
         d = self._core.step(a, self.windows_per_action, self.observe_window)
         self._pose = tuple(d["pose"])
         self._time = float(d["time_secs"])
+        self._path.append(self._pose[:2])
+        if d["detected"]:
+            self._detections.append(self._pose[:2])
         p = np.asarray(d["p_error"], dtype=np.float64)
         on_goal = d["on_goal"]
         terminated = a == 3 and on_goal is not None
@@ -400,8 +454,17 @@ class EpuckEnv(gym.Env):
         reward = float(np.mean(1.0 - 2.0 * p))
         return self._obs(p, d["detected"], d.get("window")), reward, terminated, False, info
 
-    def render(self) -> Optional[str]:
-        """The pose and time as text."""
+    def close(self) -> None:
+        """Writes the recording (``save=``); the episode in progress ends
+        without a commitment, and the environment records no more."""
+        self._core.close()
+        super().close()
+
+    def render(self):
+        """The pose and time as text, or a top-down RGB frame of the arena,
+        by ``render_mode``."""
+        if self.render_mode == "rgb_array":
+            return _arena_frame(self)
         if self.render_mode != "ansi":
             return None
         x, y, h = self._pose
@@ -409,6 +472,105 @@ class EpuckEnv(gym.Env):
             f"t = {self._time:.2f} s: e-puck at ({100 * x:.1f}, {100 * y:.1f}) cm, "
             f"heading {np.degrees(h):.0f} deg; the user wants {self.goal_names[self._goal]}"
         )
+
+
+def _check_render_mode(mode: Optional[str], modes: list) -> None:
+    if mode is not None and mode not in modes:
+        raise ValueError(
+            f"render_mode = {mode!r} is invalid: expected None, "
+            + " or ".join(repr(m) for m in modes)
+        )
+
+
+def _warn_full(env, cap: int) -> None:
+    if env.save is not None and env._core.recording_full and not env._full_warned:
+        env._full_warned = True
+        warnings.warn(
+            f"save={os.fspath(env.save)!r}: the recording holds its first {cap} episodes; "
+            "later ones are not recorded",
+            RuntimeWarning,
+            stacklevel=3,
+        )
+
+
+class _Canvas:
+    """An RGB frame drawn with numpy: discs, rings and thick lines."""
+
+    def __init__(self, height: int, width: int, background=(250, 250, 248)) -> None:
+        self.img = np.empty((height, width, 3), dtype=np.uint8)
+        self.img[:] = background
+        self.yy, self.xx = np.mgrid[0:height, 0:width]
+
+    def disc(self, x: float, y: float, r: float, colour, inner: float = -1.0) -> None:
+        h, w, _ = self.img.shape
+        x0, x1 = max(int(x - r - 1), 0), min(int(x + r + 2), w)
+        y0, y1 = max(int(y - r - 1), 0), min(int(y + r + 2), h)
+        if x0 >= x1 or y0 >= y1:
+            return
+        d2 = (self.xx[y0:y1, x0:x1] - x) ** 2 + (self.yy[y0:y1, x0:x1] - y) ** 2
+        mask = (d2 <= r * r) & (d2 >= inner * inner if inner > 0 else True)
+        self.img[y0:y1, x0:x1][mask] = colour
+
+    def line(self, p0, p1, colour, width: float = 1.0) -> None:
+        n = int(max(abs(p1[0] - p0[0]), abs(p1[1] - p0[1]))) + 1
+        for t in np.linspace(0.0, 1.0, n + 1):
+            self.disc(p0[0] + t * (p1[0] - p0[0]), p0[1] + t * (p1[1] - p0[1]), width / 2, colour)
+
+
+def _grid_frame(cursor, goal, visits, p_error) -> np.ndarray:
+    cell = 64
+    c = _Canvas(5 * cell + 20, 5 * cell, background=(190, 190, 190))
+    most = max(int(visits.max()), 1)
+    for x in range(5):
+        for y in range(5):
+            top = (4 - y) * cell
+            v = visits[x, y] / most
+            shade = (255 - v * np.array([235, 195, 115])).astype(np.uint8)
+            c.img[top + 1 : top + cell - 1, x * cell + 1 : (x + 1) * cell - 1] = shade
+    gx, gy = goal
+    top = (4 - gy) * cell
+    for k in range(3):
+        c.img[top + k, gx * cell : (gx + 1) * cell] = (220, 40, 40)
+        c.img[top + cell - 1 - k, gx * cell : (gx + 1) * cell] = (220, 40, 40)
+        c.img[top : top + cell, gx * cell + k] = (220, 40, 40)
+        c.img[top : top + cell, (gx + 1) * cell - 1 - k] = (220, 40, 40)
+    cx, cy = cursor
+    c.disc(cx * cell + cell / 2, (4 - cy) * cell + cell / 2, cell * 0.22, (30, 30, 30))
+    c.img[5 * cell :] = (250, 250, 248)
+    if p_error is not None:
+        c.img[5 * cell + 4 : 5 * cell + 16, : int(round(p_error * 5 * cell))] = (220, 40, 40)
+    return c.img
+
+
+def _arena_frame(env) -> np.ndarray:
+    px = 400 / env._size  # pixels per metre
+    c = _Canvas(400, 400)
+
+    def at(x, y):
+        return (x * px, (env._size - y) * px)
+
+    for o in env._obstacles:
+        pts = [at(x, y) for x, y in o]
+        for p0, p1 in zip(pts, pts[1:]):
+            c.line(p0, p1, (110, 80, 50), 2)
+    for i, (_, gx, gy) in enumerate(env.goals):
+        x, y = at(gx, gy)
+        c.disc(x, y, 5, (150, 150, 150))
+        if i == env._goal:
+            r = max(env.goal_radius_m * px, 9.0)
+            c.disc(x, y, r, (220, 40, 40), inner=r - 2)
+    pts = [at(x, y) for x, y in env._path]
+    for p0, p1 in zip(pts, pts[1:]):
+        c.line(p0, p1, (40, 90, 200), 2)
+    for x, y in env._detections:
+        c.disc(*at(x, y), 4, (220, 30, 30))
+    x, y, h = env._pose
+    rx, ry = at(x, y)
+    c.disc(rx, ry, 0.037 * px, (30, 30, 30))
+    c.line((rx, ry), (rx + 0.08 * px * np.cos(h), ry - 0.08 * px * np.sin(h)), (230, 120, 20), 2)
+    c.img[[0, -1], :] = (60, 60, 60)
+    c.img[:, [0, -1]] = (60, 60, 60)
+    return c.img
 
 
 def _cell(name: str, c) -> Optional[Tuple[int, int]]:

@@ -12,7 +12,9 @@ use errp_robot::{Pose, WheelSpeeds};
 use rand_chacha::ChaCha8Rng;
 
 use crate::epuck::decoder::ContinuousDecoder;
-use crate::epuck::episode::{PHYSICS_DT_SECS, STEPS_PER_WINDOW};
+use crate::epuck::episode::{
+    EpisodeStart, EpuckObserver, PHYSICS_DT_SECS, PhysicsFrame, STEPS_PER_WINDOW, WindowFrame,
+};
 use crate::epuck::scenario::EpuckScenario;
 use crate::epuck::tracker::CameraTracker;
 use crate::epuck::user::SyntheticUser;
@@ -77,6 +79,8 @@ pub struct EpuckEnvironment {
     detector: Detector,
     time_secs: f64,
     tracked: Pose,
+    t_e: f64,
+    ended: bool,
 }
 
 impl EpuckEnvironment {
@@ -121,6 +125,8 @@ impl EpuckEnvironment {
             decoder,
             time_secs: 0.0,
             tracked,
+            t_e,
+            ended: false,
         })
     }
 
@@ -144,6 +150,44 @@ impl EpuckEnvironment {
         &self.scenario
     }
 
+    /// What an observer is told when the episode starts, so that it can
+    /// score the episode again from what it observes (the detector's T_e
+    /// and the response spans of the decoder).
+    pub fn start(&self) -> EpisodeStart {
+        let span = self.decoder.detection_span();
+        let window_span = self.decoder.window_span();
+        EpisodeStart {
+            pose: self.world.pose(),
+            goal: self.user.goal(),
+            t_e: self.t_e,
+            detection_span: (span.from_secs, span.to_secs),
+            window_span: (window_span.from_secs, window_span.to_secs),
+        }
+    }
+
+    /// True once the episode ended: the robot stopped on a goal, or
+    /// [`EpuckEnvironment::end`] was called.
+    pub fn ended(&self) -> bool {
+        self.ended
+    }
+
+    /// Ends the episode without a commitment (a time limit outside it, a
+    /// reset or a close) and tells `observer`; nothing if it already ended.
+    pub fn end(&mut self, observer: &mut impl EpuckObserver) {
+        if self.ended {
+            return;
+        }
+        self.ended = true;
+        if observer.watches() {
+            observer.on_event(
+                self.time_secs,
+                "the episode ended without a commitment",
+                true,
+            );
+            observer.on_end(self.time_secs, None);
+        }
+    }
+
     /// Runs `action` for `windows` decoder windows of 62.5 ms (4 physics
     /// steps each, with the scenario's obstacle reflex and wheel noise);
     /// `keep_window` returns the last window's EEG too.
@@ -152,6 +196,22 @@ impl EpuckEnvironment {
         action: EpuckAction,
         windows: usize,
         keep_window: bool,
+    ) -> Result<EpuckFeedback> {
+        self.step_observed(action, windows, keep_window, &mut ())
+    }
+
+    /// [`EpuckEnvironment::step`] with `observer` watching, as an episode
+    /// of the shared control is watched: every physics step (its phase is
+    /// the action's: 0 turning, 1 driving, 2 stopped; its target the user's
+    /// goal), every window (no belief: an agent drives; the step 0 turn, 1
+    /// linear, 2 stopped on a goal, 3 stopped elsewhere), the user's ErrPs,
+    /// and the end when the robot stops on a goal.
+    pub fn step_observed(
+        &mut self,
+        action: EpuckAction,
+        windows: usize,
+        keep_window: bool,
+        observer: &mut impl EpuckObserver,
     ) -> Result<EpuckFeedback> {
         if !(1..=MAX_WINDOWS_PER_ACTION).contains(&windows) {
             return Err(SimError::Scenario(format!(
@@ -184,14 +244,26 @@ impl EpuckEnvironment {
             }
             EpuckAction::Stop => WheelSpeeds::ZERO,
         };
+        let watching = observer.watches();
+        let phase = match action {
+            EpuckAction::TurnLeft | EpuckAction::TurnRight => 0,
+            EpuckAction::Forward => 1,
+            EpuckAction::Stop => 2,
+        };
+        let goal = self.user.goal();
         let mut p_error = Vec::with_capacity(windows);
         let mut detected = false;
         let mut errps = 0;
         for _ in 0..windows {
             for _ in 0..STEPS_PER_WINDOW {
                 if let Some(e) = self.user.observe(self.time_secs, &self.tracked) {
-                    errps += usize::from(e.kind == AssessmentKind::Error);
+                    let error = e.kind == AssessmentKind::Error;
+                    errps += usize::from(error);
                     self.eeg.schedule(e.onset_secs, e.kind);
+                    if watching && error {
+                        observer.on_errp(self.time_secs, e.onset_secs, phase);
+                        observer.on_event(self.time_secs, "the user sees an error (ErrP)", false);
+                    }
                 }
                 let readings = if params.avoidance.enabled {
                     self.world.proximity()
@@ -202,18 +274,74 @@ impl EpuckEnvironment {
                 let applied = safe.apply_noise(epuck, &mut self.wheels_rng);
                 self.world.step(applied.to_twist(epuck));
                 self.time_secs += PHYSICS_DT_SECS;
-                self.tracked = self.tracker.observe(self.time_secs, &self.world.pose());
+                let pose = self.world.pose();
+                self.tracked = self.tracker.observe(self.time_secs, &pose);
+                if watching {
+                    observer.on_physics(&PhysicsFrame {
+                        time_secs: self.time_secs,
+                        pose,
+                        tracked: self.tracked,
+                        wheels: applied,
+                        phase,
+                        target: goal,
+                    });
+                }
             }
-            self.eeg.advance();
+            let fresh = self.eeg.advance();
             let p = self.eeg.p_error(&self.decoder.model);
-            detected |= self.detector.push(p, self.time_secs).detected;
+            let decision = self.detector.push(p, self.time_secs);
+            detected |= decision.detected;
             p_error.push(p);
+            if watching {
+                if decision.detected {
+                    observer.on_event(
+                        self.time_secs,
+                        &format!("error detected (evidence {:.2})", decision.evidence),
+                        false,
+                    );
+                }
+                let fcz_cz = self.eeg.fcz_cz();
+                observer.on_window(&WindowFrame {
+                    time_secs: self.time_secs,
+                    p_error: p,
+                    evidence: decision.evidence,
+                    belief: Vec::new(),
+                    target: goal,
+                    detected: decision.detected,
+                    step: match phase {
+                        2 if self.on_goal().is_some() => 2,
+                        2 => 3,
+                        p => p,
+                    },
+                    tracked: self.tracked,
+                    fcz_cz: [
+                        fresh.channel(fcz_cz[0]).to_vec(),
+                        fresh.channel(fcz_cz[1]).to_vec(),
+                    ],
+                });
+            }
         }
-        let pose = self.world.pose();
-        let radius = params.control.goal_radius_m;
-        let on_goal = self.scenario.layout.goals().iter().position(|g| {
-            (g.x_m - pose.x_m).powi(2) + (g.y_m - pose.y_m).powi(2) <= radius * radius
-        });
+        let on_goal = self.on_goal();
+        if action == EpuckAction::Stop
+            && let Some(g) = on_goal
+            && !self.ended
+        {
+            self.ended = true;
+            if watching {
+                let name = &self.scenario.layout.goals()[g].name;
+                let whose = if g == goal {
+                    "the user's goal"
+                } else {
+                    "a wrong goal"
+                };
+                observer.on_event(
+                    self.time_secs,
+                    &format!("stopped on {name} ({whose})"),
+                    g != goal,
+                );
+                observer.on_end(self.time_secs, Some(g));
+            }
+        }
         Ok(EpuckFeedback {
             tracked: self.tracked,
             p_error,
@@ -222,6 +350,15 @@ impl EpuckEnvironment {
             on_goal,
             time_secs: self.time_secs,
             window: keep_window.then(|| self.eeg.window().clone()),
+        })
+    }
+
+    /// The goal within the scenario's goal radius of the true pose, if any.
+    fn on_goal(&self) -> Option<usize> {
+        let pose = self.world.pose();
+        let radius = self.scenario.params.control.goal_radius_m;
+        self.scenario.layout.goals().iter().position(|g| {
+            (g.x_m - pose.x_m).powi(2) + (g.y_m - pose.y_m).powi(2) <= radius * radius
         })
     }
 }

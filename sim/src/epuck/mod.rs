@@ -41,5 +41,8 @@ pub use task::{EpuckRunner, EpuckTask, epuck_row};
 pub use tracker::{CameraTracker, TrackerParams};
 pub use user::{Elicited, Judgement, SeenMotion, SyntheticUser, UserParams};
 #[cfg(feature = "rerun")]
-pub use view::{EpuckRecorder, RUN_GAP_SECS, epuck_recording, record_epuck_runs};
+pub use view::{
+    EpuckRecorder, RUN_GAP_SECS, epuck_agent_recording, epuck_recording, record_epuck_runs,
+    record_epuck_runs_with,
+};
 pub use world::{ArenaSpec, Obstacle, ProximitySensors, World};

@@ -8,7 +8,7 @@
 //! detections also stay as a faint static layer, so the whole batch shows
 //! at a glance.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use errp_robot::{GoalLayout, LAYOUT_GRID_CELLS};
 use rerun::blueprint::{Blueprint, Spatial2DView, TimeSeriesView};
@@ -18,7 +18,7 @@ use rerun::{
 
 use crate::epuck::decoder::ContinuousDecoder;
 use crate::epuck::episode::{
-    EpisodeStart, EpuckEpisodeResult, EpuckObserver, PhysicsFrame, WindowFrame,
+    EpisodeStart, EpuckEpisodeResult, EpuckObserver, PhysicsFrame, WindowDecoder, WindowFrame,
 };
 use crate::epuck::run::run_epuck_once;
 use crate::epuck::scenario::EpuckScenario;
@@ -34,26 +34,42 @@ pub const RUN_GAP_SECS: f64 = 2.0;
 /// The trajectory is logged every this many physics steps (8 Hz).
 const TRAJECTORY_EVERY: usize = 8;
 
-fn blueprint() -> Blueprint {
-    task_blueprint(
-        Spatial2DView::new("Arena (cm): e-puck, trajectory, detected errors").with_origin("/arena"),
-        vec![
+/// The layout: the arena beside the belief (when the shared control
+/// drives), p(error) and the EEG.
+fn blueprint(belief: bool) -> Blueprint {
+    let mut series = Vec::new();
+    if belief {
+        series.push(
             TimeSeriesView::new("Belief per city")
                 .with_origin("/belief/city")
                 .into(),
-            TimeSeriesView::new("p(error) and T_e")
-                .with_origin(paths::DECODER)
-                .into(),
-            TimeSeriesView::new("EEG (uV, preprocessed)")
-                .with_origin(paths::EEG)
-                .into(),
-        ],
+        );
+    }
+    series.push(
+        TimeSeriesView::new("p(error) and T_e")
+            .with_origin(paths::DECODER)
+            .into(),
+    );
+    series.push(
+        TimeSeriesView::new("EEG (uV, preprocessed)")
+            .with_origin(paths::EEG)
+            .into(),
+    );
+    task_blueprint(
+        Spatial2DView::new("Arena (cm): e-puck, trajectory, detected errors").with_origin("/arena"),
+        series,
     )
 }
 
 /// Opens the `.rrd` of an e-puck run, with its layout, before the run.
 pub fn epuck_recording(path: &Path) -> Result<RrdFile> {
-    RrdFile::create("errp_epuck", path, blueprint())
+    RrdFile::create("errp_epuck", path, blueprint(true))
+}
+
+/// Opens the `.rrd` of e-puck episodes driven by an agent of the caller's
+/// own: the layout without the belief, which is the agent's.
+pub fn epuck_agent_recording(path: &Path) -> Result<RrdFile> {
+    RrdFile::create("errp_epuck", path, blueprint(false))
 }
 
 fn cm(x: f64, y: f64) -> [f32; 2] {
@@ -74,9 +90,9 @@ fn belief_colour(p: f64) -> Color {
 }
 
 /// Records one or more runs of an e-puck scenario as they happen.
-pub struct EpuckRecorder<'a> {
-    rec: &'a RecordingStream,
-    path: &'a Path,
+pub struct EpuckRecorder {
+    rec: RecordingStream,
+    path: PathBuf,
     layout: GoalLayout,
     t_e: f64,
     offset_secs: f64,
@@ -125,17 +141,12 @@ struct RunTables {
     v_text: Vec<String>,
 }
 
-impl<'a> EpuckRecorder<'a> {
+impl EpuckRecorder {
     /// Logs the static scene (walls, obstacles, city labels, series styles).
-    pub fn new(
-        file: &'a RrdFile,
-        arena: &ArenaSpec,
-        layout: &GoalLayout,
-        t_e: f64,
-    ) -> Result<Self> {
-        let rec = file.stream();
-        let path = file.path();
-        let err = record_error(path);
+    pub fn new(file: &RrdFile, arena: &ArenaSpec, layout: &GoalLayout, t_e: f64) -> Result<Self> {
+        let rec = file.stream().clone();
+        let path = file.path().to_path_buf();
+        let err = record_error(file.path());
         let s = arena.size_m;
         rec.log_static(
             "arena/walls",
@@ -168,7 +179,7 @@ impl<'a> EpuckRecorder<'a> {
             .with_labels(layout.goals().iter().map(|g| g.name.as_str())),
         )
         .map_err(&err)?;
-        log_decoder_series(rec, "T_e").map_err(&err)?;
+        log_decoder_series(&rec, "T_e").map_err(&err)?;
         for g in layout.goals() {
             rec.log_static(
                 format!("belief/city/{}", g.name),
@@ -204,6 +215,9 @@ impl<'a> EpuckRecorder<'a> {
             self.log_overview();
             self.run += 1;
         }
+        // What a run without a step left (an episode reset before any
+        // action) belongs to no run.
+        self.tables = RunTables::default();
         self.seed = seed;
         self.trajectory.clear();
         self.detections.clear();
@@ -238,7 +252,7 @@ impl<'a> EpuckRecorder<'a> {
         let cm = |v: f64| 100.0 * v;
         if let Some(s) = t.start {
             let r = send_table(
-                self.rec,
+                &self.rec,
                 data::RUNS,
                 &[off],
                 vec![
@@ -262,7 +276,7 @@ impl<'a> EpuckRecorder<'a> {
         }
         let n = t.f_t.len();
         let r = send_table(
-            self.rec,
+            &self.rec,
             data::FRAMES,
             &on_timeline(&t.f_t),
             vec![
@@ -293,7 +307,7 @@ impl<'a> EpuckRecorder<'a> {
         let n = t.w_t.len();
         let goals = self.layout.goals().len();
         let r = send_table(
-            self.rec,
+            &self.rec,
             data::WINDOWS,
             &on_timeline(&t.w_t),
             vec![
@@ -310,7 +324,7 @@ impl<'a> EpuckRecorder<'a> {
         self.keep(r);
         let n = t.e_t.len();
         let r = send_table(
-            self.rec,
+            &self.rec,
             data::ERRPS,
             &on_timeline(&t.e_t),
             vec![
@@ -323,7 +337,7 @@ impl<'a> EpuckRecorder<'a> {
         self.keep(r);
         let n = t.v_t.len();
         let r = send_table(
-            self.rec,
+            &self.rec,
             data::EVENTS,
             &on_timeline(&t.v_t),
             vec![
@@ -336,7 +350,7 @@ impl<'a> EpuckRecorder<'a> {
         self.keep(r);
         if let Some((end, committed)) = t.end {
             let r = send_table(
-                self.rec,
+                &self.rec,
                 data::ENDS,
                 &[off + end],
                 vec![
@@ -379,7 +393,7 @@ impl<'a> EpuckRecorder<'a> {
         if let Err(e) = r
             && self.error.is_none()
         {
-            self.error = Some(record_error(self.path)(e));
+            self.error = Some(record_error(&self.path)(e));
         }
     }
 
@@ -389,7 +403,7 @@ impl<'a> EpuckRecorder<'a> {
     }
 }
 
-impl EpuckObserver for EpuckRecorder<'_> {
+impl EpuckObserver for EpuckRecorder {
     fn on_start(&mut self, start: &EpisodeStart) {
         self.tables.start = Some(*start);
     }
@@ -453,13 +467,24 @@ impl EpuckObserver for EpuckRecorder<'_> {
         t.w_detected.push(f.detected);
         t.w_step.push(f.step as i64);
         t.w_target.push(f.target as i64);
-        t.w_belief.extend_from_slice(&f.belief);
+        let goals = self.layout.goals().len();
+        // No belief (an agent drives): NaN in the table, the cities grey.
+        if f.belief.len() == goals {
+            t.w_belief.extend_from_slice(&f.belief);
+        } else {
+            t.w_belief.extend(std::iter::repeat_n(f64::NAN, goals));
+        }
         self.at(f.time_secs);
+        let colours: Vec<Color> = if f.belief.len() == goals {
+            f.belief.iter().map(|&p| belief_colour(p)).collect()
+        } else {
+            vec![belief_colour(0.0); goals]
+        };
         let r = self.rec.log(
             "arena/goals",
             &Points2D::new(self.layout.goals().iter().map(|g| cm(g.x_m, g.y_m)))
                 .with_radii([5.0])
-                .with_colors(f.belief.iter().map(|&p| belief_colour(p))),
+                .with_colors(colours),
         );
         self.keep(r);
         // The city the robot heads for: an orange ring.
@@ -536,27 +561,53 @@ pub fn record_epuck_runs(
     decoder: &ContinuousDecoder,
     provenance: &Provenance,
 ) -> Result<Vec<EpuckEpisodeResult>> {
+    record_epuck_runs_with(file, scenario, decoder, provenance, scenario.runs, None)
+}
+
+/// [`record_epuck_runs`] of `runs` runs, with `window_decoder` (a decoder
+/// of the caller's own, as in [`crate::epuck::run_epuck_episode_with`]) in
+/// place of the calibrated SVM when given.
+pub fn record_epuck_runs_with(
+    file: &RrdFile,
+    scenario: &EpuckScenario,
+    decoder: &ContinuousDecoder,
+    provenance: &Provenance,
+    runs: usize,
+    mut window_decoder: Option<WindowDecoder<'_>>,
+) -> Result<Vec<EpuckEpisodeResult>> {
     let mut provenance = provenance.clone();
-    provenance.runs = scenario.runs;
+    provenance.runs = runs;
     provenance
         .log(file.stream())
         .map_err(record_error(file.path()))?;
     let layout = &scenario.layout;
     let goal = &layout.goals()[scenario.episode.goal].name;
     let decoder_text = scenario.decoder_text();
-    let mut recorder = EpuckRecorder::new(
-        file,
-        &scenario.arena,
-        layout,
-        decoder.t_e(scenario.params.control.t_e),
-    )?;
-    let mut out = Vec::with_capacity(scenario.runs);
-    for k in 0..scenario.runs {
+    let t_e = match window_decoder {
+        Some(_) => scenario.params.control.t_e,
+        None => decoder.t_e(scenario.params.control.t_e),
+    };
+    let mut recorder = EpuckRecorder::new(file, &scenario.arena, layout, t_e)?;
+    let mut out = Vec::with_capacity(runs);
+    for k in 0..runs {
+        let seed = crate::epuck::epuck_run_seed(scenario.seed, k);
         recorder.next_run(
             &format!("run {}: the user wants {goal} ({decoder_text})", k + 1),
-            crate::epuck::epuck_run_seed(scenario.seed, k),
+            seed,
         );
-        out.push(run_epuck_once(scenario, decoder, k, &mut recorder)?);
+        out.push(match window_decoder.as_mut() {
+            None => run_epuck_once(scenario, decoder, k, &mut recorder)?,
+            Some(decode) => crate::epuck::run_epuck_episode_with(
+                &scenario.params,
+                &scenario.arena,
+                layout,
+                scenario.episode,
+                decoder,
+                seed,
+                &mut recorder,
+                Some(&mut **decode),
+            )?,
+        });
     }
     recorder.finish()?;
     Ok(out)

@@ -5,14 +5,14 @@
 
 use std::sync::Arc;
 
-use errp_bci::{EegBlock, rng::stream};
+use errp_bci::{Accuracy, EegBlock, rng::stream};
 use errp_robot::{Cell, Grid, GridAction};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 use crate::error::{Result, SimError};
 use crate::grid::decoder::AssessmentDecoder;
-use crate::grid::episode::{ActionDecoder, Decoded, GridDecoding};
+use crate::grid::episode::{ActionDecoder, Decoded, GridDecoding, GridEpisodeResult, GridStep};
 use crate::grid::params::GridTaskParams;
 
 /// What one action gave the agent.
@@ -46,6 +46,13 @@ pub struct GridEnvironment {
     goal: Cell,
     rng_user: ChaCha8Rng,
     actions: usize,
+    start: Cell,
+    total_secs: f64,
+    committed: Option<Cell>,
+    ended: bool,
+    /// Every action, kept for a recording ([`GridEnvironment::keep_steps`]).
+    steps: Option<Vec<GridStep>>,
+    visits: Vec<u32>,
 }
 
 impl GridEnvironment {
@@ -88,6 +95,16 @@ impl GridEnvironment {
             goal,
             rng_user: stream(seed, "grid/user"),
             actions: 0,
+            start,
+            total_secs: 0.0,
+            committed: None,
+            ended: false,
+            steps: None,
+            visits: {
+                let mut v = vec![0; grid.n_cells()];
+                v[grid.index(start)] += 1;
+                v
+            },
         })
     }
 
@@ -104,6 +121,38 @@ impl GridEnvironment {
     /// Actions taken so far.
     pub fn actions(&self) -> usize {
         self.actions
+    }
+
+    /// Keeps every action from now on, for [`GridEnvironment::result`].
+    pub fn keep_steps(&mut self) {
+        self.steps.get_or_insert_with(Vec::new);
+    }
+
+    /// True once the agent said "goal reached".
+    pub fn ended(&self) -> bool {
+        self.ended
+    }
+
+    /// The episode so far as the task scores one: the cell where the agent
+    /// said "goal reached" is the committed goal, the time is the sum of
+    /// the inter-action intervals, and the steps (kept since
+    /// [`GridEnvironment::keep_steps`]) hold no belief (NaN): the agent's
+    /// is its own.
+    pub fn result(&self) -> GridEpisodeResult {
+        let steps = self.steps.clone().unwrap_or_default();
+        let labels: Vec<bool> = steps.iter().map(|s| s.error).collect();
+        let decoded: Vec<bool> = steps.iter().map(|s| s.decoded_error).collect();
+        GridEpisodeResult {
+            start: self.start,
+            goal: self.goal,
+            committed: self.committed,
+            actions: self.actions,
+            net_secs: self.actions as f64 * self.params.epoch_secs,
+            total_secs: self.total_secs,
+            online: Accuracy::score(&labels, &decoded),
+            visits: self.visits.clone(),
+            steps,
+        }
     }
 
     /// True if the decoder streams EEG, so that epochs can be returned.
@@ -141,8 +190,28 @@ impl GridEnvironment {
             keep_epoch,
         )?;
         let reached = action == GridAction::GoalReached && self.cell == self.goal;
+        let from = self.cell;
         self.cell = self.grid.step(self.cell, action);
         self.actions += 1;
+        self.visits[self.grid.index(self.cell)] += 1;
+        if let Some(steps) = self.steps.as_mut() {
+            steps.push(GridStep {
+                onset_secs: self.total_secs,
+                from,
+                action,
+                to: self.cell,
+                error,
+                p_error,
+                decoded_error: says_error,
+                belief: vec![f64::NAN; self.grid.n_cells()],
+                fcz: Vec::new(),
+            });
+        }
+        self.total_secs += interval;
+        if action == GridAction::GoalReached && !self.ended {
+            self.ended = true;
+            self.committed = Some(from);
+        }
         Ok(GridFeedback {
             cell: self.cell,
             p_error,

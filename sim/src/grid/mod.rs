@@ -36,4 +36,4 @@ pub use scenario::{
 pub use table1::{FIXED_PAIRS, Table1Cell, Table1Options, accuracy_time_correlation, run_table1};
 pub use task::{GridRunner, GridTask, grid_row};
 #[cfg(feature = "rerun")]
-pub use view::{grid_recording, record_grid_run};
+pub use view::{GridRecorder, grid_recording, record_grid_run};

@@ -7,6 +7,7 @@ use rerun::blueprint::{Blueprint, Spatial2DView, TimeSeriesView};
 use rerun::{Boxes2D, Color, Image, Points2D, Scalars, SeriesLines, TextLog};
 
 use crate::error::Result;
+use crate::grid::GridEpisodeResult;
 use crate::grid::run::GridRunReport;
 use crate::record::data::{self, Column, Provenance, send_table};
 use crate::record::{
@@ -49,7 +50,12 @@ fn heat_map(grid: &Grid, values: &[f64]) -> Image {
     let mut rgb = Vec::with_capacity(grid.n_cells() * 3);
     for row in 0..grid.height {
         for x in 0..grid.width {
-            let v = values[grid.index(Cell::new(x, grid.height - 1 - row))].clamp(0.0, 1.0);
+            let v = values[grid.index(Cell::new(x, grid.height - 1 - row))];
+            let v = if v.is_finite() {
+                v.clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
             // White (0) to dark blue (1).
             let shade = |lo: f64| (255.0 - v * (255.0 - lo)) as u8;
             rgb.extend_from_slice(&[shade(20.0), shade(60.0), shade(140.0)]);
@@ -65,37 +71,76 @@ pub fn record_grid_run(
     report: &GridRunReport,
     provenance: &Provenance,
 ) -> Result<PathBuf> {
-    let path = file.path().to_path_buf();
-    let rec = file.stream();
-    let err = record_error(&path);
-    let mut provenance = provenance.clone();
-    provenance.runs = report.episodes.len();
-    provenance.log(rec).map_err(&err)?;
-    let grid = Grid::paper();
-    let fs = 256.0;
-
-    let outline: Vec<([f32; 2], [f32; 2])> = grid
-        .cells()
-        .map(|c| (centre(&grid, c), [1.0, 1.0]))
-        .collect();
-    rec.log_static(
-        "grid/cells",
-        &Boxes2D::from_centers_and_sizes(outline.iter().map(|o| o.0), outline.iter().map(|o| o.1))
-            .with_colors([Color::from_rgb(160, 160, 160)]),
-    )
-    .map_err(&err)?;
-    log_decoder_series(rec, "0.5").map_err(&err)?;
-    rec.log_static(
-        "belief/true_goal",
-        &SeriesLines::new().with_names(["p(true goal)"]),
-    )
-    .map_err(&err)?;
-    rec.log_static("belief/max", &SeriesLines::new().with_names(["max p"]))
-        .map_err(&err)?;
-
-    let mut t0 = 0.0;
+    let s = &report.scenario;
+    let mut recorder = GridRecorder::new(file)?;
     for (k, ep) in report.episodes.iter().enumerate() {
-        send_episode_tables(rec, &grid, k, t0, ep, &report.scenario).map_err(&err)?;
+        let seed = errp_bci::rng::derive_seed(s.seed, "grid/episode", k as u64);
+        recorder.episode(seed, s.params.epoch_secs, ep)?;
+    }
+    recorder.finish(provenance)
+}
+
+/// A grid recording written one episode at a time (run with
+/// `record_steps`), one after another on the timeline.
+pub struct GridRecorder {
+    file: RrdFile,
+    grid: Grid,
+    t0: f64,
+    episodes: usize,
+}
+
+impl GridRecorder {
+    /// Logs the static scene into `file`.
+    pub fn new(file: RrdFile) -> Result<Self> {
+        let grid = Grid::paper();
+        let rec = file.stream();
+        let err = record_error(file.path());
+        let outline: Vec<([f32; 2], [f32; 2])> = grid
+            .cells()
+            .map(|c| (centre(&grid, c), [1.0, 1.0]))
+            .collect();
+        rec.log_static(
+            "grid/cells",
+            &Boxes2D::from_centers_and_sizes(
+                outline.iter().map(|o| o.0),
+                outline.iter().map(|o| o.1),
+            )
+            .with_colors([Color::from_rgb(160, 160, 160)]),
+        )
+        .map_err(&err)?;
+        log_decoder_series(rec, "0.5").map_err(&err)?;
+        rec.log_static(
+            "belief/true_goal",
+            &SeriesLines::new().with_names(["p(true goal)"]),
+        )
+        .map_err(&err)?;
+        rec.log_static("belief/max", &SeriesLines::new().with_names(["max p"]))
+            .map_err(&err)?;
+        drop(err);
+        Ok(Self {
+            file,
+            grid,
+            t0: 0.0,
+            episodes: 0,
+        })
+    }
+
+    /// Episodes recorded so far.
+    pub fn episodes(&self) -> usize {
+        self.episodes
+    }
+
+    /// Records the next episode, run from `seed` with actions of
+    /// `epoch_secs`. A step's belief of NaN (an agent chose the actions)
+    /// leaves the posterior and the belief series out.
+    pub fn episode(&mut self, seed: u64, epoch_secs: f64, ep: &GridEpisodeResult) -> Result<()> {
+        let k = self.episodes;
+        let grid = self.grid;
+        let t0 = self.t0;
+        let rec = self.file.stream();
+        let err = record_error(self.file.path());
+        let fs = 256.0;
+        send_episode_tables(rec, &grid, k, t0, seed, epoch_secs, ep).map_err(&err)?;
         rec.set_duration_secs(SIM_TIME, t0);
         rec.log(
             paths::LOG,
@@ -131,8 +176,11 @@ pub fn record_grid_run(
         for step in &ep.steps {
             let t = t0 + step.onset_secs;
             rec.set_duration_secs(SIM_TIME, t);
-            rec.log("grid/posterior", &heat_map(&grid, &step.belief))
-                .map_err(&err)?;
+            let has_belief = step.belief.iter().all(|p| p.is_finite());
+            if has_belief {
+                rec.log("grid/posterior", &heat_map(&grid, &step.belief))
+                    .map_err(&err)?;
+            }
             rec.log(
                 "grid/cursor",
                 &Points2D::new([centre(&grid, step.to)])
@@ -144,13 +192,15 @@ pub fn record_grid_run(
                 .map_err(&err)?;
             rec.log(paths::THRESHOLD, &Scalars::single(0.5))
                 .map_err(&err)?;
-            rec.log(
-                "belief/true_goal",
-                &Scalars::single(step.belief[grid.index(ep.goal)]),
-            )
-            .map_err(&err)?;
-            let max = step.belief.iter().copied().fold(0.0, f64::max);
-            rec.log("belief/max", &Scalars::single(max)).map_err(&err)?;
+            if has_belief {
+                rec.log(
+                    "belief/true_goal",
+                    &Scalars::single(step.belief[grid.index(ep.goal)]),
+                )
+                .map_err(&err)?;
+                let max = step.belief.iter().copied().fold(0.0, f64::max);
+                rec.log("belief/max", &Scalars::single(max)).map_err(&err)?;
+            }
             let decoded = if step.p_error >= 0.5 {
                 "error"
             } else {
@@ -203,24 +253,36 @@ pub fn record_grid_run(
             .with_level(if ep.reached() { "INFO" } else { "WARN" }),
         )
         .map_err(&err)?;
-        t0 = end + EPISODE_GAP_SECS;
+        self.t0 = end + EPISODE_GAP_SECS;
+        self.episodes += 1;
+        Ok(())
     }
-    file.finish()
+
+    /// Logs `provenance` (its `runs` set to the episodes recorded), flushes
+    /// the file and moves it into place.
+    pub fn finish(self, provenance: &Provenance) -> Result<PathBuf> {
+        let mut provenance = provenance.clone();
+        provenance.runs = self.episodes;
+        provenance
+            .log(self.file.stream())
+            .map_err(record_error(self.file.path()))?;
+        self.file.finish()
+    }
 }
 
-/// Sends episode `k`'s data tables ([`crate::record::data`]), starting at
-/// `t0` on the timeline.
+/// Sends episode `k`'s data tables ([`crate::record::data`]), run from
+/// `seed`, starting at `t0` on the timeline.
 fn send_episode_tables(
     rec: &rerun::RecordingStream,
     grid: &Grid,
     k: usize,
     t0: f64,
-    ep: &crate::grid::GridEpisodeResult,
-    scenario: &crate::grid::GridScenario,
+    seed: u64,
+    epoch_secs: f64,
+    ep: &GridEpisodeResult,
 ) -> std::result::Result<(), rerun::RecordingStreamError> {
     let run = k as i64;
     let runs = |n: usize| Column::I64(vec![run; n]);
-    let seed = errp_bci::rng::derive_seed(scenario.seed, "grid/episode", k as u64);
     send_table(
         rec,
         data::RUNS,
@@ -233,7 +295,7 @@ fn send_episode_tables(
             ("start_y", Column::I64(vec![ep.start.y as i64])),
             ("goal_x", Column::I64(vec![ep.goal.x as i64])),
             ("goal_y", Column::I64(vec![ep.goal.y as i64])),
-            ("epoch_s", Column::F64(vec![scenario.params.epoch_secs])),
+            ("epoch_s", Column::F64(vec![epoch_secs])),
         ],
     )?;
     let steps = &ep.steps;

@@ -18,7 +18,7 @@ mod read;
 mod tables;
 
 pub use read::{MAX_RECORDING_BYTES, Table};
-pub use tables::{CsvTable, csv_tables, phase_secs};
+pub use tables::{CsvTable, PARQUET_TABLE_KEY, csv_tables, phase_secs};
 
 /// Why a recording cannot be read.
 #[derive(Debug, thiserror::Error)]

@@ -57,6 +57,63 @@ impl CsvTable {
     }
 }
 
+/// The key of a Parquet file's metadata that names the errp table it holds
+/// (how `errp inspect --parquet` knows a file it may replace).
+pub const PARQUET_TABLE_KEY: &str = "errp.table";
+
+impl CsvTable {
+    /// The table as a Parquet file (Snappy-compressed, one row group): the
+    /// columns of [`CsvTable::to_csv`] with their types (float64, int64,
+    /// bool, string); a missing number is null. The file's metadata names
+    /// the table under [`PARQUET_TABLE_KEY`].
+    pub fn to_parquet(&self) -> Result<Vec<u8>, String> {
+        use std::sync::Arc;
+
+        use parquet::arrow::ArrowWriter;
+        use parquet::basic::Compression;
+        use parquet::file::metadata::KeyValue;
+        use parquet::file::properties::WriterProperties;
+        use rerun::external::arrow::array::{
+            ArrayRef, BooleanArray, Float64Array, Int64Array, RecordBatch, StringArray,
+        };
+        use rerun::external::arrow::datatypes::{DataType, Field, Schema};
+
+        let mut fields = Vec::new();
+        let mut arrays: Vec<ArrayRef> = Vec::new();
+        for (name, c) in &self.columns {
+            let (kind, array): (DataType, ArrayRef) = match c {
+                Column::F64(v) => (
+                    DataType::Float64,
+                    Arc::new(Float64Array::from_iter(
+                        v.iter().map(|&x| (!x.is_nan()).then_some(x)),
+                    )),
+                ),
+                Column::I64(v) => (DataType::Int64, Arc::new(Int64Array::from(v.clone()))),
+                Column::Bool(v) => (DataType::Boolean, Arc::new(BooleanArray::from(v.clone()))),
+                Column::Str(v) => (DataType::Utf8, Arc::new(StringArray::from(v.clone()))),
+                Column::F64Rows(..) => continue,
+            };
+            fields.push(Field::new(*name, kind, true));
+            arrays.push(array);
+        }
+        let schema = Arc::new(Schema::new(fields));
+        let batch = RecordBatch::try_new(schema.clone(), arrays).map_err(|e| e.to_string())?;
+        let props = WriterProperties::builder()
+            .set_compression(Compression::SNAPPY)
+            .set_key_value_metadata(Some(vec![KeyValue::new(
+                PARQUET_TABLE_KEY.to_string(),
+                self.name.to_string(),
+            )]))
+            .build();
+        let mut out = Vec::new();
+        let mut writer =
+            ArrowWriter::try_new(&mut out, schema, Some(props)).map_err(|e| e.to_string())?;
+        writer.write(&batch).map_err(|e| e.to_string())?;
+        writer.close().map_err(|e| e.to_string())?;
+        Ok(out)
+    }
+}
+
 /// A CSV field: quoted when it holds a comma, a quote or a line break.
 fn quote(s: &str) -> String {
     if s.contains([',', '"', '\n', '\r']) {

@@ -74,6 +74,11 @@ pub struct Provenance {
     pub command: Vec<String>,
     /// The decoder's calibration, as `errp run` printed it.
     pub decoder_summary: String,
+    /// Set when an agent of the caller's own chose the actions (a
+    /// Gymnasium environment of `errp.gym`), not the shared control: what
+    /// drove them. Each run's seed is in `/errp/runs`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub agent: Option<String>,
 }
 
 impl Provenance {
@@ -91,6 +96,7 @@ impl Provenance {
             runs: 0,
             command: Vec::new(),
             decoder_summary: String::new(),
+            agent: None,
         }
     }
 

@@ -6,10 +6,10 @@
 use std::sync::Arc;
 
 use errp_bci::{EegBlock, EpochWindow, ErrorModel};
-use errp_robot::{Cell, GridAction};
+use errp_robot::{Cell, Grid, GridAction};
 use errp_sim::epuck::{
-    EpuckAction, EpuckEnvironment, prepare_continuous_decoder, run_epuck_episode,
-    run_epuck_episode_with,
+    EpuckAction, EpuckEnvironment, EpuckObserver, PhysicsFrame, WindowFrame,
+    prepare_continuous_decoder, run_epuck_episode, run_epuck_episode_with,
 };
 use errp_sim::grid::{
     AssessmentDecoder, EpochBlocks, GridDecoding, GridEnvironment, GridTaskParams, PErrorMapping,
@@ -122,6 +122,33 @@ fn the_grid_environment_judges_and_decodes_each_action() {
     assert!(!stop.error && stop.cell == Cell::new(2, 0));
     let done = env.step(GridAction::GoalReached, false).unwrap();
     assert!(done.reached && !done.error && env.actions() == 5);
+    assert!(env.ended());
+
+    // Kept for a recording: the episode as the task scores one.
+    let mut kept = GridEnvironment::new(decoder.clone(), params, start, goal, 4).unwrap();
+    kept.keep_steps();
+    let mut intervals = Vec::new();
+    for a in [GridAction::Right, GridAction::Left, GridAction::Up] {
+        intervals.push(kept.step(a, false).unwrap().interval_secs);
+    }
+    assert!(!kept.ended() && kept.result().committed.is_none());
+    intervals.push(
+        kept.step(GridAction::GoalReached, false)
+            .unwrap()
+            .interval_secs,
+    );
+    let r = kept.result();
+    assert_eq!(r.committed, Some(Cell::new(0, 1)));
+    assert!(!r.reached() && r.actions == 4 && r.steps.len() == 4);
+    // Each onset is the sum of the intervals before it.
+    let onsets: Vec<f64> = r.steps.iter().map(|s| s.onset_secs).collect();
+    let sums: Vec<f64> = (0..4).map(|k| intervals[..k].iter().sum()).collect();
+    assert_eq!(onsets, sums);
+    assert_eq!(r.total_secs, intervals.iter().sum::<f64>());
+    assert_eq!(r.visits.iter().sum::<u32>(), 5);
+    assert_eq!(r.visits[Grid::paper().index(Cell::new(0, 0))], 2);
+    assert!(r.steps.iter().all(|s| s.belief.iter().all(|p| p.is_nan())));
+    assert_eq!(r.online.n_error + r.online.n_correct, 4);
 
     // Cells drawn from the seed, and bad cells refused by name.
     let drawn = GridEnvironment::new(decoder.clone(), params, None, None, 7).unwrap();
@@ -188,4 +215,77 @@ fn a_window_decoder_reads_the_windows_the_svm_reads() {
     let ahead = env.step(EpuckAction::Forward, 16, false).unwrap();
     assert!(ahead.tracked.y_m - y0 > 0.03, "{ahead:?}");
     assert!(env.step(EpuckAction::Stop, 0, false).is_err());
+
+    // Watched, the same episode: what the observer sees adds up to what
+    // the agent is told, and stopping on a goal ends the episode.
+    let mut watched = EpuckEnvironment::new(decoder.clone(), &s, None, 5).unwrap();
+    let mut plain = EpuckEnvironment::new(decoder.clone(), &s, None, 5).unwrap();
+    let mut seen = Seen::default();
+    let start = watched.start();
+    assert_eq!(start.goal, s.episode.goal);
+    let mut errps = 0;
+    for (a, n) in [
+        (EpuckAction::TurnLeft, 8),
+        (EpuckAction::Forward, 32),
+        (EpuckAction::Stop, 8),
+    ] {
+        let f = watched.step_observed(a, n, false, &mut seen).unwrap();
+        assert_eq!(plain.step(a, n, false).unwrap(), f);
+        errps += f.errps;
+    }
+    assert_eq!((seen.frames, seen.windows, seen.errps), (192, 48, errps));
+    assert_eq!(seen.phases, [32, 128, 32]);
+    // Stopped off every city: the episode goes on until it is ended.
+    assert!(!watched.ended() && seen.end.is_none());
+    watched.end(&mut seen);
+    assert_eq!(seen.end, Some((3.0, None)));
+    watched.end(&mut seen);
+    assert_eq!(seen.ends, 1);
+    // The robot starts on a city: stopping there commits to it.
+    let mut on_start = EpuckEnvironment::new(decoder, &s, None, 6).unwrap();
+    let mut seen = Seen::default();
+    on_start
+        .step_observed(EpuckAction::Stop, 2, false, &mut seen)
+        .unwrap();
+    assert!(on_start.ended());
+    assert_eq!(seen.end, Some((0.125, Some(start_city(&s)))));
+}
+
+/// The city the scenario's robot starts on.
+fn start_city(s: &errp_sim::epuck::EpuckScenario) -> usize {
+    let p = s.episode.start;
+    s.layout
+        .goals()
+        .iter()
+        .position(|g| (g.x_m - p.x_m).hypot(g.y_m - p.y_m) < 0.01)
+        .expect("the robot starts on a city")
+}
+
+/// What an observer of the environment saw.
+#[derive(Default)]
+struct Seen {
+    frames: usize,
+    windows: usize,
+    errps: usize,
+    phases: [usize; 3],
+    end: Option<(f64, Option<usize>)>,
+    ends: usize,
+}
+
+impl EpuckObserver for Seen {
+    fn on_physics(&mut self, f: &PhysicsFrame) {
+        self.frames += 1;
+        self.phases[f.phase] += 1;
+    }
+    fn on_window(&mut self, f: &WindowFrame) {
+        self.windows += 1;
+        assert!(f.belief.is_empty());
+    }
+    fn on_errp(&mut self, _: f64, _: f64, _: usize) {
+        self.errps += 1;
+    }
+    fn on_end(&mut self, t: f64, committed: Option<usize>) {
+        self.end = Some((t, committed));
+        self.ends += 1;
+    }
 }
