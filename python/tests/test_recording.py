@@ -82,3 +82,28 @@ def test_bad_files_raise(tmp_path, content, why):
         errp.read_recording(p)
     with pytest.raises(FileNotFoundError):
         errp.read_recording(tmp_path / "missing.rrd")
+
+
+def test_fig5_for_lisbon_to_tokyo(root, tmp_path):
+    """The other city run draws too: its path runs from Lisbon (top left)
+    to Tokyo (right), with red marks at its detections."""
+    from PIL import Image
+
+    rrd = tmp_path / "l.rrd"
+    df = errp.run(str(root / "scenarios/lisbon_to_tokyo.toml"), seed=2, runs=2, save=rrd)
+    png = tmp_path / "fig5.png"
+    cli("inspect", str(rrd), "--figure", str(png), "--run", "2")
+    img = np.asarray(Image.open(png).convert("RGB")).astype(int)
+    assert img.shape[0] > 400 and img.shape[1] > 400
+    r, g, b = img[..., 0], img[..., 1], img[..., 2]
+    blue = (b > 150) & (r < 120) & (g < 170)
+    red = (r > 180) & (g < 80) & (b < 80)
+    assert blue.sum() > 500, "no path drawn"
+    # Run 2's detections (36 at seed 2) are drawn as red marks.
+    rec = errp.read_recording(rrd)
+    assert list(rec.runs.detected) == list(df.detected)
+    assert rec.runs.detected.iloc[1] > 10
+    assert red.sum() > 50, "no detection drawn"
+    # The path spans much of the arena's width: Lisbon to Tokyo.
+    cols = np.flatnonzero(blue.any(axis=0))
+    assert cols.max() - cols.min() > img.shape[1] / 4

@@ -184,3 +184,18 @@ def test_record_video_of_an_episode(tmp_path):
     shaded = [(x, y) for x in range(5) for y in range(5) if g[(4 - y) * 64 + 10, x * 64 + 10, 0] < 250]
     assert sorted(shaded) == [(0, 0), (1, 0), (2, 0), (2, 1)]
     assert (g[(4 - 1) * 64 + 32, 2 * 64 + 32] == [30, 30, 30]).all()
+
+
+def test_an_environment_never_closed_still_writes_its_recording(tmp_path):
+    import gc
+
+    rrd = tmp_path / "forgotten.rrd"
+    env = errp.gym.GridEnv(save=rrd, goal=(1, 1), start=(0, 0))
+    env.reset(seed=0)
+    env.step(3)
+    env.step(0)
+    env.step(4)
+    del env
+    gc.collect()
+    rec = errp.read_recording(rrd)
+    assert list(rec.runs.actions) == [3] and list(rec.runs.reached) == [True]

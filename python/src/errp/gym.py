@@ -17,8 +17,8 @@ Importing this module registers:
   goal) or after ``max_episode_steps`` actions (100).
 
 ``save="file.rrd"`` records every episode of an environment (each a run)
-into one Rerun recording, written when the environment is closed; ``errp
-inspect file.rrd``, :func:`errp.read_recording` and the Rerun viewer read it.
+into one Rerun recording, written when the environment is closed (or
+collected, or when Python exits); ``errp inspect file.rrd``, :func:`errp.read_recording` and the Rerun viewer read it.
 ``render_mode="rgb_array"`` draws a top-down frame (the arena or the grid)
 for Gymnasium's ``RecordVideo``.
 
@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import os
 import warnings
+import weakref
 from typing import Any, Optional, Tuple
 
 import numpy as np
@@ -116,6 +117,9 @@ class GridEnv(gym.Env):
         )
         self.save = save
         self._full_warned = False
+        # The recording is written by close(), or when the environment is
+        # collected or the interpreter exits without it.
+        self._finalizer = weakref.finalize(self, self._core.close)
         self.goal = _cell("goal", goal)
         self.start = _cell("start", start)
         self.observe_epoch = bool(observe_epoch)
@@ -216,7 +220,7 @@ class GridEnv(gym.Env):
 
     def close(self) -> None:
         """Writes the recording (``save=``); the environment records no more."""
-        self._core.close()
+        self._finalizer()
         super().close()
 
     def render(self):
@@ -314,6 +318,9 @@ class EpuckEnv(gym.Env):
         )
         self.save = save
         self._full_warned = False
+        # The recording is written by close(), or when the environment is
+        # collected or the interpreter exits without it.
+        self._finalizer = weakref.finalize(self, self._core.close)
         self.metadata = {
             **type(self).metadata,
             "render_fps": 1.0 / (0.0625 * windows_per_action),
@@ -457,7 +464,7 @@ class EpuckEnv(gym.Env):
     def close(self) -> None:
         """Writes the recording (``save=``); the episode in progress ends
         without a commitment, and the environment records no more."""
-        self._core.close()
+        self._finalizer()
         super().close()
 
     def render(self):
