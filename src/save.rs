@@ -43,20 +43,7 @@ pub(crate) fn wrote(path: &Path) -> Result<()> {
 /// one that is not empty and does not begin with `magic` (the format's
 /// signature). A special file is left to the writer, which refuses it.
 pub(crate) fn check_ours(path: &Path, magic: &[u8], what: &str, flag: &str) -> Result<()> {
-    use std::io::Read;
-    let Ok(file) = errp_sim::open_regular(path) else {
-        return Ok(());
-    };
-    let mut head = Vec::with_capacity(magic.len());
-    if file
-        .take(magic.len() as u64)
-        .read_to_end(&mut head)
-        .is_err()
-        || head.is_empty()
-    {
-        return Ok(());
-    }
-    if head != magic {
+    if errp_sim::is_foreign(path, magic) {
         bail!(
             "{flag} {}: the file exists and is not {what}; errp replaces only files it wrote: \
              move it away or give another name",

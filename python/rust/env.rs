@@ -646,14 +646,7 @@ impl EpuckEnvCore {
             if save.runs == 0 {
                 return Ok(None);
             }
-            let mut provenance = save.provenance;
-            provenance.runs = save.runs;
-            provenance
-                .log(save.file.stream())
-                .map_err(|e| errp_sim::SimError::Record {
-                    path: save.file.path().to_path_buf(),
-                    message: e.to_string(),
-                })?;
+            save.provenance.write(&save.file, save.runs)?;
             return save.file.finish().map(Some);
         }
         Ok(None)

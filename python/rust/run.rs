@@ -86,23 +86,17 @@ pub(crate) fn check_save(save: Option<&PathBuf>) -> PyResult<()> {
     check_ours(p)
 }
 
-/// Refuses to replace an existing `path` that errp did not write: one
-/// that is not empty and does not begin with a Rerun recording's signature
-/// (a special file is left to the writer, which refuses it).
+/// Refuses to replace an existing `path` that errp did not write (one
+/// that does not begin with a Rerun recording's signature).
 fn check_ours(path: &std::path::Path) -> PyResult<()> {
-    use std::io::Read;
-    let Ok(file) = errp_sim::open_regular(path) else {
-        return Ok(());
-    };
-    let mut head = Vec::with_capacity(4);
-    if file.take(4).read_to_end(&mut head).is_err() || head.is_empty() || head == b"RRF2" {
-        return Ok(());
+    if errp_sim::is_foreign(path, b"RRF2") {
+        return Err(PyValueError::new_err(format!(
+            "save: {}: the file exists and is not a Rerun recording; errp replaces only files \
+             it wrote: move it away or give another name",
+            path.display()
+        )));
     }
-    Err(PyValueError::new_err(format!(
-        "save: {}: the file exists and is not a Rerun recording; errp replaces only files it \
-         wrote: move it away or give another name",
-        path.display()
-    )))
+    Ok(())
 }
 
 /// Runs a scenario as `errp run` does (the same decoder, seeds and

@@ -53,6 +53,26 @@ pub fn open_regular_with(options: &mut OpenOptions, path: &Path) -> io::Result<F
     Ok(file)
 }
 
+/// True if `path` is a regular file that errp must not replace: it is not
+/// empty and does not begin with `magic` (the signature of the format errp
+/// would write there). A missing, unreadable or special file is not
+/// foreign: the writer refuses what it cannot replace.
+pub fn is_foreign(path: &Path, magic: &[u8]) -> bool {
+    use std::io::Read;
+    let Ok(file) = open_regular(path) else {
+        return false;
+    };
+    let mut head = Vec::with_capacity(magic.len());
+    if file
+        .take(magic.len() as u64)
+        .read_to_end(&mut head)
+        .is_err()
+    {
+        return false;
+    }
+    !head.is_empty() && head != magic
+}
+
 /// What a file that is not regular is, for an error message.
 fn describe(kind: &std::fs::FileType) -> &'static str {
     #[cfg(unix)]

@@ -41,7 +41,7 @@ mod stats;
 pub mod task;
 
 pub use error::{Result, SimError};
-pub use files::{append_regular, open_regular, open_regular_with, write_regular};
+pub use files::{append_regular, is_foreign, open_regular, open_regular_with, write_regular};
 pub use output::{
     CreatedDirs, PendingFile, create_dir, create_dirs, forget_if_interrupted,
     remove_if_interrupted, remove_unfinished, write_atomic,

@@ -575,11 +575,7 @@ pub fn record_epuck_runs_with(
     runs: usize,
     mut window_decoder: Option<WindowDecoder<'_>>,
 ) -> Result<Vec<EpuckEpisodeResult>> {
-    let mut provenance = provenance.clone();
-    provenance.runs = runs;
-    provenance
-        .log(file.stream())
-        .map_err(record_error(file.path()))?;
+    provenance.write(file, runs)?;
     let layout = &scenario.layout;
     let goal = &layout.goals()[scenario.episode.goal].name;
     let decoder_text = scenario.decoder_text();

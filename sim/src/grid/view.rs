@@ -261,11 +261,7 @@ impl GridRecorder {
     /// Logs `provenance` (its `runs` set to the episodes recorded), flushes
     /// the file and moves it into place.
     pub fn finish(self, provenance: &Provenance) -> Result<PathBuf> {
-        let mut provenance = provenance.clone();
-        provenance.runs = self.episodes;
-        provenance
-            .log(self.file.stream())
-            .map_err(record_error(self.file.path()))?;
+        provenance.write(&self.file, self.episodes)?;
         self.file.finish()
     }
 }

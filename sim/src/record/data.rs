@@ -24,7 +24,7 @@ use rerun::external::arrow::array::{
 use rerun::{ComponentDescriptor, RecordingStream, SerializedComponentBatch};
 use serde::{Deserialize, Serialize};
 
-use crate::record::SIM_TIME;
+use crate::record::{RrdFile, SIM_TIME, record_error};
 
 /// The provenance document (static).
 pub const PROVENANCE: &str = "/errp/provenance";
@@ -105,6 +105,14 @@ impl Provenance {
     pub fn log(&self, rec: &RecordingStream) -> Result<(), rerun::RecordingStreamError> {
         let json = serde_json::to_string_pretty(self).unwrap_or_default();
         rec.log_static(PROVENANCE, &rerun::TextDocument::new(json))
+    }
+
+    /// [`Provenance::log`] into `file`, with `runs` set, its error naming
+    /// the file.
+    pub fn write(&self, file: &RrdFile, runs: usize) -> crate::Result<()> {
+        let mut p = self.clone();
+        p.runs = runs;
+        p.log(file.stream()).map_err(record_error(file.path()))
     }
 }
 
