@@ -3,8 +3,8 @@
 # median time and detections of RUNS seeded runs (defaults: detector, user,
 # 95 % decoder) for each start cell x goal cell of the 5 x 5 city grid.
 # It answers whether any placement of the paper's cities could make one trip
-# much longer than another without changing the decoder (README, "The
-# e-puck task against sec. 5.3").
+# much longer than another without changing the decoder (docs/guide/epuck.md,
+# "Measured: 200 runs of each city scenario, against the paper's sec. 5.3").
 #
 #   scripts/epuck_geometry_scan.sh [RUNS] [START_CELLS] [GOAL_CELLS] [HEADING_DEG]
 #

@@ -35,6 +35,8 @@ record() {
   run grid run scenarios/grid_fixed_goals.toml --seed 1 --quiet --save "$out/grid.rrd"
   run epuck run scenarios/mexico_to_pisa.toml --seed 1 --quiet --save "$out/epuck.rrd"
   run epuck-20 run scenarios/mexico_to_pisa.toml --runs 20 --quiet
+  run lisbon run scenarios/lisbon_to_tokyo.toml --runs 3 --seed 2 --quiet
+  run grid-free run scenarios/grid_free_goals.toml --seed 2 --quiet
   run table1 table1 --seed 1 --quiet
   run sweep-grid sweep --task grid --accuracy 0.6,0.8 --param strategy=greedy,info_gain \
     --episodes 40 --seed 1 --no-cache --quiet --out "$out/sweep-grid"

@@ -1,9 +1,17 @@
 """Reports import circles between the modules of each crate: module A uses
 `crate::B...` while B uses `crate::A...` (directly or through up to four
-others). A parent's re-exports of its children do not count. Exits 1 if it
-finds one.
+others). A parent's re-exports of its children do not count.
 
-usage: python3 scripts/module_cycles.py CRATE_SRC_DIR ...
+With --layers FILE, also checks each crate against the floor plan in FILE
+(ARCHITECTURE.md): a fenced ```layers block with one line per crate,
+`DIR: a b | c | d e`, the top-level modules from the bottom layer up. A
+module may use a module of its own top-level module or of a lower layer;
+anything else (a shared module using a task's, a task using another task's)
+is reported, as is a module the plan does not place.
+
+Exits 1 if it finds anything.
+
+usage: python3 scripts/module_cycles.py [--layers ARCHITECTURE.md] CRATE_SRC_DIR ...
 """
 
 import os
@@ -59,10 +67,62 @@ def cycles(graph: dict[str, set[str]]) -> set[tuple[str, ...]]:
     return found
 
 
+def read_layers(path: str) -> dict[str, list[set[str]]]:
+    """The ```layers block of `path`: crate directory -> layers, bottom first."""
+    plan, inside = {}, False
+    for line in open(path, encoding="utf-8"):
+        line = line.rstrip("\n")
+        if line.strip() == "```layers":
+            inside = True
+        elif inside and line.strip() == "```":
+            inside = False
+        elif inside and ":" in line and not line.lstrip().startswith("#"):
+            root, rest = line.split(":", 1)
+            plan[root.strip()] = [set(layer.split()) for layer in rest.split("|")]
+    return plan
+
+
+def layer_errors(root: str, graph: dict[str, set[str]], layers: list[set[str]]) -> list[str]:
+    def top(module: str) -> str:
+        return module.split("::")[0]
+
+    level = {m: i for i, layer in enumerate(layers) for m in layer}
+    out = []
+    for module in sorted(graph):
+        if module == "crate":
+            continue  # lib.rs / main.rs: the crate's front, above every layer
+        if top(module) not in level:
+            out.append(f"{root}: {module} is in no layer of the floor plan")
+            continue
+        for dep in sorted(graph[module]):
+            if dep == "crate" or top(dep) == top(module):
+                continue
+            if top(dep) not in level:
+                continue  # reported as a module of its own
+            if level[top(dep)] >= level[top(module)]:
+                where = "the same layer" if level[top(dep)] == level[top(module)] else "a higher layer"
+                out.append(f"{root}: {module} uses {dep}, in {where}")
+    return out
+
+
 if __name__ == "__main__":
+    args = sys.argv[1:]
+    plan = None
+    if args[:1] == ["--layers"]:
+        plan = read_layers(args[1])
+        args = args[2:]
     bad = 0
-    for root in sys.argv[1:]:
-        for c in sorted(cycles(edges(root))):
+    for root in args:
+        graph = edges(root)
+        for c in sorted(cycles(graph)):
             print(f"{root}: import circle between {', '.join(c)}", file=sys.stderr)
             bad += 1
+        if plan is not None:
+            if root not in plan:
+                print(f"{root}: not in the floor plan of {sys.argv[2]}", file=sys.stderr)
+                bad += 1
+                continue
+            for e in layer_errors(root, graph, plan[root]):
+                print(e, file=sys.stderr)
+                bad += 1
     sys.exit(1 if bad else 0)

@@ -1,17 +1,17 @@
 #!/usr/bin/env bash
-# The commands behind the figures the README quotes, and their outputs.
+# The commands behind the figures the README and the guide quote, and their outputs.
 #
 #   scripts/readme_figures.sh [--check] [--cheap] [NAME...]
 #
 # Each figure is a command of the release `errp` (or $ERRP), or a script
-# ("sh: ..."), whose standard output is kept in docs/figures/NAME.txt; the README's tables are copied
-# from those files and name them. Without --check the outputs are written
-# anew; with --check each command runs again and the script fails on any
-# difference (a unified diff shows it). --cheap keeps to the figures that
-# take seconds (CI runs these); NAME... picks figures by name. Every run is
-# seeded and independent of the thread count, so the outputs are exact. The
-# targeting cache is a fresh temporary directory, so nothing on the machine
-# changes a result.
+# ("sh: ..."), whose standard output is kept in docs/figures/NAME.txt; the
+# tables of the README and of the guide (docs/guide/) are copied from those
+# files and name them. Without --check the outputs are written anew; with
+# --check each command runs again and the script fails on any difference (a
+# unified diff shows it). --cheap keeps to the figures that take seconds (CI
+# runs these); NAME... picks figures by name. Every run is seeded and
+# independent of the thread count, so the outputs are exact. The targeting
+# cache is a fresh temporary directory, so nothing on the machine changes a result.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 

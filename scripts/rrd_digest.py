@@ -1,16 +1,33 @@
 """A digest of what a Rerun recording holds, independent of how it was
 chunked and of the ids and wall-clock times Rerun stamps on each write:
 every entity's rows on each timeline, with RowIds and `log_time` dropped,
-hashed in time order. Two recordings of the same seeded run give the same
-digest.
+hashed in time order. The provenance is read without the commit and the
+command line (which name the build and the output path). Two recordings of
+the same seeded run give the same digest.
 
 usage: python rrd_digest.py FILE.rrd [TIMELINE ...]   (default: sim_time latency)
 """
 
 import hashlib
+import json
 import sys
 
 import rerun as rr
+
+
+def values(column: str, cells: list) -> list:
+    """A column's cells; the provenance without its commit and command."""
+    if not column.startswith("/errp/provenance:") or not column.endswith(":text"):
+        return cells
+    out = []
+    for cell in cells:
+        if cell:
+            doc = json.loads(cell[0])
+            doc.pop("commit", None)
+            doc.pop("command", None)
+            cell = [json.dumps(doc, sort_keys=True)]
+        out.append(cell)
+    return out
 
 
 def digest(path: str, timelines: list[str]) -> str:
@@ -25,7 +42,7 @@ def digest(path: str, timelines: list[str]) -> str:
             c for c in table.column_names if "log_time" not in c and "RowId" not in c
         )
         rows = sorted(
-            zip(*(map(repr, table.column(c).to_pylist()) for c in columns))
+            zip(*(map(repr, values(c, table.column(c).to_pylist())) for c in columns))
         )
         h.update(repr((index, columns, rows)).encode())
     return h.hexdigest()

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
 use clap::ValueEnum;
-use errp_bci::{MeanAccuracy, TargetingStep};
+use errp_bci::{MeanAccuracy, RequestedAccuracy, TargetingStep};
 use errp_sim::grid::EegMode;
 
 use crate::out::errln;
@@ -77,8 +77,9 @@ pub(crate) struct RunArgs {
     /// The scenario file (TOML), e.g. scenarios/mexico_to_pisa.toml or
     /// scenarios/grid_fixed_goals.toml.
     pub(crate) scenario: PathBuf,
-    /// Override the scenario's seed.
-    #[arg(long, value_parser = parse_seed, allow_negative_numbers = true)]
+    /// Override the scenario's seed (a new simulated user, new runs, new
+    /// free goals).
+    #[arg(long, value_parser = parse_scenario_seed, allow_negative_numbers = true)]
     pub(crate) seed: Option<u64>,
     /// Override the scenario's decoder (grid scenarios).
     #[arg(long, value_enum)]
@@ -144,8 +145,8 @@ pub(crate) fn parse_accuracy(s: &str) -> Result<MeanAccuracy, String> {
 /// `--accuracy` of `errp run`: a mean accuracy in (0.5, 1), or 1 (for the
 /// grid's oracle; `errp run` checks the decoder).
 pub(crate) fn parse_run_accuracy(s: &str) -> Result<f64, String> {
-    match s.trim().parse::<f64>() {
-        Ok(v) if v == 1.0 => Ok(v),
+    match s.trim().parse::<f64>().map(RequestedAccuracy::new) {
+        Ok(Ok(a)) => Ok(a.get()),
         _ => parse_accuracy(s)
             .map(|a| a.get())
             .map_err(|e| format!("{e} (or 1 with --decoder oracle)")),
@@ -160,6 +161,21 @@ pub(crate) fn parse_seed(s: &str) -> Result<u64, String> {
             u64::MAX
         )
     })
+}
+
+/// A scenario's seed: a whole number from 0 to 2^63 - 1 (a TOML integer,
+/// as the file holds it).
+pub(crate) fn parse_scenario_seed(s: &str) -> Result<u64, String> {
+    s.trim()
+        .parse::<u64>()
+        .ok()
+        .filter(|&seed| i64::try_from(seed).is_ok())
+        .ok_or_else(|| {
+            format!(
+                "{s:?} is not a scenario's seed: give a whole number from 0 to {}",
+                i64::MAX
+            )
+        })
 }
 
 pub(crate) fn check_extension(path: &Path, ext: &str, flag: &str) -> Result<()> {

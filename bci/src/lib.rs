@@ -49,9 +49,9 @@ mod targeting;
 
 pub use calibration::{
     Accuracy, Calibrated, CalibrationParams, CalibrationSession, CalibrationSetup, GrandAverage,
-    Protocol, RawSink, SessionOptions, Setup, calibrate, calibrate_session, cross_validate,
-    cv_seed, eog_session, out_of_fold_decisions, schedule, simulate_session, simulate_session_with,
-    stratified_folds,
+    Protocol, RawSink, SessionOptions, Setup, TargetingParams, calibrate, calibrate_session,
+    cross_validate, cv_seed, eog_session, out_of_fold_decisions, schedule, simulate_session,
+    simulate_session_with, stratified_folds,
 };
 pub use classify::{Classifier, ErrorModel, Features, sigmoid};
 pub use continuous::ContinuousFeatures;
@@ -62,6 +62,7 @@ pub use continuous_calibration::{
 pub use edf::EdfWriter;
 pub use erp::{AssessmentKind, Component, ErpTemplates};
 pub use error::{BciError, Result};
+pub use errp_valid::{Check, Valid};
 pub use features::{EpochWindow, FeatureExtractor};
 pub use filter::{Biquad, FilterBank, FilterChain};
 pub use generator::{Assessment, Components, EegBlock, EegGenerator, GeneratorParams};
@@ -80,7 +81,7 @@ pub use psd::ThetaPsd;
 pub use subjects::{GoalSet, Subject, subject, subjects};
 pub use svm::{SvmDecoder, SvmModel};
 pub use targeting::{
-    MeanAccuracy, SessionParts, TargetingParams, TargetingResult, TargetingStep,
+    MeanAccuracy, RequestedAccuracy, SessionParts, TargetingResult, TargetingStep,
     inverse_normal_cdf, ratio_text, search_ratio, target_accuracy, target_accuracy_on,
     target_continuous_accuracy,
 };

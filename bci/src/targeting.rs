@@ -4,36 +4,14 @@
 use serde::{Deserialize, Serialize};
 
 use crate::calibration::{
-    Accuracy, CalibrationSession, CalibrationSetup, SessionOptions, cross_validate, cv_seed,
-    simulate_session,
+    Accuracy, CalibrationSession, CalibrationSetup, SessionOptions, TargetingParams,
+    cross_validate, cv_seed, simulate_session,
 };
 use crate::classify::{Classifier, Features};
 use crate::continuous_calibration::{ContinuousSetup, simulate_continuous_session};
 use crate::error::{BciError, Result, check};
 use crate::generator::Components;
 use crate::svm::SvmDecoder;
-
-/// How closely and how hard to search.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct TargetingParams {
-    /// Stop once the cross-validated mean accuracy is this close (fraction).
-    pub tolerance: f64,
-    /// Most decoder evaluations (each a full cross-validation).
-    pub max_evaluations: usize,
-    /// Largest ratio tried.
-    pub max_ratio: f64,
-}
-
-impl Default for TargetingParams {
-    fn default() -> Self {
-        Self {
-            tolerance: 0.005,
-            max_evaluations: 16,
-            max_ratio: 8.0,
-        }
-    }
-}
 
 /// One evaluation of the search.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -151,6 +129,54 @@ impl From<MeanAccuracy> for f64 {
 impl std::fmt::Display for MeanAccuracy {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "{}", self.0)
+    }
+}
+
+/// An accuracy a decoder may be asked for: a [`MeanAccuracy`] in (0.5, 1),
+/// which an EEG decoder is targeted at, or exactly 1, which only the grid's
+/// oracle decoder can be. The one statement of that rule: scenario files,
+/// `errp run --accuracy` and sweep levels all check it here (which decoder
+/// may be perfect is the task's to say).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RequestedAccuracy {
+    /// A real decoder's target.
+    Targeted(MeanAccuracy),
+    /// A perfect decoder: the grid's oracle.
+    Perfect,
+}
+
+impl RequestedAccuracy {
+    /// The accepted values, in words.
+    pub const RANGE: &'static str = "a mean accuracy strictly between 0.5 (chance) and 1, e.g. 0.7438, or 1 for the \
+         grid's oracle decoder";
+
+    /// `value` if it is in (0.5, 1] ; otherwise an
+    /// [`InvalidParameter`](BciError::InvalidParameter) naming `accuracy`
+    /// and [`RANGE`](Self::RANGE).
+    pub fn new(value: f64) -> Result<Self> {
+        if value == 1.0 {
+            return Ok(Self::Perfect);
+        }
+        MeanAccuracy::new(value).map(Self::Targeted).or_else(|_| {
+            check(false, "accuracy", value, Self::RANGE)?;
+            unreachable!("check(false, ..) is an error")
+        })
+    }
+
+    /// The accuracy.
+    pub fn get(self) -> f64 {
+        match self {
+            Self::Targeted(a) => a.get(),
+            Self::Perfect => 1.0,
+        }
+    }
+
+    /// The target of a real decoder, if this is one.
+    pub fn targeted(self) -> Option<MeanAccuracy> {
+        match self {
+            Self::Targeted(a) => Some(a),
+            Self::Perfect => None,
+        }
     }
 }
 

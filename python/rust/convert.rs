@@ -118,14 +118,10 @@ impl ScenarioSource {
 pub(crate) fn load_any_text(
     scenario: Option<PathBuf>,
     default_epuck: bool,
-    accuracy: Option<f64>,
+    keys: Keys,
     given: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<String> {
-    let mut extra = Vec::new();
-    if let Some(a) = accuracy {
-        extra.push(("user.accuracy".to_string(), toml::Value::Float(a)));
-    }
-    ScenarioSource::new(scenario, default_epuck).text_as_run(&overrides(extra, given)?)
+    ScenarioSource::new(scenario, default_epuck).text_as_run(&overrides(keys.pairs()?, given)?)
 }
 
 /// `overrides={"control.tau": 0.5, ...}` as scenario keys and TOML values,
@@ -278,32 +274,81 @@ pub(crate) fn check_callable(py: Python<'_>, name: &str, f: Option<&Py<PyAny>>) 
     }
 }
 
-/// The scenario keyword with `accuracy=` and `overrides=` set: the file
-/// given, or the built-in scenario of the e-puck (`default_epuck`) or of the
-/// grid.
+/// The keyword arguments that set a scenario's keys, set before
+/// `overrides=` and as `errp run`'s flags set them
+/// ([`errp_sim::apply_overrides`]).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Keys {
+    /// `accuracy=`: `user.accuracy`.
+    pub(crate) accuracy: Option<f64>,
+    /// `seed=`: `seed` (a new simulated user, new runs, new free goals).
+    pub(crate) seed: Option<u64>,
+    /// `runs=`: `runs` (e-puck scenarios).
+    pub(crate) runs: Option<usize>,
+}
+
+impl Keys {
+    /// Only `accuracy=`.
+    pub(crate) fn accuracy(accuracy: Option<f64>) -> Self {
+        Self {
+            accuracy,
+            ..Self::default()
+        }
+    }
+
+    /// The keys and their values, in order.
+    fn pairs(self) -> PyResult<Vec<(String, toml::Value)>> {
+        let mut out = Vec::new();
+        if let Some(a) = self.accuracy {
+            out.push(("user.accuracy".to_string(), toml::Value::Float(a)));
+        }
+        if let Some(seed) = self.seed {
+            let seed = i64::try_from(seed).map_err(|_| {
+                value_error(
+                    "seed",
+                    seed,
+                    &format!("a whole number from 0 to {}", i64::MAX),
+                )
+            })?;
+            out.push(("seed".to_string(), toml::Value::Integer(seed)));
+        }
+        if let Some(runs) = self.runs {
+            let max = errp_sim::epuck::MAX_RUNS;
+            let n = u64::try_from(runs).ok().filter(|n| (1..=max).contains(n));
+            let Some(n) = n else {
+                return Err(value_error(
+                    "runs",
+                    runs,
+                    &format!("a whole number from 1 to {max}"),
+                ));
+            };
+            out.push(("runs".to_string(), toml::Value::Integer(n as i64)));
+        }
+        Ok(out)
+    }
+}
+
+/// The scenario keyword with `keys` and `overrides=` set: the file given,
+/// or the built-in scenario of the e-puck (`default_epuck`) or of the grid.
 pub(crate) fn load_any(
     scenario: Option<PathBuf>,
     default_epuck: bool,
-    accuracy: Option<f64>,
+    keys: Keys,
     given: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<AnyScenario> {
-    let mut extra = Vec::new();
-    if let Some(a) = accuracy {
-        extra.push(("user.accuracy".to_string(), toml::Value::Float(a)));
-    }
-    ScenarioSource::new(scenario, default_epuck).load(&overrides(extra, given)?)
+    ScenarioSource::new(scenario, default_epuck).load(&overrides(keys.pairs()?, given)?)
 }
 
 /// A grid scenario (the built-in one by default); `who` names what needs
 /// it in the error for an e-puck scenario.
 pub(crate) fn load_grid(
     scenario: Option<PathBuf>,
-    accuracy: Option<f64>,
+    keys: Keys,
     given: Option<&Bound<'_, PyDict>>,
     who: &str,
 ) -> PyResult<GridScenario> {
     let shown = shown(&scenario);
-    match load_any(scenario, false, accuracy, given)? {
+    match load_any(scenario, false, keys, given)? {
         AnyScenario::Grid(s) => Ok(*s),
         AnyScenario::Epuck(_) => Err(PyValueError::new_err(format!(
             "scenario: {shown} is an e-puck scenario; {who} needs a grid scenario"
@@ -314,12 +359,12 @@ pub(crate) fn load_grid(
 /// An e-puck scenario (the built-in Mexico-to-Pisa one by default).
 pub(crate) fn load_epuck(
     scenario: Option<PathBuf>,
-    accuracy: Option<f64>,
+    keys: Keys,
     given: Option<&Bound<'_, PyDict>>,
     who: &str,
 ) -> PyResult<EpuckScenario> {
     let shown = shown(&scenario);
-    match load_any(scenario, true, accuracy, given)? {
+    match load_any(scenario, true, keys, given)? {
         AnyScenario::Epuck(s) => Ok(*s),
         AnyScenario::Grid(_) => Err(PyValueError::new_err(format!(
             "scenario: {shown} is a grid scenario; {who} needs an e-puck scenario"

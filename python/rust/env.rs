@@ -18,7 +18,9 @@ use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{block_to_numpy, load_any_text, load_epuck, load_grid, py_err, value_error};
+use crate::convert::{
+    Keys, block_to_numpy, load_any_text, load_epuck, load_grid, py_err, value_error,
+};
 use crate::run::check_save;
 
 /// The most episodes a grid environment records (as `errp run --save`).
@@ -145,10 +147,15 @@ impl GridEnvCore {
     ) -> PyResult<Self> {
         check_save(save.as_ref())?;
         let text = match &save {
-            Some(_) => load_any_text(scenario.clone(), false, accuracy, overrides)?,
+            Some(_) => load_any_text(scenario.clone(), false, Keys::accuracy(accuracy), overrides)?,
             None => String::new(),
         };
-        let s = load_grid(scenario, accuracy, overrides, "the grid environment")?;
+        let s = load_grid(
+            scenario,
+            Keys::accuracy(accuracy),
+            overrides,
+            "the grid environment",
+        )?;
         #[cfg(feature = "rerun")]
         let save = match save {
             Some(path) => {
@@ -382,10 +389,15 @@ impl EpuckEnvCore {
     ) -> PyResult<Self> {
         check_save(save.as_ref())?;
         let text = match &save {
-            Some(_) => load_any_text(scenario.clone(), true, accuracy, overrides)?,
+            Some(_) => load_any_text(scenario.clone(), true, Keys::accuracy(accuracy), overrides)?,
             None => String::new(),
         };
-        let s = load_epuck(scenario, accuracy, overrides, "the e-puck environment")?;
+        let s = load_epuck(
+            scenario,
+            Keys::accuracy(accuracy),
+            overrides,
+            "the e-puck environment",
+        )?;
         let key = EpuckInfo::decoder_key(&s);
         let decoder = match cached(&EPUCK_DECODERS, &key) {
             Some(d) => d,
@@ -400,7 +412,7 @@ impl EpuckEnvCore {
         let save = match save {
             Some(path) => {
                 let file = errp_sim::epuck::epuck_agent_recording(&path).map_err(py_err)?;
-                let t_e = decoder.t_e(s.params.control.t_e);
+                let t_e = decoder.detector_t_e(&s.params, false);
                 let recorder = errp_sim::epuck::EpuckRecorder::new(&file, &s.arena, &s.layout, t_e)
                     .map_err(py_err)?;
                 Some(EpuckSave {

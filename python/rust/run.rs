@@ -20,7 +20,7 @@ use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{load_any, load_any_text, py_err, value_error};
+use crate::convert::{Keys, load_any, load_any_text, py_err, value_error};
 
 /// Keyword names in errors.
 const NAMES: InputNames = InputNames {
@@ -114,23 +114,38 @@ pub(crate) fn run<'py>(
     save: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyDict>> {
     check_save(save.as_ref())?;
+    let keys = Keys {
+        accuracy,
+        seed,
+        runs,
+    };
+    // The file as given first (the task decides whether runs= applies),
+    // then with runs= set as a key as well.
+    let mut any = load_any(
+        scenario.clone(),
+        true,
+        Keys { runs: None, ..keys },
+        overrides,
+    )?;
+    match (&any, runs) {
+        (AnyScenario::Grid(_), Some(_)) => {
+            return Err(PyValueError::new_err(
+                "runs: applies to e-puck scenarios; a grid scenario lists its episodes \
+                 (set `repeats`, or give overrides)",
+            ));
+        }
+        (AnyScenario::Epuck(_), Some(_)) => {
+            any = load_any(scenario.clone(), true, keys, overrides)?
+        }
+        _ => {}
+    }
     let text = match &save {
-        Some(_) => load_any_text(scenario.clone(), true, accuracy, overrides)?,
+        Some(_) => load_any_text(scenario, true, keys, overrides)?,
         None => String::new(),
     };
-    let any = load_any(scenario, true, accuracy, overrides)?;
     let out = PyDict::new(py);
     match any {
-        AnyScenario::Grid(mut s) => {
-            if runs.is_some() {
-                return Err(PyValueError::new_err(
-                    "runs: applies to e-puck scenarios; a grid scenario lists its episodes \
-                     (set `repeats`, or give overrides)",
-                ));
-            }
-            if let Some(seed) = seed {
-                s.seed = seed;
-            }
+        AnyScenario::Grid(s) => {
             let (csv, info) = py
                 .detach(|| run_grid(&s, save.as_ref(), text))
                 .map_err(py_err)?;
@@ -138,20 +153,7 @@ pub(crate) fn run<'py>(
             out.set_item("csv", csv)?;
             out.set_item("decoder", info)?;
         }
-        AnyScenario::Epuck(mut s) => {
-            if let Some(seed) = seed {
-                s.reseed(seed);
-            }
-            if let Some(r) = runs {
-                if !(1..=errp_sim::epuck::MAX_RUNS as usize).contains(&r) {
-                    return Err(value_error(
-                        "runs",
-                        r,
-                        &format!("a whole number from 1 to {}", errp_sim::epuck::MAX_RUNS),
-                    ));
-                }
-                s.runs = r;
-            }
+        AnyScenario::Epuck(s) => {
             if save.is_some() && s.runs > 100 {
                 return Err(value_error(
                     "runs",
@@ -217,7 +219,7 @@ pub(crate) fn epuck_summary(
         ("cv_correct", a.correct),
         ("cv_error", a.error),
         ("cv_mean", a.mean()),
-        ("t_e", decoder.t_e(s.params.control.t_e)),
+        ("t_e", decoder.detector_t_e(&s.params, false)),
     ];
     if let Some(o) = &decoder.online {
         info.extend([
@@ -311,17 +313,13 @@ fn run_epuck(
     Ok((lines.join("\n") + "\n", info))
 }
 
-/// Runs a Monte Carlo sweep as `errp sweep` does, into `out`, and returns
-/// the paths of its files. A rerun of the same sweep into the same
-/// directory resumes it.
-#[pyfunction]
-#[pyo3(signature = (out, *, accuracy, task=None, scenario=None, episodes=100, seed=1, params=None, stream=None, cache=None, threads=None))]
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn sweep<'py>(
-    py: Python<'py>,
-    out: PathBuf,
-    accuracy: &str,
-    task: Option<&str>,
+/// The keywords of `errp.sweep`, which its Python wrapper passes as one
+/// dictionary (every key present).
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+pub(crate) struct SweepKeywords {
+    accuracy: String,
+    task: Option<String>,
     scenario: Option<PathBuf>,
     episodes: usize,
     seed: u64,
@@ -329,8 +327,29 @@ pub(crate) fn sweep<'py>(
     stream: Option<bool>,
     cache: Option<PathBuf>,
     threads: Option<usize>,
+}
+
+/// Runs a Monte Carlo sweep as `errp sweep` does, into `out`, and returns
+/// the paths of its files. A rerun of the same sweep into the same
+/// directory resumes it.
+#[pyfunction]
+pub(crate) fn sweep<'py>(
+    py: Python<'py>,
+    out: PathBuf,
+    keywords: SweepKeywords,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let want = match task {
+    let SweepKeywords {
+        accuracy,
+        task,
+        scenario,
+        episodes,
+        seed,
+        params,
+        stream,
+        cache,
+        threads,
+    } = keywords;
+    let want = match task.as_deref() {
         None => None,
         Some("grid") => Some(SweepTask::Grid),
         Some("epuck") => Some(SweepTask::Epuck),
@@ -361,7 +380,7 @@ pub(crate) fn sweep<'py>(
         task,
         scenario_path: path,
         scenario_toml: text,
-        accuracies: parse_accuracies(accuracy)
+        accuracies: parse_accuracies(&accuracy)
             .map_err(|e| PyValueError::new_err(format!("accuracy: {}", e)))?,
         axes: params
             .unwrap_or_default()

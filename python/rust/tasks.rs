@@ -23,7 +23,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::{
-    PyDecoder, blocks_to_array3, channel_names, check_callable, load_any_text, load_epuck,
+    Keys, PyDecoder, blocks_to_array3, channel_names, check_callable, load_any_text, load_epuck,
     load_grid, py_err, value_error,
 };
 use crate::run::{
@@ -86,11 +86,13 @@ impl GridTask {
         accuracy: Option<f64>,
         overrides: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
-        let text = load_any_text(scenario.clone(), false, accuracy, overrides)?;
-        let mut s = load_grid(scenario, accuracy, overrides, "errp.GridTask")?;
-        if let Some(seed) = seed {
-            s.seed = seed;
-        }
+        let keys = Keys {
+            accuracy,
+            seed,
+            runs: None,
+        };
+        let text = load_any_text(scenario.clone(), false, keys, overrides)?;
+        let s = load_grid(scenario, keys, overrides, "errp.GridTask")?;
         check_callable(py, "decoder", decoder.as_ref())?;
         check_callable(py, "batch_decoder", batch_decoder.as_ref())?;
         if decoder.is_some() && batch_decoder.is_some() {
@@ -309,11 +311,13 @@ impl EpuckTask {
         accuracy: Option<f64>,
         overrides: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
-        let text = load_any_text(scenario.clone(), true, accuracy, overrides)?;
-        let mut s = load_epuck(scenario, accuracy, overrides, "errp.EpuckTask")?;
-        if let Some(seed) = seed {
-            s.reseed(seed);
-        }
+        let keys = Keys {
+            accuracy,
+            seed,
+            runs: None,
+        };
+        let text = load_any_text(scenario.clone(), true, keys, overrides)?;
+        let s = load_epuck(scenario, keys, overrides, "errp.EpuckTask")?;
         check_callable(py, "decoder", decoder.as_ref())?;
         let (builtin, report) = py
             .detach(|| errp_sim::epuck::prepare_continuous_decoder(&s, |_| {}))
@@ -399,10 +403,7 @@ impl EpuckTask {
                         .map(|k| {
                             let mut call = |b: &EegBlock| dec.call(b);
                             run_epuck_episode_with(
-                                &s.params,
-                                &s.arena,
-                                &s.layout,
-                                s.episode,
+                                s,
                                 d,
                                 epuck_run_seed(s.seed, k),
                                 &mut (),
@@ -448,7 +449,7 @@ impl EpuckTask {
     /// scenario's `control.t_e`.
     #[getter]
     fn t_e(&self) -> f64 {
-        self.scenario.params.control.t_e
+        self.builtin.detector_t_e(&self.scenario.params, true)
     }
 
     /// Times the decoder was called so far.

@@ -53,6 +53,23 @@ def test_grid_run_matches_errp_run(root):
     assert f"{100 * df.attrs['decoder']['cv_mean']:.2f}" == cal
 
 
+def test_a_seed_draws_the_free_goals_as_errp_run_seed_does(root):
+    # seed= is set in the scenario before its free goals are drawn from it,
+    # as `errp run --seed` sets it: the same pairs, and others for another
+    # seed.
+    free = "scenarios/grid_free_goals.toml"
+    pairs = {}
+    for seed in (1, 3):
+        text = cli("run", free, "--decoder", "oracle", "--seed", str(seed), "--quiet")
+        cells = [re.findall(r"\((\d), (\d)\)", " ".join(r))[:2] for r in table_rows(text, "#   start")]
+        want = [tuple(int(v) for c in pair for v in c) for pair in cells]
+        df = errp.run(str(root / free), seed=seed, overrides={"decoder": "oracle"})
+        got = list(zip(df.start_x, df.start_y, df.goal_x, df.goal_y))
+        assert got == want and len(got) == 5
+        pairs[seed] = got
+    assert pairs[1] != pairs[3]
+
+
 def test_epuck_run_matches_errp_run(root):
     text = cli("run", "scenarios/mexico_to_pisa.toml", "--runs", "3", "--seed", "2", "--quiet")
     rows = table_rows(text, "run  converged on")

@@ -67,6 +67,8 @@ use std::f64::consts::FRAC_PI_2;
 
 use serde::{Deserialize, Serialize};
 
+use errp_valid::Valid;
+
 use crate::belief::Belief;
 use crate::continuous_likelihood::{ContinuousControlParams, linear_likelihood, turn_likelihood};
 use crate::epuck::{Twist, WheelSpeeds};
@@ -142,7 +144,7 @@ pub struct Observation {
 /// pose and the simulated time (which starts at 0).
 #[derive(Debug, Clone)]
 pub struct ContinuousController {
-    params: ContinuousControlParams,
+    params: Valid<ContinuousControlParams>,
     layout: GoalLayout,
     potentials: Vec<QuadraticPotential>,
     belief: Belief,
@@ -162,8 +164,11 @@ impl ContinuousController {
     /// is not on (with the uniform belief, greedy takes the nearest): the
     /// robot moves at once, and the goal it starts on is no target until it
     /// has left it.
-    pub fn new(params: ContinuousControlParams, layout: GoalLayout, start: Pose) -> Result<Self> {
-        params.validate()?;
+    pub fn new(
+        params: Valid<ContinuousControlParams>,
+        layout: GoalLayout,
+        start: Pose,
+    ) -> Result<Self> {
         let goals = layout.goals();
         let mut closest = f64::INFINITY;
         for (i, a) in goals.iter().enumerate() {
@@ -336,7 +341,6 @@ impl ContinuousController {
 
     fn gain(&self, p: &[f64], pose: &Pose, g: usize) -> f64 {
         let alpha = self.params.assumed_accuracy;
-        let p_error = |says_error: bool| if says_error { 1.0 } else { 0.0 };
         if self.on_goal(pose, g) {
             return expected_information_gain(
                 p,
@@ -344,7 +348,7 @@ impl ContinuousController {
                 |i| if i == g { 0.0 } else { 1.0 },
                 |i, says_error| {
                     if i == g {
-                        linear_likelihood(&self.params, p_error(says_error), 0.0)
+                        linear_likelihood(&self.params, says_error, 0.0)
                     } else {
                         1.0
                     }
@@ -369,7 +373,7 @@ impl ContinuousController {
                 if self.on_goal(pose, i) {
                     1.0
                 } else {
-                    linear_likelihood(&self.params, p_error(says_error), delta(i))
+                    linear_likelihood(&self.params, says_error, delta(i))
                 }
             },
         )
@@ -479,20 +483,21 @@ impl ContinuousController {
         }
     }
 
-    /// The likelihood of `step` for every goal, given p(error) and the pose:
+    /// The likelihood of `step` for every goal, given the detector's verdict
+    /// (`error`) and the pose:
     /// eq. (6) for a turn, eq. (7) for a linear step, eq. (7) at bearing 0
     /// for the goal the robot is stopped on, 1 elsewhere (see the module
     /// doc).
-    pub fn likelihoods(&self, step: StepKind, p_error: f64, pose: &Pose) -> Vec<f64> {
+    pub fn likelihoods(&self, step: StepKind, error: bool, pose: &Pose) -> Vec<f64> {
         (0..self.layout.len())
             .map(|i| match step {
                 StepKind::Turn { direction } if !self.on_goal(pose, i) => {
-                    turn_likelihood(&self.params, p_error, direction, self.bearing_rad(pose, i))
+                    turn_likelihood(&self.params, error, direction, self.bearing_rad(pose, i))
                 }
                 StepKind::Linear if !self.on_goal(pose, i) => {
-                    linear_likelihood(&self.params, p_error, self.bearing_rad(pose, i))
+                    linear_likelihood(&self.params, error, self.bearing_rad(pose, i))
                 }
-                StepKind::StopOnGoal(j) if i == j => linear_likelihood(&self.params, p_error, 0.0),
+                StepKind::StopOnGoal(j) if i == j => linear_likelihood(&self.params, error, 0.0),
                 _ => 1.0,
             })
             .collect()
@@ -507,8 +512,6 @@ impl ContinuousController {
     /// `time_secs + stop_secs`. Reports convergence when the robot is
     /// stopped on a goal whose probability is >= p_c.
     pub fn observe(&mut self, error: bool, pose: &Pose, time_secs: f64) -> Result<Observation> {
-        // Eq. (6) and (7) read p(error) only through p >= T_e.
-        let p_error = if error { 1.0 } else { 0.0 };
         let heading_change = wrap_angle(pose.heading_rad - self.last_heading_rad);
         self.last_heading_rad = pose.heading_rad;
         let moving = matches!(self.phase, Phase::Turning | Phase::Driving);
@@ -537,7 +540,7 @@ impl ContinuousController {
                 },
             ) => StepKind::Idle,
         };
-        let likelihoods = self.likelihoods(step, p_error, pose);
+        let likelihoods = self.likelihoods(step, error, pose);
         if step != StepKind::Idle {
             self.belief.update(&likelihoods)?;
         }
@@ -577,7 +580,7 @@ mod tests {
     fn the_robot_leaves_its_start_city_at_once() {
         let l = GoalLayout::cities();
         let start = on(&l, "Mexico", 0.0);
-        let mut c = ContinuousController::new(params(), l, start).unwrap();
+        let mut c = ContinuousController::new(Valid::new(params()).unwrap(), l, start).unwrap();
         let mexico = 0;
         // The nearest goals other than Mexico, Havana and Bogota, tie at
         // 0.4 m; the lower index (Havana) wins. No stop on Mexico first.
@@ -619,7 +622,7 @@ mod tests {
             strategy: Strategy::InfoGain,
             ..params()
         };
-        let c = ContinuousController::new(p, l, start).unwrap();
+        let c = ContinuousController::new(Valid::new(p).unwrap(), l, start).unwrap();
         assert_ne!(c.target(), 0);
         assert_eq!(c.phase(), Phase::Turning);
     }
@@ -628,7 +631,7 @@ mod tests {
     fn a_detected_error_stops_the_robot_and_freezes_the_belief() {
         let l = GoalLayout::cities();
         let start = Pose::new(1.0, 0.9, PI / 2.0); // just below Athens
-        let mut c = ContinuousController::new(params(), l, start).unwrap();
+        let mut c = ContinuousController::new(Valid::new(params()).unwrap(), l, start).unwrap();
         let athens = c.layout().index_of("Athens").unwrap();
         assert_eq!(c.target(), athens);
         let w = c.command(&start, 0.0);
@@ -670,7 +673,7 @@ mod tests {
             veto_window_secs: Some(1.2),
             ..params()
         };
-        let mut c = ContinuousController::new(held, l, start).unwrap();
+        let mut c = ContinuousController::new(Valid::new(held).unwrap(), l, start).unwrap();
         assert_eq!(c.target(), athens);
         let on_athens = on(c.layout(), "Athens", PI / 2.0);
         assert_eq!(c.command(&on_athens, 0.5), WheelSpeeds::ZERO, "arrived");
@@ -708,7 +711,9 @@ mod tests {
     fn belief_stays_a_distribution_under_any_decoder_output() {
         let l = GoalLayout::cities();
         let mut rng = ChaCha8Rng::seed_from_u64(5);
-        let mut c = ContinuousController::new(params(), l, Pose::new(0.9, 1.1, 0.0)).unwrap();
+        let mut c =
+            ContinuousController::new(Valid::new(params()).unwrap(), l, Pose::new(0.9, 1.1, 0.0))
+                .unwrap();
         for k in 0..5000 {
             let pose = Pose::new(
                 rng.random_range(0.0..2.0),
@@ -736,7 +741,8 @@ mod tests {
                 rng.random_range(0.0..2.0),
                 rng.random_range(-PI..PI),
             );
-            let mut c = ContinuousController::new(params(), l.clone(), pose).unwrap();
+            let mut c =
+                ContinuousController::new(Valid::new(params()).unwrap(), l.clone(), pose).unwrap();
             let w = c.command(&pose, 0.0);
             assert!(w.left_m_per_s.abs() <= top + 1e-12 && w.right_m_per_s.abs() <= top + 1e-12);
         }
@@ -749,9 +755,13 @@ mod tests {
             goal_radius_m: 0.2,
             ..d
         };
-        let e = ContinuousController::new(wide, GoalLayout::cities(), Pose::default())
-            .unwrap_err()
-            .to_string();
+        let e = ContinuousController::new(
+            Valid::new(wide).unwrap(),
+            GoalLayout::cities(),
+            Pose::default(),
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("goal_radius_m"), "{e}");
     }
 
@@ -764,7 +774,8 @@ mod tests {
             strategy: Strategy::InfoGain,
             ..params()
         };
-        let mut c = ContinuousController::new(params, l.clone(), start).unwrap();
+        let mut c =
+            ContinuousController::new(Valid::new(params).unwrap(), l.clone(), start).unwrap();
         let idx: Vec<usize> = goals.iter().map(|g| l.index_of(g).unwrap()).collect();
         let rest = (1.0 - mass.iter().sum::<f64>()) / (l.len() - goals.len()) as f64;
         let w: Vec<f64> = (0..l.len())
@@ -806,7 +817,10 @@ mod tests {
         assert!(gain("Rio de Janeiro") < gain("Athens"));
         // Greedy with the same belief heads for Bangkok.
         let mut greedy = c.clone();
-        greedy.params.strategy = Strategy::Greedy;
+        greedy.params = greedy
+            .params
+            .with(|p| p.strategy = Strategy::Greedy)
+            .unwrap();
         assert_eq!(greedy.next_target(&pose), bangkok);
     }
 

@@ -5,6 +5,8 @@ use std::f64::consts::PI;
 
 use serde::{Deserialize, Serialize};
 
+use errp_valid::Check;
+
 use crate::epuck::EpuckParams;
 use crate::error::{Result, RobotError, check};
 use crate::pose::wrap_angle;
@@ -109,9 +111,18 @@ impl Default for ContinuousControlParams {
     }
 }
 
+/// Checked where a scenario enters; the controller takes it checked.
+impl Check for ContinuousControlParams {
+    type Error = RobotError;
+
+    fn check(&self) -> Result<()> {
+        self.validate()
+    }
+}
+
 impl ContinuousControlParams {
     /// Checks every field; messages name the field and the accepted range.
-    pub fn validate(&self) -> Result<()> {
+    fn validate(&self) -> Result<()> {
         let check = |ok: bool, name: &'static str, v: f64, range: &str| {
             check(ok && v.is_finite(), name, v, range)
         };
@@ -199,12 +210,6 @@ impl ContinuousControlParams {
         self.sigma_deg.to_radians()
     }
 
-    /// The paper's detection rule read literally: p(error) >= T_e. The one
-    /// place T_e is compared with.
-    pub fn detects(&self, p_error: f64) -> bool {
-        p_error >= self.t_e
-    }
-
     /// N(0; 0, sigma), the peak of eq. (7)'s normal pdf (1.1399 for 20 deg).
     pub fn pdf_peak(&self) -> f64 {
         normal_pdf(0.0, self.sigma_rad())
@@ -217,7 +222,8 @@ fn normal_pdf(x: f64, sigma: f64) -> f64 {
 }
 
 /// Eq. (6) of the paper, the likelihood of a turn step for one goal: k_n
-/// (`k_turn`) if an error is detected (p(error) >= T_e) while the robot turns
+/// (`k_turn`) if an error is detected (`error`: the detector's verdict, the
+/// paper's p(error) >= T_e, which the detector alone compares) while the robot turns
 /// anticlockwise (`turn_direction` > 0, the sign of theta_t - theta_{t-1})
 /// and the goal is to its left (bearing theta_i - theta_t in (0, pi]), or
 /// while it turns clockwise and the goal is to its right (bearing in
@@ -226,13 +232,12 @@ fn normal_pdf(x: f64, sigma: f64) -> f64 {
 /// says. `bearing_rad` is wrapped here.
 pub fn turn_likelihood(
     params: &ContinuousControlParams,
-    p_error: f64,
+    error: bool,
     turn_direction: f64,
     bearing_rad: f64,
 ) -> f64 {
     let b = wrap_angle(bearing_rad);
     let left = b > 0.0; // (0, pi]; wrapped, so b <= pi
-    let error = params.detects(p_error);
     if error && ((turn_direction > 0.0 && left) || (turn_direction < 0.0 && !left)) {
         params.k_turn
     } else {
@@ -241,12 +246,12 @@ pub fn turn_likelihood(
 }
 
 /// Eq. (7) of the paper, the likelihood of a linear step for one goal:
-/// 1 + k_p N(bearing; 0, sigma) if no error is detected (p(error) < T_e),
-/// 1 - k_n N(bearing; 0, sigma) if one is, with the bearing
+/// 1 + k_p N(bearing; 0, sigma) if no error is detected (`error` false: the
+/// paper's p(error) < T_e), 1 - k_n N(bearing; 0, sigma) if one is, with the bearing
 /// theta_i - theta_t in radians (N is even, so its sign does not matter).
-pub fn linear_likelihood(params: &ContinuousControlParams, p_error: f64, bearing_rad: f64) -> f64 {
+pub fn linear_likelihood(params: &ContinuousControlParams, error: bool, bearing_rad: f64) -> f64 {
     let n = normal_pdf(wrap_angle(bearing_rad), params.sigma_rad());
-    if !params.detects(p_error) {
+    if !error {
         1.0 + params.k_p * n
     } else {
         1.0 - params.k_n * n
@@ -265,7 +270,7 @@ mod tests {
     #[test]
     fn eq6_penalises_goals_on_the_side_of_the_turn() {
         let p = params();
-        let (err, ok) = (0.9, 0.5);
+        let (err, ok) = (true, false);
         let (acw, cw) = (0.05, -0.05);
         // Anticlockwise: goals to the left, bearing in (0, pi].
         assert_eq!(turn_likelihood(&p, err, acw, 0.5), 0.2);
@@ -277,9 +282,8 @@ mod tests {
         assert_eq!(turn_likelihood(&p, err, cw, 0.0), 0.2);
         assert_eq!(turn_likelihood(&p, err, cw, 0.5), 1.0);
         assert_eq!(turn_likelihood(&p, err, cw, -PI), 1.0, "-pi wraps to pi");
-        // No detected error, or no turn: no change. T_e itself is an error.
+        // No detected error, or no turn: no change.
         assert_eq!(turn_likelihood(&p, ok, acw, 0.5), 1.0);
-        assert_eq!(turn_likelihood(&p, 0.8, acw, 0.5), 0.2);
         assert_eq!(turn_likelihood(&p, err, 0.0, 0.5), 1.0);
     }
 
@@ -294,10 +298,10 @@ mod tests {
         let left = robot.bearing_to(0.6, 1.8);
         let right = robot.bearing_to(1.8, 0.6);
         assert!(left > 0.0 && right < 0.0);
-        assert_eq!(turn_likelihood(&p, 0.95, 0.02, left), 0.2);
-        assert_eq!(turn_likelihood(&p, 0.95, 0.02, right), 1.0);
-        assert_eq!(turn_likelihood(&p, 0.95, -0.02, left), 1.0);
-        assert_eq!(turn_likelihood(&p, 0.95, -0.02, right), 0.2);
+        assert_eq!(turn_likelihood(&p, true, 0.02, left), 0.2);
+        assert_eq!(turn_likelihood(&p, true, 0.02, right), 1.0);
+        assert_eq!(turn_likelihood(&p, true, -0.02, left), 1.0);
+        assert_eq!(turn_likelihood(&p, true, -0.02, right), 0.2);
     }
 
     #[test]
@@ -306,19 +310,19 @@ mod tests {
         let peak = 1.0 / (20f64.to_radians() * (2.0 * PI).sqrt());
         assert!((p.pdf_peak() - peak).abs() < 1e-12);
         assert!((peak - 1.1429).abs() < 1e-4, "{peak}");
-        assert!((linear_likelihood(&p, 0.1, 0.0) - (1.0 + 0.01 * peak)).abs() < 1e-12);
-        assert!((linear_likelihood(&p, 0.8, 0.0) - (1.0 - 0.7 * peak)).abs() < 1e-12);
-        assert!(linear_likelihood(&p, 0.8, 0.0) > 0.19);
+        assert!((linear_likelihood(&p, false, 0.0) - (1.0 + 0.01 * peak)).abs() < 1e-12);
+        assert!((linear_likelihood(&p, true, 0.0) - (1.0 - 0.7 * peak)).abs() < 1e-12);
+        assert!(linear_likelihood(&p, true, 0.0) > 0.19);
         // Even in the bearing, and flat far from the field of view.
         let b = 0.3;
         assert_eq!(
-            linear_likelihood(&p, 0.9, b),
-            linear_likelihood(&p, 0.9, -b)
+            linear_likelihood(&p, true, b),
+            linear_likelihood(&p, true, -b)
         );
-        assert!((linear_likelihood(&p, 0.9, PI) - 1.0).abs() < 1e-8);
-        assert!((linear_likelihood(&p, 0.1, 2.0) - 1.0).abs() < 1e-5);
+        assert!((linear_likelihood(&p, true, PI) - 1.0).abs() < 1e-8);
+        assert!((linear_likelihood(&p, false, 2.0) - 1.0).abs() < 1e-5);
         // One sigma off the heading: N = peak * e^(-1/2).
-        let one_sigma = linear_likelihood(&p, 0.9, 20f64.to_radians());
+        let one_sigma = linear_likelihood(&p, true, 20f64.to_radians());
         assert!((one_sigma - (1.0 - 0.7 * peak * (-0.5f64).exp())).abs() < 1e-12);
     }
 

@@ -4,6 +4,8 @@
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
+use errp_valid::{Check, Valid};
+
 use crate::belief::Belief;
 use crate::error::{Result, RobotError, check};
 use crate::grid::{Cell, Grid, GridAction};
@@ -64,6 +66,16 @@ impl Default for GridControlParams {
     }
 }
 
+/// Checked where a scenario enters (the reward model of the Q-values
+/// with it); the controller takes it checked.
+impl Check for GridControlParams {
+    type Error = RobotError;
+
+    fn check(&self) -> Result<()> {
+        self.validate()
+    }
+}
+
 impl GridControlParams {
     /// The reward model of the Q-values.
     pub fn q(&self) -> QParams {
@@ -75,7 +87,7 @@ impl GridControlParams {
     }
 
     /// Checks every field; messages name the field and the accepted range.
-    pub fn validate(&self) -> Result<()> {
+    fn validate(&self) -> Result<()> {
         check(
             self.tau.is_finite() && self.tau > 0.0,
             "tau",
@@ -131,7 +143,7 @@ pub fn policy_likelihood(q_hat: f64, p_error: f64) -> f64 {
 /// [`observe`](GridController::observe)).
 #[derive(Debug, Clone)]
 pub struct GridController {
-    params: GridControlParams,
+    params: Valid<GridControlParams>,
     table: QTable,
     /// Eq. (3) at `params.tau`: `softmax[goal_index * n_cells + cell_index]`.
     softmax: Vec<[f64; 5]>,
@@ -147,16 +159,16 @@ pub struct GridController {
 
 impl GridController {
     /// A controller with a uniform belief over every cell of `grid`.
-    pub fn new(grid: Grid, params: GridControlParams) -> Result<Self> {
-        params.validate()?;
-        let table = QTable::compute(grid, &params.q())?;
+    pub fn new(grid: Grid, params: Valid<GridControlParams>) -> Result<Self> {
+        // The control parameters' checks include the reward model's.
+        let table = QTable::compute(grid, &params.part(GridControlParams::q))?;
         Ok(Self::with_table(table, params))
     }
 
     /// A controller reusing precomputed Q-values (they depend only on the
     /// grid and the reward model). Computes the soft-max (eq. 3) of every
     /// goal and cell once.
-    pub fn with_table(table: QTable, params: GridControlParams) -> Self {
+    pub fn with_table(table: QTable, params: Valid<GridControlParams>) -> Self {
         let grid = *table.grid();
         let n = grid.n_cells();
         let mut softmax = Vec::with_capacity(n * n);
@@ -403,7 +415,11 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     fn controller() -> GridController {
-        GridController::new(Grid::paper(), GridControlParams::default()).unwrap()
+        GridController::new(
+            Grid::paper(),
+            Valid::new(GridControlParams::default()).unwrap(),
+        )
+        .unwrap()
     }
 
     #[test]
@@ -453,7 +469,7 @@ mod tests {
                 ..GridControlParams::default()
             },
         ] {
-            let mut c = GridController::new(g, params).unwrap();
+            let mut c = GridController::new(g, Valid::new(params).unwrap()).unwrap();
             for _ in 0..3000 {
                 let cell = g.cell(rng.random_range(0..25));
                 let action = GridAction::ALL[rng.random_range(0..5)];
@@ -618,10 +634,11 @@ mod tests {
         // so it tells nothing; left and right each split them.
         let mut c = GridController::new(
             Grid::paper(),
-            GridControlParams {
+            Valid::new(GridControlParams {
                 epsilon: 0.0,
                 ..info_gain()
-            },
+            })
+            .unwrap(),
         )
         .unwrap();
         let (a, b) = (Cell::new(1, 4), Cell::new(3, 4));
@@ -678,7 +695,7 @@ mod tests {
                 tau,
                 ..GridControlParams::default()
             };
-            let mut c = GridController::new(g, params).unwrap();
+            let mut c = GridController::new(g, Valid::new(params).unwrap()).unwrap();
             let mut rng = ChaCha8Rng::seed_from_u64(21);
             let mut old_rng = rng.clone();
             let mut world = ChaCha8Rng::seed_from_u64(22);
@@ -704,7 +721,7 @@ mod tests {
     fn info_gain_draws_the_same_random_numbers_as_greedy() {
         let g = Grid::paper();
         let mut greedy = controller();
-        let mut info = GridController::new(g, info_gain()).unwrap();
+        let mut info = GridController::new(g, Valid::new(info_gain()).unwrap()).unwrap();
         let mut r1 = ChaCha8Rng::seed_from_u64(5);
         let mut r2 = r1.clone();
         for k in 0..500 {
@@ -718,11 +735,12 @@ mod tests {
     fn thompson(epsilon: f64) -> GridController {
         GridController::new(
             Grid::paper(),
-            GridControlParams {
+            Valid::new(GridControlParams {
                 strategy: Strategy::Thompson,
                 epsilon,
                 ..GridControlParams::default()
-            },
+            })
+            .unwrap(),
         )
         .unwrap()
     }
@@ -825,7 +843,10 @@ mod tests {
         }
         assert_eq!(c.drawn_goal(), Some(b));
         // The other strategies never hold a draw.
-        for mut c in [controller(), GridController::new(g, info_gain()).unwrap()] {
+        for mut c in [
+            controller(),
+            GridController::new(g, Valid::new(info_gain()).unwrap()).unwrap(),
+        ] {
             for k in 0..50 {
                 c.choose(g.cell(k % 25), &mut rng);
                 c.observe(g.cell(k % 25), GridAction::Up, 0.3).unwrap();
@@ -841,10 +862,11 @@ mod tests {
         let g = Grid::paper();
         let mut greedy = GridController::new(
             g,
-            GridControlParams {
+            Valid::new(GridControlParams {
                 epsilon: 1.0,
                 ..GridControlParams::default()
-            },
+            })
+            .unwrap(),
         )
         .unwrap();
         let mut th = thompson(1.0);
@@ -873,7 +895,7 @@ mod tests {
         // a greedy one (no table).
         let g = Grid::paper();
         let mut rng = ChaCha8Rng::seed_from_u64(9);
-        let mut info = GridController::new(g, info_gain()).unwrap();
+        let mut info = GridController::new(g, Valid::new(info_gain()).unwrap()).unwrap();
         let mut greedy = controller();
         let alpha = info.params().assumed_accuracy;
         for _ in 0..300 {

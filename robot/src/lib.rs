@@ -43,6 +43,7 @@ pub use continuous_control::{ContinuousController, Observation, Phase, StepKind,
 pub use continuous_likelihood::{ContinuousControlParams, linear_likelihood, turn_likelihood};
 pub use epuck::{EpuckParams, Twist, WheelSpeeds, integrate};
 pub use error::{Result, RobotError};
+pub use errp_valid::{Check, Valid};
 pub use grid::{Cell, Grid, GridAction};
 pub use grid_control::{GridControlParams, GridController, policy_likelihood};
 pub use layout::{Goal, GoalLayout, LAYOUT_GRID_CELLS};

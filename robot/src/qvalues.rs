@@ -2,7 +2,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Result, check};
+use errp_valid::{Check, Valid};
+
+use crate::error::{Result, RobotError, check};
 use crate::grid::{Cell, Grid, GridAction};
 
 /// The reward model behind Q*_i. The paper says the Q-values come from
@@ -29,9 +31,18 @@ impl Default for QParams {
     }
 }
 
+/// The reward model, checked with the control parameters it is part of.
+impl Check for QParams {
+    type Error = RobotError;
+
+    fn check(&self) -> Result<()> {
+        self.validate()
+    }
+}
+
 impl QParams {
     /// Checks every field.
-    pub fn validate(&self) -> Result<()> {
+    pub(crate) fn validate(&self) -> Result<()> {
         check(
             self.discount.is_finite() && (0.0..1.0).contains(&self.discount),
             "discount",
@@ -69,8 +80,7 @@ impl QTable {
     /// cell as a goal. This is the fixed point Q-learning converges to
     /// (deterministic moves, goal-reached terminal), without its sampling
     /// noise: Q(s, move) = gamma V(s'), Q(s, goal-reached) = reward.
-    pub fn compute(grid: Grid, params: &QParams) -> Result<Self> {
-        params.validate()?;
+    pub fn compute(grid: Grid, params: &Valid<QParams>) -> Result<Self> {
         let n = grid.n_cells();
         let mut values = vec![[0.0; 5]; n * n];
         for goal in 0..n {
@@ -148,7 +158,7 @@ mod tests {
     #[test]
     fn q_values_are_discounted_distances() {
         let g = Grid::paper();
-        let t = QTable::compute(g, &QParams::default()).unwrap();
+        let t = QTable::compute(g, &Valid::default()).unwrap();
         let goal = Cell::new(2, 2);
         // From (0, 2), distance 2: moving right leads to distance 1, whose
         // value is gamma^1, so Q = gamma^2; moving left bumps the border.
@@ -166,7 +176,7 @@ mod tests {
     #[test]
     fn greedy_actions_are_always_judged_correct() {
         let g = Grid::paper();
-        let t = QTable::compute(g, &QParams::default()).unwrap();
+        let t = QTable::compute(g, &Valid::default()).unwrap();
         for goal in g.cells() {
             for cell in g.cells() {
                 assert!(

@@ -23,7 +23,7 @@ static SETUP: LazyLock<(EpuckScenario, ContinuousDecoder)> = LazyLock::new(|| {
     );
     let mut s = EpuckScenario::load(path).unwrap();
     // Exactly 60 s every time: no convergence, no early end.
-    s.params.control.p_c = 0.999_999;
+    s.params.control = s.params.control.with(|c| c.p_c = 0.999_999).unwrap();
     s.params.max_secs = 60.0;
     let (d, _) = prepare_continuous_decoder(&s, |_| {}).unwrap();
     (s, d)
@@ -36,8 +36,6 @@ fn sixty_simulated_seconds(bencher: Bencher) {
     let mut seed = 0u64;
     bencher.bench_local(|| {
         seed += 1;
-        black_box(
-            run_epuck_episode(&s.params, &s.arena, &s.layout, s.episode, d, seed, &mut ()).unwrap(),
-        )
+        black_box(run_epuck_episode(s, d, seed, &mut ()).unwrap())
     });
 }

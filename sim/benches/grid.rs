@@ -4,7 +4,7 @@
 use std::sync::LazyLock;
 
 use divan::{Bencher, black_box};
-use errp_robot::{Grid, QTable};
+use errp_robot::{Grid, GridControlParams, QTable};
 use errp_sim::grid::{
     AssessmentDecoder, EpochBank, FIXED_PAIRS, GridTaskParams, eeg_decoder, run_grid_episode,
 };
@@ -17,7 +17,7 @@ static EEG: LazyLock<AssessmentDecoder> = LazyLock::new(|| eeg_decoder(0.7438, 1
 
 fn episodes(bencher: Bencher, decoder: &AssessmentDecoder) {
     let params = GridTaskParams::default();
-    let table = QTable::compute(Grid::paper(), &params.control.q()).unwrap();
+    let table = QTable::compute(Grid::paper(), &params.control.part(GridControlParams::q)).unwrap();
     let mut k = 0u64;
     bencher.bench_local(|| {
         let (start, goal) = FIXED_PAIRS[(k % 5) as usize];

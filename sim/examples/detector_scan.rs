@@ -7,8 +7,8 @@
 //! (defaults 0.95 and 1; 30 minutes of held-out EEG).
 
 use errp_bci::{
-    Detector, DetectorMode, DetectorParams, OnlineRecordingParams, detector_span, operating_point,
-    record_online,
+    Detector, DetectorMode, DetectorParams, OnlineRecordingParams, Valid, detector_span,
+    operating_point, record_online,
 };
 use errp_sim::epuck::{ContinuousDecoder, ContinuousRequest, run_continuous_calibration};
 
@@ -36,11 +36,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("t_e  windows  span (s)    hit rate  false alarms/min  median latency (s)");
     for t_e in [0.5, 0.6, 0.7, 0.8, 0.9] {
         for n in [1usize, 2, 3, 4, 6, 8] {
-            let p = DetectorParams {
+            let p = Valid::new(DetectorParams {
                 mode: DetectorMode::Smoothed,
                 smooth_windows: n,
                 ..DetectorParams::default()
-            };
+            })?;
             let span = detector_span(&rec, p, t_e)?;
             let op = operating_point(&rec, Detector::new(p, t_e)?, span);
             println!(

@@ -11,7 +11,7 @@
 //! `cargo run --release -p errp_sim --example grid_sensitivity` (about a
 //! minute).
 
-use errp_robot::{Grid, QTable};
+use errp_robot::{Grid, GridControlParams, QTable};
 use errp_sim::grid::{
     AssessmentDecoder, EegDecoder, FIXED_PAIRS, GridScenario, GridTaskParams, PErrorChoice,
     prepare_decoder, run_grid_episode,
@@ -116,12 +116,18 @@ fn main() {
                 None => AssessmentDecoder::Oracle { accuracy },
             };
             let mut params = GridTaskParams::default();
-            params.control.epsilon = v.epsilon;
-            params.control.discount = v.discount;
-            if let Some(reward) = v.reward {
-                params.control.goal_reward = reward;
-            }
-            let table = QTable::compute(Grid::paper(), &params.control.q()).expect("Q-values");
+            params.control = params
+                .control
+                .with(|c| {
+                    c.epsilon = v.epsilon;
+                    c.discount = v.discount;
+                    if let Some(reward) = v.reward {
+                        c.goal_reward = reward;
+                    }
+                })
+                .expect("the variants are valid");
+            let table = QTable::compute(Grid::paper(), &params.control.part(GridControlParams::q))
+                .expect("Q-values");
             let mut reached = 0;
             let mut actions = Vec::new();
             for k in 0..100 {

@@ -48,3 +48,14 @@ pub enum SimError {
 
 /// Shorthand for results in this crate.
 pub type Result<T, E = SimError> = std::result::Result<T, E>;
+
+/// Checks a p(error) that a decoder of the user's own returned.
+pub fn check_p_error(p: f64) -> Result<f64> {
+    if p.is_finite() && (0.0..=1.0).contains(&p) {
+        Ok(p)
+    } else {
+        Err(SimError::Scenario(format!(
+            "decoder: returned p(error) = {p}, expected a number from 0 to 1"
+        )))
+    }
+}

@@ -29,6 +29,7 @@ pub mod grid;
 pub mod host;
 #[cfg(feature = "rerun")]
 pub mod inspect;
+mod key;
 mod output;
 mod paper;
 #[cfg(feature = "rerun")]
@@ -40,16 +41,17 @@ mod snapshot;
 mod stats;
 pub mod task;
 
-pub use error::{Result, SimError};
+pub use error::{Result, SimError, check_p_error};
 pub use files::{append_regular, is_foreign, open_regular, open_regular_with, write_regular};
+pub use key::StableKey;
 pub use output::{
     CreatedDirs, PendingFile, create_dir, create_dirs, forget_if_interrupted,
     remove_if_interrupted, remove_unfinished, write_atomic,
 };
 pub use paper::{PAPER, PAPER_EPUCK, PAPER_POOLED};
 pub use scenario::{
-    AnyScenario, is_epuck, load_scenario, load_scenario_with, parse_scenario, parse_scenario_table,
-    parse_scenario_with, scenario_text_with,
+    AnyScenario, apply_overrides, is_epuck, load_scenario, load_scenario_with, parse_scenario,
+    parse_scenario_table, parse_scenario_with, scenario_text_with,
 };
 pub use scenario_file::{
     MAX_KEY_PARTS, MAX_SCENARIO_BYTES, parse_toml, read_scenario, set_key, table_into, truncate,

@@ -4,6 +4,9 @@
 use std::path::Path;
 
 pub mod data;
+pub mod paths;
+
+pub use paths::eeg_channel;
 
 use rerun::{RecordingStream, RecordingStreamBuilder, blueprint::Blueprint};
 
@@ -16,27 +19,6 @@ pub const SIM_TIME: &str = "sim_time";
 /// The timeline of calibration recordings: time after the action (s), on
 /// which grand averages are drawn.
 pub const LATENCY_TIMELINE: &str = "latency";
-
-/// Entity paths that the task recordings share, so that views, loggers and
-/// readers (tests/python) agree; each view keeps its own task's paths beside
-/// its blueprint.
-pub mod paths {
-    /// The decoder's output and threshold, under one time-series view.
-    pub const DECODER: &str = "/decoder";
-    /// p(error) of each decision.
-    pub const P_ERROR: &str = "/decoder/p_error";
-    /// The decision threshold (0.5, or T_e).
-    pub const THRESHOLD: &str = "/decoder/threshold";
-    /// A few preprocessed EEG channels, each at `/eeg/NAME`.
-    pub const EEG: &str = "/eeg";
-    /// The text log of events.
-    pub const LOG: &str = "/log";
-}
-
-/// The entity path of preprocessed EEG channel `name` (e.g. "FCz").
-pub fn eeg_channel(name: &str) -> String {
-    format!("/eeg/{name}")
-}
 
 /// The layout of a task recording: the scene above the event log on the
 /// left, `panels` stacked on the right.

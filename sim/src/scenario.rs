@@ -19,6 +19,18 @@ pub enum AnyScenario {
     Epuck(Box<EpuckScenario>),
 }
 
+impl AnyScenario {
+    /// The scenario, if it is an `S` (a task's
+    /// [`Task::Scenario`](crate::task::Task::Scenario)).
+    pub fn get<S: 'static>(&self) -> Option<&S> {
+        let any: &dyn std::any::Any = match self {
+            AnyScenario::Grid(s) => &**s,
+            AnyScenario::Epuck(s) => &**s,
+        };
+        any.downcast_ref()
+    }
+}
+
 /// Reads a scenario file and validates it according to its `task` field.
 pub fn load_scenario(path: impl AsRef<Path>) -> Result<AnyScenario> {
     let path = path.as_ref();
@@ -26,25 +38,22 @@ pub fn load_scenario(path: impl AsRef<Path>) -> Result<AnyScenario> {
 }
 
 /// Reads a scenario file, sets `overrides` (dotted keys, as the file spells
-/// them: `user.accuracy`, `decoder`, ...) in its TOML, and validates the
-/// result: command-line overrides are parsed and checked exactly as if the
-/// file said them, so nothing derived from a value (the accuracy the device
-/// assumes, say) can be left behind. Setting `user.accuracy` drops the
-/// file's other ways of giving the decoder (`subject`, `goals`, `hit_rate`,
-/// `false_alarms_per_min`).
+/// them: `user.accuracy`, `seed`, `runs`, `decoder`, ...) in its text as
+/// [`apply_overrides`] does, and validates the result: overrides are parsed
+/// and checked exactly as if the file said them, so nothing derived from a
+/// value (the accuracy the device assumes, the free goals drawn from the
+/// seed) can be left behind.
 pub fn load_scenario_with(
     path: impl AsRef<Path>,
     overrides: &[(&str, toml::Value)],
 ) -> Result<AnyScenario> {
     let path = path.as_ref();
-    if overrides.is_empty() {
-        return load_scenario(path);
-    }
     parse_scenario_with(&read_scenario(path)?, path, overrides)
 }
 
 /// [`load_scenario_with`] for a scenario's text (`path` names it in
-/// errors).
+/// errors). With overrides, an error names the file and the field but no
+/// line: the text read is not the file as written.
 pub fn parse_scenario_with(
     text: &str,
     path: &Path,
@@ -53,12 +62,13 @@ pub fn parse_scenario_with(
     if overrides.is_empty() {
         return parse_scenario(text, path);
     }
-    parse_scenario_table(&overridden(text, path, overrides)?, path)
+    let table: toml::Table = parse_toml(&scenario_text_with(text, path, overrides)?, path)?;
+    parse_scenario_table(&table, path)
 }
 
-/// A scenario's text as run: `text` with `overrides` set as
-/// [`parse_scenario_with`] sets them (the text itself when there are none),
-/// for recordings that say how they were made.
+/// A scenario's text as run: `text` with `overrides` set by
+/// [`apply_overrides`] (the text itself when there are none), for
+/// recordings that say how they were made.
 pub fn scenario_text_with(
     text: &str,
     path: &Path,
@@ -67,25 +77,70 @@ pub fn scenario_text_with(
     if overrides.is_empty() {
         return Ok(text.to_string());
     }
-    toml::to_string(&overridden(text, path, overrides)?)
+    apply_overrides(text, overrides)
         .map_err(|e| SimError::Scenario(format!("{}: {e}", path.display())))
 }
 
-/// The TOML table of `text` with `overrides` set.
-fn overridden(text: &str, path: &Path, overrides: &[(&str, toml::Value)]) -> Result<toml::Table> {
-    let mut table: toml::Table = parse_toml(text, path)?;
+/// Sets `overrides` in a scenario's TOML `text`, in order, and returns the
+/// text with its comments and layout kept: the one place where a value from
+/// outside the file (`errp run`'s flags, the Python package's keywords, a
+/// sweep's level) enters a scenario, before anything is derived from it.
+/// Two keys take with them what they replace: `user.accuracy` drops the
+/// file's other ways of giving the decoder (`[user]` `subject`, `goals`,
+/// `hit_rate`, `false_alarms_per_min`), and `seed` drops `[user] seed`, so
+/// that a new seed is a new simulated user with new runs and new free
+/// goals. The error names the key.
+pub fn apply_overrides(
+    text: &str,
+    overrides: &[(&str, toml::Value)],
+) -> std::result::Result<String, String> {
+    let mut doc: toml_edit::DocumentMut = text
+        .parse()
+        .map_err(|e: toml_edit::TomlError| format!("not valid TOML: {}", e.message()))?;
     for (key, value) in overrides {
-        if *key == "user.accuracy"
-            && let Some(user) = table.get_mut("user").and_then(toml::Value::as_table_mut)
-        {
-            for other in ["subject", "goals", "hit_rate", "false_alarms_per_min"] {
+        let replaced: &[&str] = match *key {
+            "user.accuracy" => &["subject", "goals", "hit_rate", "false_alarms_per_min"],
+            "seed" => &["seed"],
+            _ => &[],
+        };
+        if let Some(user) = doc.get_mut("user").and_then(|u| u.as_table_like_mut()) {
+            for other in replaced {
                 user.remove(other);
             }
         }
-        set_key(&mut table, key, value.clone())
-            .map_err(|e| SimError::Scenario(format!("{}: {key}: {e}", path.display())))?;
+        set_edit_key(&mut doc, key, value).map_err(|e| format!("{key}: {e}"))?;
     }
-    Ok(table)
+    Ok(doc.to_string())
+}
+
+/// Sets dotted `key` to `value` in `doc`, creating the tables on the way,
+/// with the rules of [`crate::set_key`].
+fn set_edit_key(
+    doc: &mut toml_edit::DocumentMut,
+    key: &str,
+    value: &toml::Value,
+) -> std::result::Result<(), String> {
+    // The checks and the error of the plain table's setter.
+    set_key(&mut toml::Table::new(), key, value.clone())?;
+    let item: toml_edit::Value = value
+        .to_string()
+        .parse()
+        .map_err(|_| format!("{value} cannot be written in a scenario"))?;
+    let parts: Vec<&str> = key.split('.').collect();
+    let (last, tables) = parts
+        .split_last()
+        .ok_or_else(|| format!("`{key}` is empty"))?;
+    let mut t: &mut dyn toml_edit::TableLike = doc.as_table_mut();
+    for part in tables {
+        let entry = t
+            .entry(part)
+            .or_insert(toml_edit::Item::Table(toml_edit::Table::new()));
+        t = entry
+            .as_table_like_mut()
+            .ok_or_else(|| format!("`{part}` in `{key}` is not a table in the scenario"))?;
+    }
+    t.insert(last, toml_edit::Item::Value(item));
+    Ok(())
 }
 
 /// Validates a scenario of either task given as a TOML table (a file's with

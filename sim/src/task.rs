@@ -2,8 +2,7 @@
 //! types, the one way to prepare a decoder, one episode as a CSV row, and
 //! the columns and labels that describe its results.
 //!
-//! [`GridTask`](crate::grid::GridTask) and
-//! [`EpuckTask`](crate::epuck::EpuckTask) implement it; `errp sweep` is
+//! The grid's `GridTask` and the e-puck's `EpuckTask` implement it; `errp sweep` is
 //! written once over it, so a sweep prepares decoders on the path `errp run`
 //! takes and a new task needs no change to the sweep.
 
@@ -15,7 +14,6 @@ use errp_bci::Accuracy;
 
 use crate::calibration::TargetingCache;
 use crate::error::Result;
-use crate::scenario::AnyScenario;
 
 /// The fixed facts of a task: its name, the columns of its episode rows and
 /// what its summaries call things.
@@ -233,7 +231,7 @@ pub trait Task: 'static {
     /// Its fixed facts.
     const INFO: TaskInfo;
     /// A validated scenario of the task.
-    type Scenario: Send + Sync;
+    type Scenario: Send + Sync + 'static;
     /// What the decoders of several scenarios share (simulated once).
     type Shared: Sync;
     /// A prepared decoder, shared by the levels with equal
@@ -241,9 +239,6 @@ pub trait Task: 'static {
     type Decoder: Send + Sync;
     /// One level, ready to run episodes.
     type Runner: Send + Sync;
-
-    /// The task's scenario, if `any` is one.
-    fn scenario(any: &AnyScenario) -> Option<&Self::Scenario>;
 
     /// What the scenario's decoder depends on: scenarios with equal keys
     /// share one decoder.

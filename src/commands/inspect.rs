@@ -167,7 +167,7 @@ fn describe(r: &Recording) -> Result<()> {
             let summary = summarise(results);
             let t_e = r
                 .tables
-                .get(errp_sim::record::data::RUNS)
+                .get(errp_sim::record::paths::RUNS)
                 .and_then(|t| match t.column("t_e") {
                     Some(errp_sim::record::data::Column::F64(v)) => v.first().copied(),
                     _ => None,
@@ -498,7 +498,7 @@ fn draw(rec: &Recording, highlight: usize, kind: FigureKind) -> Result<Vec<u8>> 
     };
     let bytes = match &rec.runs {
         Runs::Epuck { scenario, results } => {
-            let frames = rec.tables.get(errp_sim::record::data::FRAMES);
+            let frames = rec.tables.get(errp_sim::record::paths::FRAMES);
             let col = |name: &str| match frames.and_then(|t| t.column(name)) {
                 Some(errp_sim::record::data::Column::F64(v)) => v.as_slice(),
                 _ => &[],

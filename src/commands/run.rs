@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
-use errp_bci::OnlineStep;
+use errp_bci::{OnlineStep, RequestedAccuracy};
 #[cfg(feature = "rerun")]
 use errp_sim::epuck::record_epuck_runs;
 use errp_sim::epuck::{
@@ -36,11 +36,17 @@ pub(crate) fn run(args: &RunArgs) -> Result<()> {
     if let Some(a) = args.accuracy {
         overrides.push(("user.accuracy", toml::Value::Float(a)));
     }
+    // A seed of the file's range (parse_scenario_seed), so a recording's
+    // scenario says it.
+    if let Some(seed) = args.seed {
+        overrides.push(("seed", toml::Value::Integer(seed as i64)));
+    }
     // The file as written is checked first, so that its own errors quote
     // its own lines; the overrides are then set in a copy of its TOML.
     let as_written = load_scenario(&args.scenario)?;
     let epuck = matches!(as_written, AnyScenario::Epuck(_));
-    if args.accuracy == Some(1.0) {
+    let perfect = args.accuracy.map(RequestedAccuracy::new);
+    if let Some(Ok(RequestedAccuracy::Perfect)) = perfect {
         let oracle = match (&as_written, args.decoder) {
             (AnyScenario::Grid(_), Some(d)) => matches!(d, DecoderArg::Oracle),
             (AnyScenario::Grid(s), None) => s.decoder == DecoderChoice::Oracle,
@@ -53,6 +59,9 @@ pub(crate) fn run(args: &RunArgs) -> Result<()> {
                  e.g. 0.95"
             );
         }
+    }
+    if epuck && let Some(runs) = args.runs {
+        overrides.push(("runs", toml::Value::Integer(runs as i64)));
     }
     if !epuck {
         if let Some(d) = args.decoder {
@@ -82,7 +91,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<()> {
         None => String::new(),
     };
     if let (AnyScenario::Epuck(s), Some(_)) = (&scenario, &args.save) {
-        let runs = args.runs.map_or(s.runs, |r| r as usize);
+        let runs = s.runs;
         if runs > MAX_RECORDED_RUNS {
             bail!(
                 "--save with {runs} runs: a recording holds at most {MAX_RECORDED_RUNS} runs \
@@ -144,9 +153,6 @@ fn provenance(
 }
 
 pub(crate) fn run_grid(args: &RunArgs, mut scenario: GridScenario, text: String) -> Result<()> {
-    if let Some(seed) = args.seed {
-        scenario.seed = seed;
-    }
     if args.accuracy.is_some() {
         scenario.user.push_str(" (--accuracy)");
     }
@@ -213,13 +219,7 @@ pub(crate) fn run_grid(args: &RunArgs, mut scenario: GridScenario, text: String)
     Ok(())
 }
 
-pub(crate) fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario, text: String) -> Result<()> {
-    if let Some(seed) = args.seed {
-        scenario.reseed(seed);
-    }
-    if let Some(runs) = args.runs {
-        scenario.runs = runs as usize;
-    }
+pub(crate) fn run_epuck(args: &RunArgs, scenario: EpuckScenario, text: String) -> Result<()> {
     #[cfg(feature = "rerun")]
     let rrd = open_recording(args, errp_sim::epuck::epuck_recording)?;
     let quiet = args.quiet;
@@ -309,7 +309,7 @@ pub(crate) fn run_epuck(args: &RunArgs, mut scenario: EpuckScenario, text: Strin
             summary: &summary,
             scenario: &scenario.name,
             goal,
-            t_e: decoder.t_e(scenario.params.control.t_e),
+            t_e: decoder.detector_t_e(&scenario.params, false),
         }
     )?;
     #[cfg(feature = "rerun")]

@@ -79,7 +79,7 @@ mod tests {
     }
 
     fn key(level: &Level) -> String {
-        EpuckTask::decoder_key(EpuckTask::scenario(&level.scenario).unwrap())
+        EpuckTask::decoder_key(level.scenario.get().unwrap())
     }
 
     #[test]

@@ -104,7 +104,7 @@ impl<'a, T: Task> RowCheck<'a, T> {
         let scenarios = levels
             .iter()
             .map(|l| {
-                T::scenario(&l.scenario).ok_or_else(|| {
+                l.scenario.get::<T::Scenario>().ok_or_else(|| {
                     SimError::Sweep(format!(
                         "{} is not a {} scenario",
                         spec.scenario_path.display(),

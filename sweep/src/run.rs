@@ -195,7 +195,7 @@ impl<'a, T: Task> Plan<'a, T> {
         let scenarios: Vec<&T::Scenario> = levels
             .iter()
             .map(|level| {
-                T::scenario(&level.scenario).ok_or_else(|| {
+                level.scenario.get::<T::Scenario>().ok_or_else(|| {
                     SimError::Sweep(format!(
                         "the sweep is of the {} task, but {} is not a scenario of it",
                         T::INFO.name,

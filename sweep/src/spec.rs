@@ -11,14 +11,14 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 use toml::{Table, Value};
 
-use errp_bci::MeanAccuracy;
+use errp_bci::RequestedAccuracy;
 use errp_sim::epuck::EpuckTask;
 use errp_sim::grid::GridTask;
 pub use errp_sim::task::format_number;
 use errp_sim::task::{Task, TaskInfo};
-use errp_sim::{AnyScenario, is_epuck, parse_scenario_table};
+use errp_sim::{AnyScenario, is_epuck, parse_scenario_with};
 use errp_sim::{Result, SimError};
-use errp_sim::{parse_toml, read_scenario, set_key};
+use errp_sim::{parse_toml, read_scenario};
 
 /// The two tasks a sweep can run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -263,7 +263,7 @@ pub fn parse_accuracies(text: &str) -> Result<Vec<f64>> {
             }
         };
         // 1 is for the oracle; a grid EEG or e-puck scenario refuses it.
-        if !(a == 1.0 || MeanAccuracy::new(a).is_ok()) {
+        if RequestedAccuracy::new(a).is_err() {
             return Err(SimError::Sweep(format!(
                 "--accuracy {text:?} is invalid: {a} is not a mean accuracy in (0.5, 1) \
                  (e.g. 0.55:0.95:0.05)"
@@ -581,11 +581,11 @@ impl SweepSpec {
     /// is reported with the level and the scenario's own field error.
     pub fn levels(&self) -> Result<Vec<Level>> {
         self.check()?;
-        let base: Table = parse_toml(&self.scenario_toml, &self.scenario_path)?;
+        // The file's own errors quote its lines.
+        let _: Table = parse_toml(&self.scenario_toml, &self.scenario_path)?;
         (0..self.n_levels())
             .map(|index| {
                 let (accuracy, values) = self.level_values(index);
-                let mut t = base.clone();
                 let context = |why: String| {
                     let mut label = format!("accuracy={}", format_number(accuracy));
                     if !self.axes.is_empty() {
@@ -593,15 +593,9 @@ impl SweepSpec {
                     }
                     SimError::Sweep(format!("sweep level {label}: {why}"))
                 };
-                if let Some(user) = t.get_mut("user").and_then(Value::as_table_mut) {
-                    user.remove("subject");
-                    user.remove("goals");
-                    // The level's accuracy replaces an online target.
-                    user.remove("hit_rate");
-                    user.remove("false_alarms_per_min");
-                    // The sweep's seed gives the user (the calibration).
-                    user.remove("seed");
-                }
+                // The level's accuracy replaces the file's decoder (an online
+                // target included); the sweep's seed gives the user (the
+                // calibration).
                 let mut sets: Vec<(&str, Value)> = vec![
                     ("user.accuracy", Value::Float(accuracy)),
                     ("seed", Value::Integer(self.calibration_seed() as i64)),
@@ -612,10 +606,7 @@ impl SweepSpec {
                 for (a, v) in self.axes.iter().zip(&values) {
                     sets.push((&a.key, v.clone()));
                 }
-                for (k, v) in sets {
-                    set_key(&mut t, k, v).map_err(context)?;
-                }
-                let scenario = parse_scenario_table(&t, &self.scenario_path)
+                let scenario = parse_scenario_with(&self.scenario_toml, &self.scenario_path, &sets)
                     .map_err(|e| context(e.to_string()))?;
                 Ok(Level {
                     index,

@@ -122,6 +122,55 @@ fn subjects_lists_table1() {
     );
 }
 
+/// `--seed N` is the file saying `seed = N`: the grid's free goals, drawn
+/// from the seed when the scenario is read, are drawn again (they were not:
+/// `--seed` was set after the goals were drawn from the file's seed).
+#[test]
+fn a_seed_override_draws_the_free_goals_again() {
+    let free = "scenarios/grid_free_goals.toml";
+    let pairs = |scenario: &str, seed: Option<&str>| {
+        let mut args = vec!["run", scenario, "--decoder", "oracle", "--quiet"];
+        if let Some(seed) = seed {
+            args.extend(["--seed", seed]);
+        }
+        let o = errp(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let out = String::from_utf8_lossy(&o.stdout).into_owned();
+        // "  1  (0, 1) (3, 3) ...": the start and the goal of each episode.
+        let rows: Vec<String> = out
+            .lines()
+            .filter(|l| l.trim_start().starts_with(|c: char| c.is_ascii_digit()))
+            .map(|l| {
+                l.split_whitespace()
+                    .skip(1)
+                    .take(4)
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            })
+            .collect();
+        assert_eq!(rows.len(), 5, "{out}");
+        rows
+    };
+    let by_flag = pairs(free, Some("1"));
+    assert_ne!(by_flag, pairs(free, Some("3")), "another seed, other goals");
+    assert_eq!(
+        pairs(free, Some("2")),
+        pairs(free, None),
+        "the file's seed is 2"
+    );
+    let dir = temp_dir("seed-override");
+    let copy = dir.join("free.toml");
+    let text = std::fs::read_to_string(free).unwrap();
+    std::fs::write(&copy, text.replace("seed = 2", "seed = 1")).unwrap();
+    assert_eq!(by_flag, pairs(copy.to_str().unwrap(), None));
+    let e = refused(&["run", free, "--seed", "9223372036854775808"]);
+    assert!(
+        e.contains("--seed") && e.contains("9223372036854775807"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn every_shipped_grid_scenario_loads_and_runs_with_the_oracle() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");

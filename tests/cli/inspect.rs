@@ -68,11 +68,23 @@ fn epuck_runs_recomputed_from_the_recording_are_what_run_printed() {
     assert!(inspected.contains("30 run(s), seed 5"), "{inspected}");
     assert!(inspected.contains("--seed 5 --runs 30"), "{inspected}");
 
-    // The scenario as run loads, and is the file's text.
+    // The scenario as run is the file's text, comments and all, with the
+    // overrides set: the seed and the runs changed, and the file's `[user]
+    // seed` gone with `--seed` (a new simulated user).
     let s = errp(&["inspect", rrd_s, "--scenario"]);
     assert!(s.status.success());
     let text = std::fs::read_to_string("scenarios/mexico_to_pisa.toml").unwrap();
-    assert_eq!(stdout(&s), text);
+    let as_run = stdout(&s);
+    let changed: Vec<&str> = as_run
+        .lines()
+        .filter(|l| !text.lines().any(|f| f == *l))
+        .collect();
+    assert_eq!(changed, ["seed = 5", "runs = 30"], "{as_run}");
+    assert!(
+        as_run.starts_with("# The paper's first e-puck run"),
+        "{as_run}"
+    );
+    assert!(!as_run.contains("shared with lisbon_to_tokyo"), "{as_run}");
 
     // Tables and the figure.
     let csv = dir.join("tables");

@@ -173,6 +173,29 @@ impl Protocol for CalibrationParams {
     }
 }
 
+/// How closely and how hard to search for an ErrP-to-noise ratio (for an
+/// accuracy, or for an online hit rate).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct TargetingParams {
+    /// Stop once the cross-validated mean accuracy is this close (fraction).
+    pub tolerance: f64,
+    /// Most decoder evaluations (each a full cross-validation).
+    pub max_evaluations: usize,
+    /// Largest ratio tried.
+    pub max_ratio: f64,
+}
+
+impl Default for TargetingParams {
+    fn default() -> Self {
+        Self {
+            tolerance: 0.005,
+            max_evaluations: 16,
+            max_ratio: 8.0,
+        }
+    }
+}
+
 /// Everything that defines a simulated user and recording: the EEG model,
 /// the calibration protocol `P`, the preprocessing and the montage.
 #[derive(Debug, Clone, PartialEq)]

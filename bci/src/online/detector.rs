@@ -7,7 +7,9 @@ use std::collections::VecDeque;
 use serde::{Deserialize, Serialize};
 
 use super::WINDOW_STEP_SECS;
-use crate::error::{Result, check};
+use errp_valid::{Check, Valid};
+
+use crate::error::{BciError, Result, check};
 
 /// How window outputs become detected errors.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -55,18 +57,31 @@ impl Default for DetectorParams {
     }
 }
 
+/// Checked where a scenario enters; the detector takes it checked.
+impl Check for DetectorParams {
+    type Error = BciError;
+
+    fn check(&self) -> Result<()> {
+        self.validate()
+    }
+}
+
 impl DetectorParams {
     /// The paper's literal reading: each window against T_e.
-    pub fn literal() -> Self {
-        Self {
+    pub fn literal() -> Valid<Self> {
+        let literal = Self {
             mode: DetectorMode::Literal,
             smooth_windows: 1,
             refractory_secs: 0.0,
+        };
+        match Valid::new(literal) {
+            Ok(v) => v,
+            Err(e) => unreachable!("the literal reading is within the rules: {e}"),
         }
     }
 
     /// Checks every field; names them as the scenario's `[detector]` does.
-    pub fn validate(&self) -> Result<()> {
+    fn validate(&self) -> Result<()> {
         check(
             (1..=16).contains(&self.smooth_windows),
             "smooth_windows",
@@ -105,7 +120,7 @@ pub struct Decision {
 /// Turns the stream of window p(error) into detected errors.
 #[derive(Debug, Clone)]
 pub struct Detector {
-    params: DetectorParams,
+    params: Valid<DetectorParams>,
     t_e: f64,
     recent: VecDeque<f64>,
     last_detection_secs: f64,
@@ -113,8 +128,7 @@ pub struct Detector {
 
 impl Detector {
     /// A detector with threshold `t_e` (in (0, 1]).
-    pub fn new(params: DetectorParams, t_e: f64) -> Result<Self> {
-        params.validate()?;
+    pub fn new(params: Valid<DetectorParams>, t_e: f64) -> Result<Self> {
         check(
             t_e.is_finite() && t_e > 0.0 && t_e <= 1.0,
             "t_e",

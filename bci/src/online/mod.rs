@@ -143,6 +143,7 @@ mod tests {
 
     use super::*;
     use crate::rng::stream;
+    use errp_valid::{Check, Valid};
 
     #[test]
     fn the_literal_detector_fires_on_every_window_at_t_e() {
@@ -162,7 +163,7 @@ mod tests {
             smooth_windows: 3,
             refractory_secs: 0.5,
         };
-        let mut d = Detector::new(params, 0.8).unwrap();
+        let mut d = Detector::new(Valid::new(params).unwrap(), 0.8).unwrap();
         // One window at 1.0 among lows never reaches a mean of 0.8.
         let mut fired = Vec::new();
         let ps = [
@@ -185,11 +186,11 @@ mod tests {
             smooth_windows: 0,
             ..DetectorParams::default()
         }
-        .validate()
+        .check()
         .unwrap_err()
         .to_string();
         assert!(e.contains("smooth_windows") && e.contains("1 to 16"), "{e}");
-        let e = Detector::new(DetectorParams::default(), 1.5)
+        let e = Detector::new(Valid::default(), 1.5)
             .unwrap_err()
             .to_string();
         assert!(e.contains("t_e"), "{e}");
@@ -312,7 +313,7 @@ mod tests {
         for (detector, late) in [
             (DetectorParams::literal(), 1.0),
             (
-                DetectorParams::default(),
+                Valid::default(),
                 1.0 + DetectorParams::default().delay_secs(),
             ),
         ] {

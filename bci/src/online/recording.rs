@@ -4,6 +4,8 @@
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
+use errp_valid::Valid;
+
 use super::detector::{Detector, DetectorParams};
 use super::{SlidingWindow, WINDOW_STEP_SECS};
 use crate::continuous::ContinuousFeatures;
@@ -265,7 +267,7 @@ pub fn response_span(recording: &OnlineRecording, fired: &[bool]) -> ResponseSpa
 /// at any one lag to be told from chance lag by lag.
 pub fn detector_span(
     recording: &OnlineRecording,
-    detector: DetectorParams,
+    detector: Valid<DetectorParams>,
     t_e: f64,
 ) -> Result<ResponseSpan> {
     let windows = firings(recording, Detector::new(DetectorParams::literal(), t_e)?);

@@ -3,8 +3,11 @@
 
 use serde::{Deserialize, Serialize};
 
+use errp_valid::Valid;
+
 use super::detector::{Detector, DetectorParams};
 use super::recording::{OnlineRecording, OperatingPoint, detector_span, operating_point};
+use crate::calibration::TargetingParams;
 use crate::error::{Result, check};
 
 /// An online operating point to calibrate for, instead of a cross-validated
@@ -73,7 +76,7 @@ pub struct OnlineTargeting {
 /// operating point there, scored over the span measured at that T_e.
 pub fn threshold_for_false_alarms(
     recording: &OnlineRecording,
-    detector: DetectorParams,
+    detector: Valid<DetectorParams>,
     false_alarms_per_min: f64,
 ) -> Result<(f64, OperatingPoint)> {
     let at = |t_e: f64| -> Result<OperatingPoint> {
@@ -107,26 +110,23 @@ pub fn threshold_for_false_alarms(
 /// at which the detector's operating point on the held-out recording meets
 /// `target`. `evaluate(ratio)` calibrates the decoder at that ratio and
 /// returns its held-out recording; the hit rate rises with the ratio, so the
-/// search brackets it by doubling from 0.25 (up to `max_ratio`) and then
-/// bisects until the hit rate is within `tolerance` or `max_evaluations`
-/// are spent. Returns the closest evaluation.
+/// search brackets it by doubling from 0.25 (up to `search.max_ratio`) and
+/// then bisects until the hit rate is within `search.tolerance` (of a hit
+/// rate) or `search.max_evaluations` are spent. Returns the closest
+/// evaluation.
 /// Errors of `evaluate` pass through (any error type a [`BciError`]
 /// converts into).
 ///
 /// [`BciError`]: crate::BciError
-#[allow(clippy::too_many_arguments)]
 pub fn target_online<E: From<crate::error::BciError>>(
     target: OnlineTarget,
-    detector: DetectorParams,
+    detector: Valid<DetectorParams>,
     t_e: f64,
-    max_ratio: f64,
-    tolerance: f64,
-    max_evaluations: usize,
+    search: &TargetingParams,
     mut evaluate: impl FnMut(f64) -> std::result::Result<OnlineRecording, E>,
     mut progress: impl FnMut(&OnlineStep),
 ) -> std::result::Result<OnlineTargeting, E> {
     target.validate()?;
-    detector.validate()?;
     let mut steps: Vec<OnlineStep> = Vec::new();
     let mut eval = |ratio: f64, steps: &mut Vec<OnlineStep>| -> std::result::Result<f64, E> {
         let recording = evaluate(ratio)?;
@@ -149,6 +149,8 @@ pub fn target_online<E: From<crate::error::BciError>>(
         steps.push(step);
         Ok(point.hit_rate)
     };
+    let (max_ratio, tolerance, max_evaluations) =
+        (search.max_ratio, search.tolerance, search.max_evaluations);
     let close = |h: f64| (h - target.hit_rate).abs() <= tolerance;
     let (mut lo, mut hi) = (0.0, 0.25);
     let mut hit = eval(hi, &mut steps)?;

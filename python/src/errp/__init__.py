@@ -469,15 +469,17 @@ def sweep(
     try:
         d = _core.sweep(
             target,
-            accuracy=acc,
-            task=task,
-            scenario=_path(scenario),
-            episodes=episodes,
-            seed=seed,
-            params=axes,
-            stream=stream,
-            cache=_path(cache),
-            threads=threads,
+            dict(
+                accuracy=acc,
+                task=task,
+                scenario=_path(scenario),
+                episodes=episodes,
+                seed=seed,
+                params=axes,
+                stream=stream,
+                cache=_path(cache),
+                threads=threads,
+            ),
         )
         import pandas as pd
 

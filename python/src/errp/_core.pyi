@@ -27,20 +27,12 @@ def run(
 ) -> Dict[str, Any]:
     """``task``, ``csv`` (one row per episode) and ``decoder``."""
 
-def sweep(
-    out: str,
-    *,
-    accuracy: str,
-    task: Optional[str] = None,
-    scenario: Optional[str] = None,
-    episodes: int = 100,
-    seed: int = 1,
-    params: Optional[List[str]] = None,
-    stream: Optional[bool] = None,
-    cache: Optional[str] = None,
-    threads: Optional[int] = None,
-) -> Dict[str, Any]:
-    """Paths of the sweep's files, ``ran``, ``total`` and ``task``."""
+def sweep(out: str, keywords: Dict[str, Any]) -> Dict[str, Any]:
+    """Paths of the sweep's files, ``ran``, ``total`` and ``task``.
+
+    ``keywords`` holds every keyword of :func:`errp.sweep` (``accuracy``,
+    ``task``, ``scenario``, ``episodes``, ``seed``, ``params``, ``stream``,
+    ``cache``, ``threads``), as that function passes them."""
 
 def episode_columns(task: str) -> List[str]: ...
 

@@ -5,7 +5,7 @@ use std::f64::consts::PI;
 
 use errp_robot::{
     ContinuousControlParams, ContinuousController, GoalLayout, Phase, Pose, StopReason, Strategy,
-    integrate, wrap_angle,
+    Valid, integrate, wrap_angle,
 };
 
 /// Physics step, s: 5 per 62.5 ms decoder window.
@@ -56,7 +56,8 @@ fn run_with(
     max_secs: f64,
 ) -> Run {
     let epuck = params.epuck;
-    let mut c = ContinuousController::new(params, GoalLayout::cities(), start).unwrap();
+    let mut c = ContinuousController::new(Valid::new(params).unwrap(), GoalLayout::cities(), start)
+        .unwrap();
     let mut pose = start;
     let mut window_heading = start.heading_rad;
     let mut detections = 0;

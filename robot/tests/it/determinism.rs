@@ -3,7 +3,7 @@
 //! the golden runs below pin the results themselves. Update them only for a
 //! change meant to alter the numbers, and say so in the commit.
 
-use errp_robot::{Cell, GoalLayout, Grid, GridControlParams, GridController, Strategy};
+use errp_robot::{Cell, GoalLayout, Grid, GridControlParams, GridController, Strategy, Valid};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -20,7 +20,7 @@ fn grid_trace(strategy: Strategy, seed: u64) -> (String, Cell, f64) {
         ..GridControlParams::default()
     };
     let grid = Grid::paper();
-    let mut c = GridController::new(grid, params).unwrap();
+    let mut c = GridController::new(grid, Valid::new(params).unwrap()).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut cell = Cell::new(0, 0);
     let mut actions = String::new();

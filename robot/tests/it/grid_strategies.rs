@@ -2,7 +2,7 @@
 //! simulated user judges every action as sec. 4.1 says and an oracle decoder
 //! reports the judgement with a fixed accuracy.
 
-use errp_robot::{Cell, Grid, GridControlParams, GridController, QTable, Strategy};
+use errp_robot::{Cell, Grid, GridControlParams, GridController, QTable, Strategy, Valid};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -35,7 +35,7 @@ fn episode(
     seed: u64,
 ) -> Episode {
     let grid = *table.grid();
-    let mut c = GridController::with_table(table.clone(), params);
+    let mut c = GridController::with_table(table.clone(), Valid::new(params).unwrap());
     let mut explore = stream(seed, 1);
     let mut decoder = stream(seed, 2);
     let mut cell = start;
@@ -86,7 +86,7 @@ fn measure(strategy: Strategy, accuracy: f64, n: u64) -> Summary {
         strategy,
         ..GridControlParams::default()
     };
-    let table = QTable::compute(grid, &params.q()).unwrap();
+    let table = QTable::compute(grid, &Valid::new(params.q()).unwrap()).unwrap();
     let mut pairs = stream(2013, 0);
     let (mut right, mut actions, mut not_greedy) = (0, 0, 0);
     for k in 0..n {

@@ -8,12 +8,13 @@ mod view;
 pub use view::{calibration_recording, record_calibration};
 
 use errp_bci::{
-    Calibrated, CalibrationParams, GeneratorParams, LdaDecoder, LdaModel, MeanAccuracy, Protocol,
-    SessionOptions, Setup, TargetingParams, TargetingResult, TargetingStep, calibrate,
-    target_accuracy,
+    Calibrated, CalibrationParams, ChannelKind, GeneratorParams, LdaDecoder, LdaModel,
+    MeanAccuracy, Protocol, SessionOptions, Setup, TargetingParams, TargetingResult, TargetingStep,
+    calibrate, target_accuracy,
 };
 
 use crate::error::Result;
+use crate::key::StableKey;
 
 /// What to calibrate: a synthetic user recorded with protocol `P` (the
 /// discrete session or the button-locked one), targeted at a mean accuracy.
@@ -39,8 +40,15 @@ impl<P: Protocol> Request<P> {
             search: TargetingParams::default(),
         }
     }
+}
 
-    /// This request's key in a [`TargetingCache`].
+/// The version of [`Request::targeting_key`]: raise it when what the key
+/// holds changes (a field of the setup added, removed or renamed).
+pub const TARGETING_KEY_VERSION: u32 = 2;
+
+impl<P: Protocol + serde::Serialize> Request<P> {
+    /// This request's key in a [`TargetingCache`]: every field of the
+    /// request, the montage by its channels ([`crate::StableKey`]).
     pub fn targeting_key(&self) -> String {
         let Self {
             accuracy,
@@ -48,10 +56,32 @@ impl<P: Protocol> Request<P> {
             setup,
             search,
         } = self;
-        format!(
-            "{setup:?} {search:?} accuracy={:?} seed={seed}",
-            accuracy.get()
-        )
+        let Setup {
+            generator,
+            calibration,
+            preprocess,
+            montage,
+        } = setup;
+        let channels: Vec<(&str, &str, [f64; 3])> = montage
+            .channels()
+            .iter()
+            .map(|c| {
+                let kind = match c.kind {
+                    ChannelKind::Eeg => "eeg",
+                    ChannelKind::Eog => "eog",
+                };
+                (c.name.as_str(), kind, c.position)
+            })
+            .collect();
+        StableKey::new("targeting", TARGETING_KEY_VERSION)
+            .float("accuracy", accuracy.get())
+            .int("seed", *seed)
+            .value("generator", generator)
+            .value("calibration", calibration)
+            .value("preprocess", preprocess)
+            .value("montage", &channels)
+            .value("search", search)
+            .finish()
     }
 }
 
@@ -150,5 +180,79 @@ impl TargetingCache for NoCache {
         _verify: &mut dyn FnMut(&TargetingResult) -> Result<Option<String>>,
     ) -> Result<(TargetingResult, bool)> {
         Ok((search()?, false))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use errp_bci::{ContinuousCalibrationParams, DetectorParams, OnlineTarget, PreprocessParams};
+
+    use super::*;
+    use crate::key::shape;
+
+    /// What the targeting key (on disk) and the decoder keys (in memory)
+    /// hold of each parameter struct. A field renamed, added or removed
+    /// changes the keys: this fails until the list is updated and, for the
+    /// targeting key, [`TARGETING_KEY_VERSION`] raised (old cache entries
+    /// are then never read as new ones).
+    #[test]
+    fn the_keys_hold_these_fields() {
+        let fields = |v: Vec<String>| v.join(" ");
+        // Held by the targeting key, on disk: raise TARGETING_KEY_VERSION.
+        assert_eq!(
+            fields(shape(&GeneratorParams::default())),
+            "alpha_bandwidth_hz alpha_hz alpha_uv amplitude_variability background_uv \
+             blink_rate_hz blink_uv errp_to_noise latency_jitter_ms line_hz line_noise_uv \
+             saccade_rate_hz saccade_uv sensor_noise_uv sfreq_hz spatial_length"
+        );
+        assert_eq!(
+            fields(shape(&CalibrationParams::default())),
+            "eog_session_secs error_rate folds interval_max_secs interval_min_secs n_actions"
+        );
+        assert_eq!(
+            fields(shape(&ContinuousCalibrationParams::default())),
+            "eog_session_secs folds interval_max_secs interval_min_secs per_class \
+             trigger_jitter_ms"
+        );
+        assert_eq!(
+            fields(shape(&PreprocessParams::default())),
+            "high_hz line_hz low_hz"
+        );
+        assert_eq!(
+            fields(shape(&TargetingParams::default())),
+            "max_evaluations max_ratio tolerance"
+        );
+        assert_eq!(TARGETING_KEY_VERSION, 2);
+        // Held by the e-puck's decoder key, in memory.
+        assert_eq!(
+            fields(shape(&DetectorParams::default())),
+            "mode refractory_secs smooth_windows"
+        );
+        let target = OnlineTarget {
+            hit_rate: 0.7,
+            false_alarms_per_min: Some(1.0),
+        };
+        assert_eq!(fields(shape(&target)), "false_alarms_per_min hit_rate");
+    }
+
+    /// The targeting key of a request holds every value in it: a ratio
+    /// tolerance or an EEG parameter changed in the last bit is another
+    /// entry, and equal requests share one.
+    #[test]
+    fn a_targeting_key_changes_with_any_value() {
+        let base = Request::<CalibrationParams>::new(MeanAccuracy::new(0.75).unwrap(), 1);
+        let key = base.targeting_key();
+        assert!(key.starts_with("targeting/v2;accuracy=f:"), "{key}");
+        assert_eq!(key, base.clone().targeting_key());
+        let mut other = base.clone();
+        other.setup.generator.alpha_hz =
+            f64::from_bits(other.setup.generator.alpha_hz.to_bits() + 1);
+        assert_ne!(other.targeting_key(), key);
+        let mut other = base.clone();
+        other.seed = 2;
+        assert_ne!(other.targeting_key(), key);
+        let mut other = base;
+        other.search.tolerance *= 2.0;
+        assert_ne!(other.targeting_key(), key);
     }
 }

@@ -11,7 +11,7 @@ use rerun::{Color, Image, LineStrips2D, Points2D, Scalars, SeriesLines, TextDocu
 
 use crate::calibration::CalibrationReport;
 use crate::error::{Result, SimError};
-use crate::record::{LATENCY_TIMELINE, RrdFile, record_error};
+use crate::record::{LATENCY_TIMELINE, RrdFile, paths, record_error};
 
 /// Side of the topography image (pixels).
 const MAP_PX: usize = 200;
@@ -28,7 +28,7 @@ fn blueprint() -> Blueprint {
     for ch in GA_CHANNELS {
         series.push(
             TimeSeriesView::new(format!("Grand average at {ch} (uV)"))
-                .with_origin(format!("/grand_average/{ch}"))
+                .with_origin(paths::grand_average(ch))
                 .into(),
         );
     }
@@ -37,10 +37,10 @@ fn blueprint() -> Blueprint {
             Vertical::new(series).into(),
             Vertical::new([
                 Spatial2DView::new("Error - correct at the peak")
-                    .with_origin("/topography")
+                    .with_origin(paths::TOPOGRAPHY)
                     .into(),
                 TextDocumentView::new("Calibration")
-                    .with_origin("/summary")
+                    .with_origin(paths::SUMMARY)
                     .into(),
             ])
             .into(),
@@ -87,7 +87,7 @@ fn log_calibration(
 
     for name in GA_CHANNELS {
         let row = channel_row(ga, name, path)?;
-        let base = format!("grand_average/{name}");
+        let base = paths::grand_average(name);
         for (label, rgb) in [
             ("error", ERROR_RGB),
             ("correct", CORRECT_RGB),
@@ -142,7 +142,7 @@ fn log_calibration(
     let limit = values.iter().fold(1e-9f64, |a, v| a.max(v.abs()));
     let image = topography_image(&positions, &values, limit);
     rec.log_static(
-        "topography/map",
+        paths::TOPOGRAPHY_MAP,
         &Image::from_rgb24(image, [MAP_PX as u32, MAP_PX as u32]),
     )
     .map_err(&err)?;
@@ -154,7 +154,7 @@ fn log_calibration(
         ]
     };
     rec.log_static(
-        "topography/electrodes",
+        paths::TOPOGRAPHY_ELECTRODES,
         &Points2D::new(positions.iter().map(|&p| to_px(p)))
             .with_radii([2.5])
             .with_colors(values.iter().map(|&v| color(v / limit)))
@@ -178,7 +178,7 @@ fn log_calibration(
         to_px([0.12, 0.99]),
     ];
     rec.log_static(
-        "topography/head",
+        paths::TOPOGRAPHY_HEAD,
         &LineStrips2D::new([head, nose]).with_colors([Color::from_rgb(80, 80, 80)]),
     )
     .map_err(&err)?;
@@ -214,7 +214,7 @@ fn log_calibration(
         ));
     }
     rec.log_static(
-        "summary",
+        paths::SUMMARY,
         &TextDocument::new(md).with_media_type(rerun::MediaType::markdown()),
     )
     .map_err(&err)?;

@@ -6,12 +6,13 @@ use errp_bci::{
     Accuracy, ContinuousCalibrationParams, ContinuousFeatures, Detector, DetectorMode,
     DetectorParams, EegGenerator, GeneratorParams, Montage, OnlineRecording, OnlineRecordingParams,
     OnlineStep, OnlineTarget, OnlineTargeting, OperatingPoint, Preprocessor, ResponseSpan,
-    SlidingWindow, SvmDecoder, SvmModel, TargetingResult, TargetingStep, calibrate_continuous,
-    detector_span, operating_point, record_online, rng::derive_seed, target_continuous_accuracy,
-    target_online,
+    SlidingWindow, SvmDecoder, SvmModel, TargetingParams, TargetingResult, TargetingStep, Valid,
+    calibrate_continuous, detector_span, operating_point, record_online, rng::derive_seed,
+    target_continuous_accuracy, target_online,
 };
 
 use crate::calibration::{Report, Request};
+use crate::epuck::params::EpuckTaskParams;
 use crate::error::Result;
 
 /// The button-locked calibration of the e-puck task.
@@ -71,7 +72,7 @@ pub struct OnlineReport {
     /// windows respond (p(error) >= T_e clearly above its background rate).
     pub window_span: ResponseSpan,
     /// The detector in force.
-    pub detector: DetectorParams,
+    pub detector: Valid<DetectorParams>,
     /// T_e.
     pub t_e: f64,
     /// The detector in force, scored per ErrP and per minute of error-free
@@ -86,7 +87,7 @@ impl OnlineReport {
     /// `recording` of the calibrated pipeline.
     pub fn from_recording(
         recording: &OnlineRecording,
-        detector: DetectorParams,
+        detector: Valid<DetectorParams>,
         t_e: f64,
     ) -> Result<Self> {
         let window_span = detector_span(recording, DetectorParams::literal(), t_e)?;
@@ -156,7 +157,7 @@ impl std::fmt::Display for OnlineReport {
 pub fn run_online_calibration(
     request: &ContinuousRequest,
     target: OnlineTarget,
-    detector: DetectorParams,
+    detector: Valid<DetectorParams>,
     t_e: f64,
     progress: impl FnMut(&OnlineStep),
 ) -> Result<(ContinuousDecoder, ContinuousReport, OnlineTargeting)> {
@@ -165,9 +166,11 @@ pub fn run_online_calibration(
         target,
         detector,
         t_e,
-        request.search.max_ratio,
-        0.02,
-        request.search.max_evaluations,
+        // Within 2 points of the target hit rate.
+        &TargetingParams {
+            tolerance: 0.02,
+            ..request.search.clone()
+        },
         |ratio| -> Result<_> {
             let mut report = calibrate_continuous_at(
                 request,
@@ -262,7 +265,12 @@ impl ContinuousDecoder {
 
     /// Measures the operating point of `detector` at threshold `t_e` on the
     /// held-out recording for `seed` and keeps it.
-    pub fn measure_online(&mut self, detector: DetectorParams, t_e: f64, seed: u64) -> Result<()> {
+    pub fn measure_online(
+        &mut self,
+        detector: Valid<DetectorParams>,
+        t_e: f64,
+        seed: u64,
+    ) -> Result<()> {
         let recording = self.record_held_out(seed)?;
         self.online = Some(OnlineReport::from_recording(&recording, detector, t_e)?);
         Ok(())
@@ -278,11 +286,17 @@ impl ContinuousDecoder {
             .map_or(UNMEASURED_SPAN, |o| o.point.span)
     }
 
-    /// The threshold the detector runs at: the one its operating point was
-    /// measured at (calibrated, with an online false-alarm target), else
-    /// `scenario_t_e`.
-    pub fn t_e(&self, scenario_t_e: f64) -> f64 {
-        self.online.as_ref().map_or(scenario_t_e, |o| o.t_e)
+    /// The threshold the detector of an episode with `params` runs at: the
+    /// one this decoder's operating point was measured at (calibrated, with
+    /// an online false-alarm target), else the scenario's `control.t_e`,
+    /// which is also the threshold for a decoder of the user's own
+    /// (`own_decoder`) in place of this one's SVM. The one place T_e is
+    /// resolved.
+    pub fn detector_t_e(&self, params: &EpuckTaskParams, own_decoder: bool) -> f64 {
+        match &self.online {
+            Some(o) if !own_decoder => o.t_e,
+            _ => params.control.t_e,
+        }
     }
 
     /// The span over which single windows respond to an ErrP.

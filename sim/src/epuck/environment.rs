@@ -7,18 +7,13 @@
 
 use std::sync::Arc;
 
-use errp_bci::{AssessmentKind, Detector, EegBlock, SlidingWindow, rng::derive_seed, rng::stream};
+use errp_bci::EegBlock;
 use errp_robot::{Pose, WheelSpeeds};
-use rand_chacha::ChaCha8Rng;
 
 use crate::epuck::decoder::ContinuousDecoder;
-use crate::epuck::episode::{
-    EpisodeStart, EpuckObserver, PHYSICS_DT_SECS, PhysicsFrame, STEPS_PER_WINDOW, WindowFrame,
-};
+use crate::epuck::observer::{EpisodeStart, EpuckObserver};
+use crate::epuck::plant::{EpuckDriver, EpuckPlant, PlantWindow};
 use crate::epuck::scenario::EpuckScenario;
-use crate::epuck::tracker::CameraTracker;
-use crate::epuck::user::SyntheticUser;
-use crate::epuck::world::World;
 use crate::error::{Result, SimError};
 
 /// The most decoder windows one action may last (4 s).
@@ -45,6 +40,38 @@ impl EpuckAction {
         EpuckAction::TurnRight,
         EpuckAction::Stop,
     ];
+
+    /// What the robot does under the action ([`crate::epuck::PHASE_NAMES`]):
+    /// 0 turning, 1 driving, 2 stopped.
+    fn phase(self) -> usize {
+        match self {
+            EpuckAction::TurnLeft | EpuckAction::TurnRight => 0,
+            EpuckAction::Forward => 1,
+            EpuckAction::Stop => 2,
+        }
+    }
+}
+
+/// An action held for all its physics steps, heading for the user's goal
+/// as far as an observer is told.
+struct Primitive {
+    command: WheelSpeeds,
+    phase: usize,
+    target: usize,
+}
+
+impl EpuckDriver for Primitive {
+    fn phase(&self) -> usize {
+        self.phase
+    }
+
+    fn target(&self) -> usize {
+        self.target
+    }
+
+    fn command(&mut self, _tracked: &Pose, _time_secs: f64) -> WheelSpeeds {
+        self.command
+    }
 }
 
 /// What one action gave the agent.
@@ -67,19 +94,13 @@ pub struct EpuckFeedback {
     pub window: Option<EegBlock>,
 }
 
-/// One e-puck episode with the motion chosen from outside.
+/// One e-puck episode with the motion chosen from outside: the loop of
+/// [`EpuckPlant`](crate::epuck::EpuckPlant), which an episode of the shared control runs
+/// too, driven by the agent's actions.
 pub struct EpuckEnvironment {
     decoder: Arc<ContinuousDecoder>,
     scenario: EpuckScenario,
-    world: World,
-    tracker: CameraTracker,
-    wheels_rng: ChaCha8Rng,
-    user: SyntheticUser,
-    eeg: SlidingWindow,
-    detector: Detector,
-    time_secs: f64,
-    tracked: Pose,
-    t_e: f64,
+    plant: EpuckPlant,
     ended: bool,
 }
 
@@ -92,57 +113,29 @@ impl EpuckEnvironment {
         goal: Option<usize>,
         seed: u64,
     ) -> Result<Self> {
-        let n = scenario.layout.len();
-        let goal = match goal {
-            Some(g) if g < n => g,
-            Some(g) => {
-                return Err(SimError::Scenario(format!(
-                    "goal: {g} is not a goal of the layout, expected 0 to {}",
-                    n - 1
-                )));
-            }
-            None => scenario.episode.goal,
-        };
-        let params = &scenario.params;
-        let start = scenario.episode.start;
-        let world = World::new(
-            &scenario.arena,
-            &params.control.epuck,
-            start,
-            PHYSICS_DT_SECS,
-        )?;
-        let mut tracker = CameraTracker::new(params.tracker, stream(seed, "epuck/tracker"));
-        let tracked = tracker.observe(0.0, &world.pose());
-        let t_e = decoder.t_e(params.control.t_e);
+        let goal = goal.unwrap_or(scenario.episode.goal);
+        let plant = EpuckPlant::new(scenario, goal, &decoder, false, seed)?;
         Ok(Self {
-            eeg: decoder.start_stream(derive_seed(seed, "epuck/eeg", 0))?,
-            detector: Detector::new(params.detector, t_e)?,
-            user: SyntheticUser::new(params.user, &scenario.layout, goal),
-            world,
-            tracker,
-            wheels_rng: stream(seed, "epuck/wheels"),
-            scenario: scenario.clone(),
             decoder,
-            time_secs: 0.0,
-            tracked,
-            t_e,
+            scenario: scenario.clone(),
+            plant,
             ended: false,
         })
     }
 
     /// The user's goal (an index into the layout).
     pub fn goal(&self) -> usize {
-        self.user.goal()
+        self.plant.goal()
     }
 
     /// The pose the camera sees.
     pub fn tracked(&self) -> Pose {
-        self.tracked
+        self.plant.tracked()
     }
 
     /// Episode time (s).
     pub fn time_secs(&self) -> f64 {
-        self.time_secs
+        self.plant.time_secs()
     }
 
     /// The scenario.
@@ -154,15 +147,7 @@ impl EpuckEnvironment {
     /// score the episode again from what it observes (the detector's T_e
     /// and the response spans of the decoder).
     pub fn start(&self) -> EpisodeStart {
-        let span = self.decoder.detection_span();
-        let window_span = self.decoder.window_span();
-        EpisodeStart {
-            pose: self.world.pose(),
-            goal: self.user.goal(),
-            t_e: self.t_e,
-            detection_span: (span.from_secs, span.to_secs),
-            window_span: (window_span.from_secs, window_span.to_secs),
-        }
+        self.plant.start(&self.decoder)
     }
 
     /// True once the episode ended: the robot stopped on a goal, or
@@ -179,12 +164,9 @@ impl EpuckEnvironment {
         }
         self.ended = true;
         if observer.watches() {
-            observer.on_event(
-                self.time_secs,
-                "the episode ended without a commitment",
-                true,
-            );
-            observer.on_end(self.time_secs, None);
+            let time_secs = self.plant.time_secs();
+            observer.on_event(time_secs, "the episode ended without a commitment", true);
+            observer.on_end(time_secs, None);
         }
     }
 
@@ -219,106 +201,37 @@ impl EpuckEnvironment {
                  {MAX_WINDOWS_PER_ACTION} windows of 62.5 ms"
             )));
         }
-        let params = &self.scenario.params;
-        let epuck = &params.control.epuck;
-        let top = epuck.max_speed_m_per_s();
-        let command = match action {
-            EpuckAction::Forward => {
-                let v = params.control.drive_speed_fraction * top;
-                WheelSpeeds {
-                    left_m_per_s: v,
-                    right_m_per_s: v,
-                }
-            }
-            EpuckAction::TurnLeft | EpuckAction::TurnRight => {
-                let s = params.control.turn_speed_fraction * top;
-                let s = if action == EpuckAction::TurnLeft {
-                    s
-                } else {
-                    -s
-                };
-                WheelSpeeds {
-                    left_m_per_s: -s,
-                    right_m_per_s: s,
-                }
-            }
-            EpuckAction::Stop => WheelSpeeds::ZERO,
+        let goal = self.plant.goal();
+        let mut driver = Primitive {
+            command: self.command(action),
+            phase: action.phase(),
+            target: goal,
         };
         let watching = observer.watches();
-        let phase = match action {
-            EpuckAction::TurnLeft | EpuckAction::TurnRight => 0,
-            EpuckAction::Forward => 1,
-            EpuckAction::Stop => 2,
-        };
-        let goal = self.user.goal();
         let mut p_error = Vec::with_capacity(windows);
         let mut detected = false;
         let mut errps = 0;
         for _ in 0..windows {
-            for _ in 0..STEPS_PER_WINDOW {
-                if let Some(e) = self.user.observe(self.time_secs, &self.tracked) {
-                    let error = e.kind == AssessmentKind::Error;
-                    errps += usize::from(error);
-                    self.eeg.schedule(e.onset_secs, e.kind);
-                    if watching && error {
-                        observer.on_errp(self.time_secs, e.onset_secs, phase);
-                        observer.on_event(self.time_secs, "the user sees an error (ErrP)", false);
-                    }
-                }
-                let readings = if params.avoidance.enabled {
-                    self.world.proximity()
-                } else {
-                    [0.0; 8]
-                };
-                let safe = params.avoidance.apply(&readings, command, epuck);
-                let applied = safe.apply_noise(epuck, &mut self.wheels_rng);
-                self.world.step(applied.to_twist(epuck));
-                self.time_secs += PHYSICS_DT_SECS;
-                let pose = self.world.pose();
-                self.tracked = self.tracker.observe(self.time_secs, &pose);
-                if watching {
-                    observer.on_physics(&PhysicsFrame {
-                        time_secs: self.time_secs,
-                        pose,
-                        tracked: self.tracked,
-                        wheels: applied,
-                        phase,
-                        target: goal,
-                    });
-                }
-            }
-            let fresh = self.eeg.advance();
-            let p = self.eeg.p_error(&self.decoder.model);
-            let decision = self.detector.push(p, self.time_secs);
-            detected |= decision.detected;
-            p_error.push(p);
+            let w = self.window_driven(&mut driver, observer)?;
+            detected |= w.decision.detected;
+            errps += w.errps.len();
+            p_error.push(w.p_error);
             if watching {
-                if decision.detected {
-                    observer.on_event(
-                        self.time_secs,
-                        &format!("error detected (evidence {:.2})", decision.evidence),
-                        false,
-                    );
+                let time_secs = self.plant.time_secs();
+                if w.decision.detected {
+                    let evidence = w.decision.evidence;
+                    let text = format!("error detected (evidence {evidence:.2})");
+                    observer.on_event(time_secs, &text, false);
                 }
-                let fcz_cz = self.eeg.fcz_cz();
-                observer.on_window(&WindowFrame {
-                    time_secs: self.time_secs,
-                    p_error: p,
-                    evidence: decision.evidence,
-                    belief: Vec::new(),
-                    target: goal,
-                    detected: decision.detected,
-                    step: match phase {
-                        2 if self.on_goal().is_some() => 2,
-                        2 => 3,
-                        p => p,
-                    },
-                    tracked: self.tracked,
-                    fcz_cz: [
-                        fresh.channel(fcz_cz[0]).to_vec(),
-                        fresh.channel(fcz_cz[1]).to_vec(),
-                    ],
-                });
+                let step = match driver.phase {
+                    2 if self.on_goal().is_some() => 2,
+                    2 => 3,
+                    p => p,
+                };
+                let frame =
+                    self.plant
+                        .window_frame(&w, Vec::new(), goal, w.decision.detected, step);
+                observer.on_window(&frame);
             }
         }
         let on_goal = self.on_goal();
@@ -334,28 +247,68 @@ impl EpuckEnvironment {
                 } else {
                     "a wrong goal"
                 };
+                let time_secs = self.plant.time_secs();
                 observer.on_event(
-                    self.time_secs,
+                    time_secs,
                     &format!("stopped on {name} ({whose})"),
                     g != goal,
                 );
-                observer.on_end(self.time_secs, Some(g));
+                observer.on_end(time_secs, Some(g));
             }
         }
         Ok(EpuckFeedback {
-            tracked: self.tracked,
+            tracked: self.plant.tracked(),
             p_error,
             detected,
             errps,
             on_goal,
-            time_secs: self.time_secs,
-            window: keep_window.then(|| self.eeg.window().clone()),
+            time_secs: self.plant.time_secs(),
+            window: keep_window.then(|| self.plant.eeg_window().clone()),
         })
+    }
+
+    /// One decoder window with the wheels commanded physics step by physics
+    /// step by `driver`, for an agent that steers finer than the motion
+    /// primitives (the shared control itself: an episode is this
+    /// environment driven by [`crate::epuck::shared_control`]). `observer`
+    /// sees the physics steps and the user's ErrPs; the window, its
+    /// p(error) and the detector's verdict are returned.
+    pub fn window_driven(
+        &mut self,
+        driver: &mut impl EpuckDriver,
+        observer: &mut impl EpuckObserver,
+    ) -> Result<PlantWindow> {
+        self.plant.window(driver, &self.decoder, None, observer)
+    }
+
+    /// The wheel command of `action` at the scenario's speeds.
+    fn command(&self, action: EpuckAction) -> WheelSpeeds {
+        let control = &self.scenario.params.control;
+        let top = control.epuck.max_speed_m_per_s();
+        let turn = control.turn_speed_fraction * top;
+        match action {
+            EpuckAction::Forward => {
+                let v = control.drive_speed_fraction * top;
+                WheelSpeeds {
+                    left_m_per_s: v,
+                    right_m_per_s: v,
+                }
+            }
+            EpuckAction::TurnLeft => WheelSpeeds {
+                left_m_per_s: -turn,
+                right_m_per_s: turn,
+            },
+            EpuckAction::TurnRight => WheelSpeeds {
+                left_m_per_s: turn,
+                right_m_per_s: -turn,
+            },
+            EpuckAction::Stop => WheelSpeeds::ZERO,
+        }
     }
 
     /// The goal within the scenario's goal radius of the true pose, if any.
     fn on_goal(&self) -> Option<usize> {
-        let pose = self.world.pose();
+        let pose = self.plant.pose();
         let radius = self.scenario.params.control.goal_radius_m;
         self.scenario.layout.goals().iter().position(|g| {
             (g.x_m - pose.x_m).powi(2) + (g.y_m - pose.y_m).powi(2) <= radius * radius

@@ -5,6 +5,9 @@
 pub(crate) mod decoder;
 pub(crate) mod environment;
 pub(crate) mod episode;
+pub(crate) mod observer;
+pub(crate) mod params;
+pub(crate) mod plant;
 pub(crate) mod report;
 pub(crate) mod run;
 pub(crate) mod scenario;
@@ -21,12 +24,16 @@ pub use decoder::{
     run_continuous_calibration, run_online_calibration, target_continuous,
 };
 pub use environment::{EpuckAction, EpuckEnvironment, EpuckFeedback, MAX_WINDOWS_PER_ACTION};
-pub use episode::{
-    EpisodeStart, EpuckEpisode, EpuckEpisodeResult, EpuckObserver, EpuckTaskParams, PHASE_NAMES,
-    PHYSICS_DT_SECS, PhysicsFrame, STEP_NAMES, WINDOW_STEP_SECS, WindowDecoder, WindowFrame,
-    run_epuck_episode, run_epuck_episode_with,
-};
+pub use episode::{EpuckEpisodeResult, run_epuck_episode, run_epuck_episode_with, shared_control};
 pub use errp_robot::AvoidanceParams;
+pub use observer::{
+    EpisodeStart, EpuckObserver, PHASE_NAMES, PhysicsFrame, STEP_NAMES, WindowFrame,
+};
+pub use params::{EpuckEpisode, EpuckTaskParams};
+pub use plant::{
+    EpuckDriver, EpuckPlant, PHYSICS_DT_SECS, PlantWindow, STEPS_PER_WINDOW, WINDOW_STEP_SECS,
+    WindowDecoder,
+};
 pub use report::{EpuckRunHeader, EpuckRunRow, EpuckSummaryReport};
 pub use run::{
     EpuckSummary, PreparedEpuck, epuck_run_seed, finish_continuous_decoder,

@@ -10,7 +10,8 @@ use crate::epuck::decoder::{
     ContinuousDecoder, ContinuousReport, ContinuousRequest, calibrate_continuous_at,
     run_online_calibration, target_continuous,
 };
-use crate::epuck::episode::{EpuckEpisodeResult, EpuckObserver, run_epuck_episode};
+use crate::epuck::episode::{EpuckEpisodeResult, run_epuck_episode};
+use crate::epuck::observer::EpuckObserver;
 use crate::epuck::scenario::EpuckScenario;
 use crate::error::Result;
 
@@ -19,7 +20,7 @@ use crate::error::Result;
 ///
 /// With an online target (`[user] hit_rate`), `online_progress` sees that
 /// search instead, and the decoder's T_e is the one it calibrated
-/// ([`ContinuousDecoder::t_e`]).
+/// ([`ContinuousDecoder::detector_t_e`]).
 pub fn prepare_continuous_decoder(
     scenario: &EpuckScenario,
     progress: impl FnMut(&TargetingStep),
@@ -139,10 +140,7 @@ pub fn run_epuck_once(
     observer: &mut impl EpuckObserver,
 ) -> Result<EpuckEpisodeResult> {
     run_epuck_episode(
-        &scenario.params,
-        &scenario.arena,
-        &scenario.layout,
-        scenario.episode,
+        scenario,
         decoder,
         epuck_run_seed(scenario.seed, k),
         observer,

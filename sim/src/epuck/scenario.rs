@@ -6,9 +6,9 @@
 use std::path::{Path, PathBuf};
 
 use errp_bci::{DetectorMode, DetectorParams, MeanAccuracy, OnlineTarget};
-use errp_robot::{GoalLayout, Pose};
+use errp_robot::{ContinuousControlParams, GoalLayout, Pose, Valid};
 
-use crate::epuck::episode::{EpuckEpisode, EpuckTaskParams};
+use crate::epuck::params::{EpuckEpisode, EpuckTaskParams};
 use crate::epuck::schema::{EpuckFile, StartFile};
 use crate::epuck::world::{ArenaSpec, Obstacle};
 use crate::error::{Result, SimError};
@@ -285,12 +285,11 @@ impl EpuckScenario {
             .validate()
             .map_err(|e| SimError::Scenario(format!("{}: {e}", path.display())))?;
 
-        params.control = file.control.clone();
         if let Some(d) = &file.detector {
-            let p = &mut params.detector;
+            let mut p = DetectorParams::default();
             if let Some(m) = d.mode {
-                *p = match m {
-                    DetectorMode::Literal => DetectorParams::literal(),
+                p = match m {
+                    DetectorMode::Literal => DetectorParams::literal().into_inner(),
                     DetectorMode::Smoothed => DetectorParams::default(),
                 };
             }
@@ -317,14 +316,15 @@ impl EpuckScenario {
                      literal reading compares each window with T_e on its own)",
                 ));
             }
-            p.validate().map_err(|e| table_error(path, "detector", e))?;
+            // Checked here, once: episodes and detectors take it checked.
+            params.detector = Valid::new(p).map_err(|e| table_error(path, "detector", e))?;
         }
         // The device knows its decoder's accuracy from the calibration.
-        params.control.assumed_accuracy = accuracy.get();
-        params
-            .control
-            .validate()
-            .map_err(|e| robot_error(path, "control", e))?;
+        let control = ContinuousControlParams {
+            assumed_accuracy: accuracy.get(),
+            ..file.control.clone()
+        };
+        params.control = Valid::new(control).map_err(|e| robot_error(path, "control", e))?;
 
         if let Some(t) = &file.tracker {
             if let Some(v) = t.rate_hz {

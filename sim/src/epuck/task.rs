@@ -10,8 +10,8 @@ use crate::epuck::episode::{EpuckEpisodeResult, run_epuck_episode};
 use crate::epuck::run::prepare_epuck_decoder;
 use crate::epuck::scenario::EpuckScenario;
 use crate::error::Result;
+use crate::key::StableKey;
 use crate::paper::PAPER_EPUCK;
-use crate::scenario::AnyScenario;
 use crate::task::{
     Column, ColumnKind, DecoderInfo, EpisodeRow, FieldError, FigureText, PaperPoint, Task,
     TaskInfo, format_number, rate_field,
@@ -103,26 +103,16 @@ impl Task for EpuckTask {
     type Decoder = ContinuousDecoder;
     type Runner = EpuckRunner;
 
-    fn scenario(any: &AnyScenario) -> Option<&EpuckScenario> {
-        match any {
-            AnyScenario::Epuck(s) => Some(s),
-            AnyScenario::Grid(_) => None,
-        }
-    }
-
     /// The held-out operating point, and with an online target the
     /// calibration itself, depend on the detector and T_e too.
     fn decoder_key(s: &EpuckScenario) -> String {
-        format!(
-            "{:?}",
-            (
-                s.accuracy,
-                s.user_seed,
-                s.online_target,
-                s.params.detector,
-                s.params.control.t_e
-            )
-        )
+        StableKey::new("epuck-decoder", 1)
+            .float("accuracy", s.accuracy.get())
+            .int("user_seed", s.user_seed)
+            .value("online_target", &s.online_target)
+            .value("detector", &s.params.detector)
+            .float("t_e", s.params.control.t_e)
+            .finish()
     }
 
     fn shared(_: &[&EpuckScenario]) -> Result<()> {
@@ -161,15 +151,7 @@ impl Task for EpuckTask {
 
     fn run_episode(runner: &EpuckRunner, _k: usize, seed: u64) -> Result<EpisodeRow> {
         let s = &runner.scenario;
-        let r = run_epuck_episode(
-            &s.params,
-            &s.arena,
-            &s.layout,
-            s.episode,
-            &runner.decoder,
-            seed,
-            &mut (),
-        )?;
+        let r = run_epuck_episode(s, &runner.decoder, seed, &mut ())?;
         Ok(epuck_row(&s.layout, &r))
     }
 

@@ -17,14 +17,14 @@ use rerun::{
 };
 
 use crate::epuck::decoder::ContinuousDecoder;
-use crate::epuck::episode::{
-    EpisodeStart, EpuckEpisodeResult, EpuckObserver, PhysicsFrame, WindowDecoder, WindowFrame,
-};
+use crate::epuck::episode::EpuckEpisodeResult;
+use crate::epuck::observer::{EpisodeStart, EpuckObserver, PhysicsFrame, WindowFrame};
+use crate::epuck::plant::WindowDecoder;
 use crate::epuck::run::run_epuck_once;
 use crate::epuck::scenario::EpuckScenario;
 use crate::epuck::world::{ArenaSpec, Obstacle};
 use crate::error::{Result, SimError};
-use crate::record::data::{self, Column, Provenance, send_table};
+use crate::record::data::{Column, Provenance, send_table};
 use crate::record::{
     RrdFile, SIM_TIME, eeg_channel, log_decoder_series, paths, record_error, task_blueprint,
 };
@@ -41,7 +41,7 @@ fn blueprint(belief: bool) -> Blueprint {
     if belief {
         series.push(
             TimeSeriesView::new("Belief per city")
-                .with_origin("/belief/city")
+                .with_origin(paths::BELIEF_CITY)
                 .into(),
         );
     }
@@ -56,7 +56,8 @@ fn blueprint(belief: bool) -> Blueprint {
             .into(),
     );
     task_blueprint(
-        Spatial2DView::new("Arena (cm): e-puck, trajectory, detected errors").with_origin("/arena"),
+        Spatial2DView::new("Arena (cm): e-puck, trajectory, detected errors")
+            .with_origin(paths::ARENA),
         series,
     )
 }
@@ -149,7 +150,7 @@ impl EpuckRecorder {
         let err = record_error(file.path());
         let s = arena.size_m;
         rec.log_static(
-            "arena/walls",
+            paths::ARENA_WALLS,
             &LineStrips2D::new([[cm(0.0, 0.0), cm(s, 0.0), cm(s, s), cm(0.0, s), cm(0.0, 0.0)]])
                 .with_colors([Color::from_rgb(60, 60, 60)])
                 .with_radii([1.0]),
@@ -157,7 +158,7 @@ impl EpuckRecorder {
         .map_err(&err)?;
         if !arena.obstacles.is_empty() {
             rec.log_static(
-                "arena/obstacles",
+                paths::ARENA_OBSTACLES,
                 &LineStrips2D::new(arena.obstacles.iter().map(outline))
                     .with_colors([Color::from_rgb(110, 80, 50)])
                     .with_radii([0.8]),
@@ -168,7 +169,7 @@ impl EpuckRecorder {
         // so that neighbours' long names do not run into each other.
         let cell_m = layout.arena_size_m() / f64::from(LAYOUT_GRID_CELLS);
         rec.log_static(
-            "arena/cities",
+            paths::ARENA_CITIES,
             &Points2D::new(layout.goals().iter().map(|g| {
                 let column = (g.x_m / cell_m).floor() as i64;
                 let dy = if column % 2 == 0 { -0.13 } else { 0.13 };
@@ -182,7 +183,7 @@ impl EpuckRecorder {
         log_decoder_series(&rec, "T_e").map_err(&err)?;
         for g in layout.goals() {
             rec.log_static(
-                format!("belief/city/{}", g.name),
+                paths::belief_city(&g.name),
                 &SeriesLines::new().with_names([g.name.as_str()]),
             )
             .map_err(&err)?;
@@ -226,9 +227,10 @@ impl EpuckRecorder {
         self.rec.set_duration_secs(SIM_TIME, self.offset_secs);
         let r = self.rec.log(paths::LOG, &TextLog::new(start_goal_and_user));
         self.keep(r);
-        let r = self
-            .rec
-            .log("arena/detections", &Points2D::new(Vec::<[f32; 2]>::new()));
+        let r = self.rec.log(
+            paths::ARENA_DETECTIONS,
+            &Points2D::new(Vec::<[f32; 2]>::new()),
+        );
         self.keep(r);
     }
 
@@ -253,7 +255,7 @@ impl EpuckRecorder {
         if let Some(s) = t.start {
             let r = send_table(
                 &self.rec,
-                data::RUNS,
+                paths::RUNS,
                 &[off],
                 vec![
                     ("run", runs(1)),
@@ -277,7 +279,7 @@ impl EpuckRecorder {
         let n = t.f_t.len();
         let r = send_table(
             &self.rec,
-            data::FRAMES,
+            paths::FRAMES,
             &on_timeline(&t.f_t),
             vec![
                 ("run", runs(n)),
@@ -308,7 +310,7 @@ impl EpuckRecorder {
         let goals = self.layout.goals().len();
         let r = send_table(
             &self.rec,
-            data::WINDOWS,
+            paths::WINDOWS,
             &on_timeline(&t.w_t),
             vec![
                 ("run", runs(n)),
@@ -325,7 +327,7 @@ impl EpuckRecorder {
         let n = t.e_t.len();
         let r = send_table(
             &self.rec,
-            data::ERRPS,
+            paths::ERRPS,
             &on_timeline(&t.e_t),
             vec![
                 ("run", runs(n)),
@@ -338,7 +340,7 @@ impl EpuckRecorder {
         let n = t.v_t.len();
         let r = send_table(
             &self.rec,
-            data::EVENTS,
+            paths::EVENTS,
             &on_timeline(&t.v_t),
             vec![
                 ("run", runs(n)),
@@ -351,7 +353,7 @@ impl EpuckRecorder {
         if let Some((end, committed)) = t.end {
             let r = send_table(
                 &self.rec,
-                data::ENDS,
+                paths::ENDS,
                 &[off + end],
                 vec![
                     ("run", runs(1)),
@@ -380,8 +382,8 @@ impl EpuckRecorder {
             .with_radii([2.0])
             .with_draw_order(-1.0);
         let layers: [(&str, &dyn rerun::AsComponents); 2] = [
-            ("arena/overview/trajectories", &trajectories),
-            ("arena/overview/detections", &detections),
+            (paths::ARENA_OVERVIEW_TRAJECTORIES, &trajectories),
+            (paths::ARENA_OVERVIEW_DETECTIONS, &detections),
         ];
         for (path, layer) in layers {
             let r = self.rec.log_static(path, layer);
@@ -436,14 +438,14 @@ impl EpuckObserver for EpuckRecorder {
         let p = f.pose;
         self.trajectory.push(cm(p.x_m, p.y_m));
         let r = self.rec.log(
-            "arena/trajectory",
+            paths::ARENA_TRAJECTORY,
             &LineStrips2D::new([self.trajectory.clone()])
                 .with_colors([Color::from_rgb(40, 90, 200)])
                 .with_radii([0.6]),
         );
         self.keep(r);
         let r = self.rec.log(
-            "arena/robot",
+            paths::ARENA_ROBOT,
             &Points2D::new([cm(p.x_m, p.y_m)])
                 .with_radii([3.7])
                 .with_colors([Color::from_rgb(30, 30, 30)]),
@@ -451,7 +453,7 @@ impl EpuckObserver for EpuckRecorder {
         self.keep(r);
         let (s, c) = p.heading_rad.sin_cos();
         let r = self.rec.log(
-            "arena/heading",
+            paths::ARENA_HEADING,
             &Arrows2D::from_vectors([[(8.0 * c) as f32, (8.0 * s) as f32]])
                 .with_origins([cm(p.x_m, p.y_m)])
                 .with_colors([Color::from_rgb(230, 120, 20)]),
@@ -481,7 +483,7 @@ impl EpuckObserver for EpuckRecorder {
             vec![belief_colour(0.0); goals]
         };
         let r = self.rec.log(
-            "arena/goals",
+            paths::ARENA_GOALS,
             &Points2D::new(self.layout.goals().iter().map(|g| cm(g.x_m, g.y_m)))
                 .with_radii([5.0])
                 .with_colors(colours),
@@ -496,30 +498,28 @@ impl EpuckObserver for EpuckRecorder {
             })
             .collect();
         let r = self.rec.log(
-            "arena/target",
+            paths::ARENA_TARGET,
             &LineStrips2D::new([ring])
                 .with_colors([Color::from_rgb(230, 120, 20)])
                 .with_radii([0.7]),
         );
         self.keep(r);
         for (i, &p) in f.belief.iter().enumerate() {
-            let path = format!("belief/city/{}", self.layout.goals()[i].name);
+            let path = paths::belief_city(&self.layout.goals()[i].name);
             let r = self.rec.log(path, &Scalars::single(p));
             self.keep(r);
         }
         let r = self.rec.log(paths::P_ERROR, &Scalars::single(f.p_error));
         self.keep(r);
         // What the detector compared with T_e (the smoothed p(error)).
-        let r = self
-            .rec
-            .log("decoder/evidence", &Scalars::single(f.evidence));
+        let r = self.rec.log(paths::EVIDENCE, &Scalars::single(f.evidence));
         self.keep(r);
         let r = self.rec.log(paths::THRESHOLD, &Scalars::single(self.t_e));
         self.keep(r);
         if f.detected {
             self.detections.push(cm(f.tracked.x_m, f.tracked.y_m));
             let r = self.rec.log(
-                "arena/detections",
+                paths::ARENA_DETECTIONS,
                 &Points2D::new(self.detections.clone())
                     .with_radii([2.5])
                     .with_colors([Color::from_rgb(220, 30, 30)]),
@@ -528,7 +528,7 @@ impl EpuckObserver for EpuckRecorder {
         }
         // The EEG of the last 62.5 ms, sample by sample.
         let n = f.fcz_cz[0].len();
-        let fs = n as f64 / crate::epuck::episode::WINDOW_STEP_SECS;
+        let fs = n as f64 / crate::epuck::plant::WINDOW_STEP_SECS;
         for (name, samples) in ["FCz", "Cz"].iter().zip(&f.fcz_cz) {
             let path = eeg_channel(name);
             for (k, v) in samples.iter().enumerate() {
@@ -579,10 +579,7 @@ pub fn record_epuck_runs_with(
     let layout = &scenario.layout;
     let goal = &layout.goals()[scenario.episode.goal].name;
     let decoder_text = scenario.decoder_text();
-    let t_e = match window_decoder {
-        Some(_) => scenario.params.control.t_e,
-        None => decoder.t_e(scenario.params.control.t_e),
-    };
+    let t_e = decoder.detector_t_e(&scenario.params, window_decoder.is_some());
     let mut recorder = EpuckRecorder::new(file, &scenario.arena, layout, t_e)?;
     let mut out = Vec::with_capacity(runs);
     for k in 0..runs {
@@ -594,10 +591,7 @@ pub fn record_epuck_runs_with(
         out.push(match window_decoder.as_mut() {
             None => run_epuck_once(scenario, decoder, k, &mut recorder)?,
             Some(decode) => crate::epuck::run_epuck_episode_with(
-                &scenario.params,
-                &scenario.arena,
-                layout,
-                scenario.episode,
+                scenario,
                 decoder,
                 seed,
                 &mut recorder,

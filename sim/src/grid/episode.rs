@@ -7,7 +7,7 @@ use errp_robot::{Cell, Grid, GridAction, GridController, QTable};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
-use crate::error::{Result, SimError};
+use crate::error::{Result, SimError, check_p_error};
 use crate::grid::decoder::{AssessmentDecoder, EegSource, OnlineEeg, decide};
 use crate::grid::params::GridTaskParams;
 
@@ -128,17 +128,6 @@ impl GridDecoding<'_> {
             },
             GridDecoding::Scores { error, correct } => GridDecoding::Scores { error, correct },
         }
-    }
-}
-
-/// Checks a p(error) that a decoder of the user's own returned.
-pub fn check_p_error(p: f64) -> Result<f64> {
-    if p.is_finite() && (0.0..=1.0).contains(&p) {
-        Ok(p)
-    } else {
-        Err(SimError::Scenario(format!(
-            "decoder: returned p(error) = {p}, expected a number from 0 to 1"
-        )))
     }
 }
 

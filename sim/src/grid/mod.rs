@@ -19,7 +19,7 @@ pub use decoder::{
 };
 pub use environment::{GridEnvironment, GridFeedback};
 pub use episode::{
-    EpochDecoder, GridDecoding, GridEpisodeResult, GridStep, check_p_error, run_grid_episode,
+    EpochDecoder, GridDecoding, GridEpisodeResult, GridStep, run_grid_episode,
     run_grid_episode_with,
 };
 pub use params::GridTaskParams;

@@ -1,14 +1,15 @@
 //! Timing and limits of a grid episode, and the strategy it runs.
 
-use errp_robot::GridControlParams;
+use errp_robot::{GridControlParams, Valid};
 use serde::{Deserialize, Serialize};
 
 /// Timing and limits of a grid episode.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct GridTaskParams {
-    /// The device's strategy (tau, epsilon, p_c, reward model).
-    pub control: GridControlParams,
+    /// The device's strategy (tau, epsilon, p_c, reward model), checked
+    /// where the scenario entered.
+    pub control: Valid<GridControlParams>,
     /// Shortest inter-action interval (s); the paper: 3.
     pub interval_min_secs: f64,
     /// Longest inter-action interval (s); the paper: 3.5.
@@ -22,7 +23,7 @@ pub struct GridTaskParams {
 impl Default for GridTaskParams {
     fn default() -> Self {
         Self {
-            control: GridControlParams::default(),
+            control: Valid::default(),
             interval_min_secs: 3.0,
             interval_max_secs: 3.5,
             epoch_secs: 0.8,

@@ -8,7 +8,7 @@ use errp_bci::{
     Accuracy, CalibrationSetup, Classifier, LdaDecoder, MeanAccuracy, SessionParts,
     TargetingResult, TargetingStep, calibrate_session, rng::derive_seed, search_ratio,
 };
-use errp_robot::{Grid, QTable};
+use errp_robot::{Grid, GridControlParams, QTable};
 
 use crate::calibration::{CalibrationReport, CalibrationRequest, NoCache, TargetingCache};
 use crate::error::Result;
@@ -388,7 +388,10 @@ pub fn run_grid_scenario_with(
     record_steps: bool,
     mut on_episode: impl FnMut(usize, &GridEpisodeResult),
 ) -> Result<Vec<GridEpisodeResult>> {
-    let table = QTable::compute(Grid::paper(), &scenario.params.control.q())?;
+    let table = QTable::compute(
+        Grid::paper(),
+        &scenario.params.control.part(GridControlParams::q),
+    )?;
     let mut out = Vec::with_capacity(scenario.episodes.len());
     for (k, &(start, goal)) in scenario.episodes.iter().enumerate() {
         let seed = derive_seed(scenario.seed, "grid/episode", k as u64);

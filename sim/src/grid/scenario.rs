@@ -7,8 +7,8 @@
 
 use std::path::{Path, PathBuf};
 
-use errp_bci::{GoalSet, MeanAccuracy, subject};
-use errp_robot::{Cell, Grid, GridControlParams};
+use errp_bci::{GoalSet, RequestedAccuracy, subject};
+use errp_robot::{Cell, Grid, GridControlParams, Valid};
 use rand::Rng;
 use serde::Deserialize;
 
@@ -227,11 +227,11 @@ impl GridScenario {
         };
         // A real decoder is targeted at a mean accuracy; the oracle may also
         // be perfect.
-        let targetable = MeanAccuracy::new(accuracy).is_ok();
-        let ok = match file.decoder {
-            DecoderChoice::Oracle => targetable || accuracy == 1.0,
-            DecoderChoice::Eeg => targetable,
-        };
+        let ok = matches!(
+            (RequestedAccuracy::new(accuracy), file.decoder),
+            (Ok(RequestedAccuracy::Targeted(_)), _)
+                | (Ok(RequestedAccuracy::Perfect), DecoderChoice::Oracle)
+        );
         if !ok {
             return Err(bad(
                 "user.accuracy",
@@ -241,16 +241,16 @@ impl GridScenario {
         }
 
         // Strategy and timing, on top of the paper's defaults.
+        // The device knows its decoder's accuracy from the calibration.
+        // Checked here, once: the controllers take it checked.
+        let control = GridControlParams {
+            assumed_accuracy: accuracy,
+            ..file.control
+        };
         let mut params = GridTaskParams {
-            control: file.control,
+            control: Valid::new(control).map_err(|e| robot_error(path, "control", e))?,
             ..GridTaskParams::default()
         };
-        // The device knows its decoder's accuracy from the calibration.
-        params.control.assumed_accuracy = accuracy;
-        params
-            .control
-            .validate()
-            .map_err(|e| robot_error(path, "control", e))?;
         if let Some(t) = &file.timing {
             let d = GridTaskParams::default();
             params.interval_min_secs = t.interval_min_secs.unwrap_or(d.interval_min_secs);

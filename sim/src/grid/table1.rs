@@ -2,7 +2,7 @@
 //! the fixed and the free goals.
 
 use errp_bci::{GoalSet, TargetingStep, rng::derive_seed, subjects};
-use errp_robot::{Cell, Grid, QTable};
+use errp_robot::{Cell, Grid, GridControlParams, QTable};
 use rayon::prelude::*;
 
 use crate::error::Result;
@@ -73,7 +73,7 @@ pub fn run_table1(
     progress: impl Fn(&str, &TargetingStep) + Sync,
 ) -> Result<Vec<Table1Cell>> {
     let grid = Grid::paper();
-    let table = QTable::compute(grid, &options.params.control.q())?;
+    let table = QTable::compute(grid, &options.params.control.part(GridControlParams::q))?;
     let jobs: Vec<(String, GoalSet, f64, usize)> = subjects()
         .into_iter()
         .enumerate()

@@ -3,20 +3,20 @@
 use std::sync::Arc;
 
 use errp_bci::GoalSet;
-use errp_robot::{Cell, Grid, QTable};
+use errp_robot::{Cell, Grid, GridControlParams, QTable};
 
 use crate::calibration::TargetingCache;
 use crate::error::Result;
-use crate::grid::decoder::AssessmentDecoder;
+use crate::grid::decoder::{AssessmentDecoder, PErrorChoice};
 use crate::grid::episode::{GridEpisodeResult, run_grid_episode};
 use crate::grid::run::{GridShared, prepare_grid_decoder};
 use crate::grid::scenario::{DecoderChoice, EegMode, GridScenario};
+use crate::key::StableKey;
 
 /// About the memory of one epoch in a bank: 312 features and the FCz
 /// trace, as f64.
 const BANK_EPOCH_BYTES: usize = 5_000;
 use crate::paper::PAPER;
-use crate::scenario::AnyScenario;
 use crate::task::{
     Column, ColumnKind, DecoderInfo, EpisodeRow, FieldError, FigureText, PaperPoint, Task,
     TaskInfo, format_number, overall,
@@ -108,27 +108,29 @@ impl Task for GridTask {
     type Decoder = AssessmentDecoder;
     type Runner = GridRunner;
 
-    fn scenario(any: &AnyScenario) -> Option<&GridScenario> {
-        match any {
-            AnyScenario::Grid(s) => Some(s),
-            AnyScenario::Epuck(_) => None,
-        }
-    }
-
     fn decoder_key(s: &GridScenario) -> String {
-        format!(
-            "{:?}",
-            (
-                s.accuracy,
-                s.seed,
-                s.decoder,
-                s.p_error,
-                s.eeg,
-                s.bank_per_class,
-                s.params.interval_min_secs,
-                s.params.interval_max_secs
-            )
-        )
+        let decoder = match s.decoder {
+            DecoderChoice::Eeg => "eeg",
+            DecoderChoice::Oracle => "oracle",
+        };
+        let p_error = match s.p_error {
+            PErrorChoice::Sigmoid => "sigmoid",
+            PErrorChoice::Platt => "platt",
+        };
+        let eeg = match s.eeg {
+            EegMode::Stream => "stream",
+            EegMode::Bank => "bank",
+        };
+        StableKey::new("grid-decoder", 1)
+            .float("accuracy", s.accuracy)
+            .int("seed", s.seed)
+            .text("decoder", decoder)
+            .text("p_error", p_error)
+            .text("eeg", eeg)
+            .int("bank_per_class", s.bank_per_class as u64)
+            .float("interval_min_secs", s.params.interval_min_secs)
+            .float("interval_max_secs", s.params.interval_max_secs)
+            .finish()
     }
 
     fn shared(scenarios: &[&GridScenario]) -> Result<GridShared> {
@@ -149,7 +151,7 @@ impl Task for GridTask {
         Ok(GridRunner {
             scenario: s.clone(),
             decoder,
-            table: QTable::compute(Grid::paper(), &s.params.control.q())?,
+            table: QTable::compute(Grid::paper(), &s.params.control.part(GridControlParams::q))?,
         })
     }
 

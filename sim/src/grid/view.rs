@@ -9,7 +9,7 @@ use rerun::{Boxes2D, Color, Image, Points2D, Scalars, SeriesLines, TextLog};
 use crate::error::Result;
 use crate::grid::GridEpisodeResult;
 use crate::grid::run::GridRunReport;
-use crate::record::data::{self, Column, Provenance, send_table};
+use crate::record::data::{Column, Provenance, send_table};
 use crate::record::{
     RrdFile, SIM_TIME, eeg_channel, log_decoder_series, paths, record_error, task_blueprint,
 };
@@ -19,17 +19,19 @@ const EPISODE_GAP_SECS: f64 = 2.0;
 
 fn blueprint() -> Blueprint {
     task_blueprint(
-        Spatial2DView::new("Grid: cursor, goal, posterior").with_origin("/grid"),
+        Spatial2DView::new("Grid: cursor, goal, posterior").with_origin(paths::GRID),
         vec![
             TimeSeriesView::new("p(error) per action")
                 .with_origin(paths::DECODER)
                 .into(),
-            TimeSeriesView::new("Belief").with_origin("/belief").into(),
+            TimeSeriesView::new("Belief")
+                .with_origin(paths::BELIEF)
+                .into(),
             TimeSeriesView::new("EEG at FCz (uV, preprocessed)")
                 .with_origin(paths::EEG)
                 .into(),
             Spatial2DView::new("Visited states (Fig. 4)")
-                .with_origin("/visits")
+                .with_origin(paths::VISITS)
                 .into(),
         ],
     )
@@ -100,7 +102,7 @@ impl GridRecorder {
             .map(|c| (centre(&grid, c), [1.0, 1.0]))
             .collect();
         rec.log_static(
-            "grid/cells",
+            paths::GRID_CELLS,
             &Boxes2D::from_centers_and_sizes(
                 outline.iter().map(|o| o.0),
                 outline.iter().map(|o| o.1),
@@ -110,11 +112,11 @@ impl GridRecorder {
         .map_err(&err)?;
         log_decoder_series(rec, "0.5").map_err(&err)?;
         rec.log_static(
-            "belief/true_goal",
+            paths::BELIEF_TRUE_GOAL,
             &SeriesLines::new().with_names(["p(true goal)"]),
         )
         .map_err(&err)?;
-        rec.log_static("belief/max", &SeriesLines::new().with_names(["max p"]))
+        rec.log_static(paths::BELIEF_MAX, &SeriesLines::new().with_names(["max p"]))
             .map_err(&err)?;
         drop(err);
         Ok(Self {
@@ -153,21 +155,21 @@ impl GridRecorder {
         )
         .map_err(&err)?;
         rec.log(
-            "grid/goal",
+            paths::GRID_GOAL,
             &Boxes2D::from_centers_and_sizes([centre(&grid, ep.goal)], [[0.9, 0.9]])
                 .with_colors([Color::from_rgb(220, 40, 40)])
                 .with_labels(["G"]),
         )
         .map_err(&err)?;
         rec.log(
-            "grid/start",
+            paths::GRID_START,
             &Points2D::new([centre(&grid, ep.start)])
                 .with_labels(["S"])
                 .with_colors([Color::from_rgb(40, 160, 40)]),
         )
         .map_err(&err)?;
         rec.log(
-            "grid/cursor",
+            paths::GRID_CURSOR,
             &Points2D::new([centre(&grid, ep.start)])
                 .with_radii([0.25])
                 .with_colors([Color::from_rgb(30, 30, 30)]),
@@ -178,11 +180,11 @@ impl GridRecorder {
             rec.set_duration_secs(SIM_TIME, t);
             let has_belief = step.belief.iter().all(|p| p.is_finite());
             if has_belief {
-                rec.log("grid/posterior", &heat_map(&grid, &step.belief))
+                rec.log(paths::GRID_POSTERIOR, &heat_map(&grid, &step.belief))
                     .map_err(&err)?;
             }
             rec.log(
-                "grid/cursor",
+                paths::GRID_CURSOR,
                 &Points2D::new([centre(&grid, step.to)])
                     .with_radii([0.25])
                     .with_colors([Color::from_rgb(30, 30, 30)]),
@@ -194,12 +196,13 @@ impl GridRecorder {
                 .map_err(&err)?;
             if has_belief {
                 rec.log(
-                    "belief/true_goal",
+                    paths::BELIEF_TRUE_GOAL,
                     &Scalars::single(step.belief[grid.index(ep.goal)]),
                 )
                 .map_err(&err)?;
                 let max = step.belief.iter().copied().fold(0.0, f64::max);
-                rec.log("belief/max", &Scalars::single(max)).map_err(&err)?;
+                rec.log(paths::BELIEF_MAX, &Scalars::single(max))
+                    .map_err(&err)?;
             }
             let decoded = if step.p_error >= 0.5 {
                 "error"
@@ -234,7 +237,7 @@ impl GridRecorder {
         rec.set_duration_secs(SIM_TIME, end);
         let most = ep.visits.iter().copied().max().unwrap_or(1).max(1) as f64;
         let visits: Vec<f64> = ep.visits.iter().map(|&v| f64::from(v) / most).collect();
-        rec.log("visits/map", &heat_map(&grid, &visits))
+        rec.log(paths::VISITS_MAP, &heat_map(&grid, &visits))
             .map_err(&err)?;
         let outcome = match ep.committed {
             Some(c) if c == ep.goal => format!("reached the goal {c}"),
@@ -281,7 +284,7 @@ fn send_episode_tables(
     let runs = |n: usize| Column::I64(vec![run; n]);
     send_table(
         rec,
-        data::RUNS,
+        paths::RUNS,
         &[t0],
         vec![
             ("run", runs(1)),
@@ -302,7 +305,7 @@ fn send_episode_tables(
     };
     send_table(
         rec,
-        data::ACTIONS,
+        paths::ACTIONS,
         &times,
         vec![
             ("run", runs(n)),
@@ -344,7 +347,7 @@ fn send_episode_tables(
     )?;
     send_table(
         rec,
-        data::ENDS,
+        paths::ENDS,
         &[t0 + ep.total_secs],
         vec![
             ("run", runs(1)),

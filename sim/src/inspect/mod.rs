@@ -11,7 +11,8 @@ use errp_robot::{Cell, Grid, GridAction};
 
 use crate::epuck::{EpuckEpisodeResult, EpuckScenario, PHYSICS_DT_SECS, WINDOW_STEP_SECS};
 use crate::grid::{GridEpisodeResult, GridScenario, GridStep};
-use crate::record::data::{self, Column, Provenance};
+use crate::record::data::{Column, Provenance};
+use crate::record::paths;
 use crate::scenario::AnyScenario;
 
 mod read;
@@ -218,18 +219,18 @@ fn epuck_results(
     scenario: &EpuckScenario,
 ) -> Result<Vec<EpuckEpisodeResult>, String> {
     let n_goals = scenario.layout.goals().len();
-    let runs = View::of(tables, data::RUNS)?;
-    let frames = View::of(tables, data::FRAMES)?;
-    let windows = View::of(tables, data::WINDOWS)?;
-    let ends = View::of(tables, data::ENDS)?;
+    let runs = View::of(tables, paths::RUNS)?;
+    let frames = View::of(tables, paths::FRAMES)?;
+    let windows = View::of(tables, paths::WINDOWS)?;
+    let ends = View::of(tables, paths::ENDS)?;
     let empty = Table::default();
-    let errps = tables.get(data::ERRPS).map_or(
+    let errps = tables.get(paths::ERRPS).map_or(
         View {
-            name: data::ERRPS,
+            name: paths::ERRPS,
             table: &empty,
         },
         |table| View {
-            name: data::ERRPS,
+            name: paths::ERRPS,
             table,
         },
     );
@@ -243,11 +244,11 @@ fn epuck_results(
     };
     let end_run = ends.i64("run")?;
     for (name, r) in [
-        (data::RUNS, run_col),
-        (data::FRAMES, f_run),
-        (data::WINDOWS, w_run),
-        (data::ERRPS, e_run),
-        (data::ENDS, end_run),
+        (paths::RUNS, run_col),
+        (paths::FRAMES, f_run),
+        (paths::WINDOWS, w_run),
+        (paths::ERRPS, e_run),
+        (paths::ENDS, end_run),
     ] {
         check_run_order(name, r)?;
     }
@@ -293,7 +294,7 @@ fn epuck_results(
     let mut out = Vec::new();
     for (k, &r) in run_col.iter().enumerate() {
         if r != k as i64 {
-            return Err(format!("its table {} skips run {k}", data::RUNS));
+            return Err(format!("its table {} skips run {k}", paths::RUNS));
         }
         let Some(e) = end_run.iter().position(|&x| x == r) else {
             // A run without its end: the recording stopped in it.
@@ -428,12 +429,12 @@ fn grid_results(
     tables: &std::collections::BTreeMap<String, Table>,
 ) -> Result<Vec<GridEpisodeResult>, String> {
     let grid = Grid::paper();
-    let runs = View::of(tables, data::RUNS)?;
-    let ends = View::of(tables, data::ENDS)?;
+    let runs = View::of(tables, paths::RUNS)?;
+    let ends = View::of(tables, paths::ENDS)?;
     let empty = Table::default();
     let actions = View {
-        name: data::ACTIONS,
-        table: tables.get(data::ACTIONS).unwrap_or(&empty),
+        name: paths::ACTIONS,
+        table: tables.get(paths::ACTIONS).unwrap_or(&empty),
     };
     let run_col = runs.i64("run")?;
     let end_run = ends.i64("run")?;
@@ -443,9 +444,9 @@ fn grid_results(
         actions.i64("run")?
     };
     for (name, r) in [
-        (data::RUNS, run_col),
-        (data::ACTIONS, a_run),
-        (data::ENDS, end_run),
+        (paths::RUNS, run_col),
+        (paths::ACTIONS, a_run),
+        (paths::ENDS, end_run),
     ] {
         check_run_order(name, r)?;
     }
@@ -493,7 +494,7 @@ fn grid_results(
         _ => {
             return Err(format!(
                 "its table {} has no column `action`",
-                data::ACTIONS
+                paths::ACTIONS
             ));
         }
     };
@@ -511,7 +512,7 @@ fn grid_results(
     let mut out = Vec::new();
     for (k, &r) in run_col.iter().enumerate() {
         if r != k as i64 {
-            return Err(format!("its table {} skips run {k}", data::RUNS));
+            return Err(format!("its table {} skips run {k}", paths::RUNS));
         }
         let Some(e) = end_run.iter().position(|&x| x == r) else {
             break;

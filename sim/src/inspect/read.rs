@@ -14,7 +14,8 @@ use rerun::external::arrow::datatypes::DataType;
 use rerun::log::{Chunk, LogMsg};
 
 use crate::inspect::InspectError;
-use crate::record::data::{self, Column, FORMAT, FORMAT_VERSION, Provenance};
+use crate::record::data::{Column, FORMAT, FORMAT_VERSION, Provenance};
+use crate::record::paths;
 
 /// The largest recording read (bytes): more than 5000 grid episodes or 200
 /// e-puck runs make.
@@ -160,9 +161,9 @@ pub(crate) fn read_raw(path: &Path) -> Result<RawRecording, InspectError> {
                 let chunk = Chunk::from_arrow_msg(&arrow)
                     .map_err(|e| bad(format!("it is corrupt: {e}")))?;
                 let entity = chunk.entity_path().to_string();
-                if entity == data::PROVENANCE {
+                if entity == paths::PROVENANCE {
                     raw.provenance = first_text(&chunk);
-                } else if entity.starts_with("/errp/") {
+                } else if entity.starts_with(paths::TABLES) {
                     let table = raw.tables.entry(entity.clone()).or_default();
                     read_chunk(&chunk, table)
                         .map_err(|e| bad(format!("its table {entity} is corrupt: {e}")))?;
@@ -297,13 +298,13 @@ pub(crate) fn parse_provenance(
             Some(app) if app.starts_with("errp") => format!(
                 "it is a recording of errp ({app}) made before recordings carried their \
                  provenance and data tables ({})); record it again with this errp",
-                data::PROVENANCE
+                paths::PROVENANCE
             ),
             Some(app) => format!(
                 "it is a Rerun recording of `{app}`, not of errp (it has no {})",
-                data::PROVENANCE
+                paths::PROVENANCE
             ),
-            None => format!("it holds no recording of errp (no {})", data::PROVENANCE),
+            None => format!("it holds no recording of errp (no {})", paths::PROVENANCE),
         }));
     };
     let value: serde_json::Value =
@@ -311,7 +312,7 @@ pub(crate) fn parse_provenance(
     if value.get("format").and_then(|v| v.as_str()) != Some(FORMAT) {
         return Err(bad(format!(
             "its {} does not say `\"format\": \"{FORMAT}\"`",
-            data::PROVENANCE
+            paths::PROVENANCE
         )));
     }
     let version = value

@@ -8,7 +8,8 @@ use errp_robot::Grid;
 
 use crate::epuck::{EpuckEpisodeResult, PHASE_NAMES, PHYSICS_DT_SECS, STEP_NAMES};
 use crate::inspect::{Recording, Runs};
-use crate::record::data::{self, Column};
+use crate::record::data::Column;
+use crate::record::paths;
 
 /// One tidy table.
 #[derive(Debug, Clone, PartialEq)]
@@ -152,7 +153,7 @@ fn bools<'a>(t: &'a crate::inspect::Table, c: &str) -> &'a [bool] {
 /// frames (one pass over them).
 pub fn phase_secs(rec: &Recording) -> Vec<[f64; 3]> {
     let mut out = vec![[0.0; 3]; rec.n_runs()];
-    if let Some(t) = get(rec, data::FRAMES) {
+    if let Some(t) = get(rec, paths::FRAMES) {
         for (r, p) in i64s(t, "run").iter().zip(i64s(t, "phase")) {
             if let Some(slot) = usize::try_from(*r)
                 .ok()
@@ -280,8 +281,8 @@ fn epuck_tables(
     };
     let mut out = vec![runs];
     let empty = crate::inspect::Table::default();
-    let frames = get(rec, data::FRAMES).unwrap_or(&empty);
-    let windows = get(rec, data::WINDOWS).unwrap_or(&empty);
+    let frames = get(rec, paths::FRAMES).unwrap_or(&empty);
+    let windows = get(rec, paths::WINDOWS).unwrap_or(&empty);
     // p(error) and the evidence of the latest window at each frame.
     let (w_run, w_t) = (i64s(windows, "run"), f64s(windows, "t_s"));
     let (w_p, w_ev) = (f64s(windows, "p_error"), f64s(windows, "evidence"));
@@ -423,7 +424,7 @@ fn epuck_tables(
             ("p", Column::F64(b.3)),
         ],
     });
-    let errps = get(rec, data::ERRPS).unwrap_or(&empty);
+    let errps = get(rec, paths::ERRPS).unwrap_or(&empty);
     out.push(CsvTable {
         name: "errps",
         columns: vec![
@@ -445,7 +446,7 @@ fn epuck_tables(
             ),
         ],
     });
-    let events = get(rec, data::EVENTS).unwrap_or(&empty);
+    let events = get(rec, paths::EVENTS).unwrap_or(&empty);
     out.push(CsvTable {
         name: "events",
         columns: vec![

@@ -1,5 +1,5 @@
 //! The data a recording carries beside what the viewer draws: how it was
-//! made ([`Provenance`], a static JSON document at [`PROVENANCE`]) and, for
+//! made ([`Provenance`], a static JSON document at [`PROVENANCE`](crate::record::paths::PROVENANCE)) and, for
 //! every run, tables of what happened (one Rerun chunk per table and run,
 //! sent with `send_columns` on the `sim_time` timeline, each row also
 //! holding its `run` and its time `t_s` within the run). `errp inspect` and
@@ -24,24 +24,7 @@ use rerun::external::arrow::array::{
 use rerun::{ComponentDescriptor, RecordingStream, SerializedComponentBatch};
 use serde::{Deserialize, Serialize};
 
-use crate::record::{RrdFile, SIM_TIME, record_error};
-
-/// The provenance document (static).
-pub const PROVENANCE: &str = "/errp/provenance";
-/// One row per run, at its start.
-pub const RUNS: &str = "/errp/runs";
-/// E-puck: one row per physics step.
-pub const FRAMES: &str = "/errp/frames";
-/// E-puck: one row per decoder window.
-pub const WINDOWS: &str = "/errp/windows";
-/// E-puck: one row per ErrP of the user.
-pub const ERRPS: &str = "/errp/errps";
-/// Grid: one row per action.
-pub const ACTIONS: &str = "/errp/actions";
-/// One row per run, at its end.
-pub const ENDS: &str = "/errp/ends";
-/// E-puck: the event log with run numbers.
-pub const EVENTS: &str = "/errp/events";
+use crate::record::{RrdFile, SIM_TIME, paths, record_error};
 
 /// [`Provenance::format`] of the recordings this build writes.
 pub const FORMAT: &str = "errp-recording";
@@ -100,11 +83,11 @@ impl Provenance {
         }
     }
 
-    /// Logs the document, static, at [`PROVENANCE`] (a text document the
+    /// Logs the document, static, at [`PROVENANCE`](crate::record::paths::PROVENANCE) (a text document the
     /// viewer shows).
     pub fn log(&self, rec: &RecordingStream) -> Result<(), rerun::RecordingStreamError> {
         let json = serde_json::to_string_pretty(self).unwrap_or_default();
-        rec.log_static(PROVENANCE, &rerun::TextDocument::new(json))
+        rec.log_static(paths::PROVENANCE, &rerun::TextDocument::new(json))
     }
 
     /// [`Provenance::log`] into `file`, with `runs` set, its error naming

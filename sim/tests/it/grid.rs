@@ -2,7 +2,7 @@
 //! determinism checks with fixed seeds.
 
 use errp_bci::Accuracy;
-use errp_robot::{Grid, QTable};
+use errp_robot::{Grid, GridControlParams, QTable};
 use errp_sim::grid::{
     AssessmentDecoder, EegDecoder, FIXED_PAIRS, GridTaskParams, run_grid_episode,
 };
@@ -20,7 +20,7 @@ fn streamed(accuracy: f64, seed: u64) -> EegDecoder {
 }
 
 pub(crate) fn table(params: &GridTaskParams) -> QTable {
-    QTable::compute(Grid::paper(), &params.control.q()).unwrap()
+    QTable::compute(Grid::paper(), &params.control.part(GridControlParams::q)).unwrap()
 }
 
 fn episodes(

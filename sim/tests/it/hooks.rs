@@ -6,10 +6,10 @@
 use std::sync::Arc;
 
 use errp_bci::{EegBlock, EpochWindow, ErrorModel};
-use errp_robot::{Cell, Grid, GridAction};
+use errp_robot::{Cell, Grid, GridAction, StepKind};
 use errp_sim::epuck::{
     EpuckAction, EpuckEnvironment, EpuckObserver, PhysicsFrame, WindowFrame,
-    prepare_continuous_decoder, run_epuck_episode, run_epuck_episode_with,
+    prepare_continuous_decoder, run_epuck_episode, run_epuck_episode_with, shared_control,
 };
 use errp_sim::grid::{
     AssessmentDecoder, EpochBlocks, GridDecoding, GridEnvironment, GridTaskParams, PErrorMapping,
@@ -168,16 +168,7 @@ fn a_window_decoder_reads_the_windows_the_svm_reads() {
     let mut s = epuck::scenario("mexico_to_pisa.toml");
     s.params.max_secs = 20.0;
     let (decoder, _) = prepare_continuous_decoder(&s, |_| {}).unwrap();
-    let want = run_epuck_episode(
-        &s.params,
-        &s.arena,
-        &s.layout,
-        s.episode,
-        &decoder,
-        5,
-        &mut (),
-    )
-    .unwrap();
+    let want = run_epuck_episode(&s, &decoder, 5, &mut ()).unwrap();
     let mut scratch = Vec::new();
     let mut calls = 0;
     let mut decode = |w: &EegBlock| {
@@ -186,17 +177,7 @@ fn a_window_decoder_reads_the_windows_the_svm_reads() {
         decoder.features.extract_into(w, 0, &mut scratch);
         Ok(decoder.model.p_error(&scratch))
     };
-    let got = run_epuck_episode_with(
-        &s.params,
-        &s.arena,
-        &s.layout,
-        s.episode,
-        &decoder,
-        5,
-        &mut (),
-        Some(&mut decode),
-    )
-    .unwrap();
+    let got = run_epuck_episode_with(&s, &decoder, 5, &mut (), Some(&mut decode)).unwrap();
     assert_eq!(got, want);
     assert_eq!(calls as f64, (want.time_secs / 0.0625).round());
 
@@ -249,6 +230,111 @@ fn a_window_decoder_reads_the_windows_the_svm_reads() {
         .unwrap();
     assert!(on_start.ended());
     assert_eq!(seen.end, Some((0.125, Some(start_city(&s)))));
+}
+
+/// An episode of the shared control is the environment driven by the
+/// shared control: the same physics steps, ErrPs, p(error), detections and
+/// belief, bit for bit, and the same result. (The episode and the
+/// environment share one loop; this holds the episode's own parts, the
+/// controller's use of each window and the scoring, to it.)
+#[test]
+fn an_episode_is_the_environment_driven_by_the_shared_control() {
+    let mut s = epuck::scenario("mexico_to_pisa.toml");
+    s.params.max_secs = 60.0;
+    let (decoder, _) = prepare_continuous_decoder(&s, |_| {}).unwrap();
+    let seed = 11;
+    let mut episode = Log::default();
+    let want = run_epuck_episode(&s, &decoder, seed, &mut episode).unwrap();
+
+    let decoder = Arc::new(decoder);
+    let mut env = EpuckEnvironment::new(decoder.clone(), &s, None, seed).unwrap();
+    let mut controller = shared_control(&s, &decoder).unwrap();
+    let mut driven = Log::default();
+    let mut detections = Vec::new();
+    let mut committed = None;
+    for _ in 0..(s.params.max_secs / 0.0625).ceil() as usize {
+        let w = env.window_driven(&mut controller, &mut driven).unwrap();
+        let time_secs = env.time_secs();
+        let obs = controller
+            .observe(w.decision.detected, &env.tracked(), time_secs)
+            .unwrap();
+        let detected = w.decision.detected && obs.step != StepKind::Idle;
+        if detected {
+            detections.push(driven.last_pose);
+        }
+        let mut row = vec![
+            time_secs,
+            w.p_error,
+            w.decision.evidence,
+            f64::from(u8::from(detected)),
+        ];
+        row.extend(controller.belief().probabilities());
+        driven.windows.push(bits(&row));
+        if obs.converged.is_some() {
+            committed = obs.converged;
+            break;
+        }
+    }
+    assert!(
+        episode.physics.len() > 400 && want.detected_errors >= 2 && want.errps >= 2,
+        "the episode exercises the loop: {want:?}"
+    );
+    assert_eq!(driven.physics, episode.physics, "trajectory");
+    assert_eq!(driven.errps, episode.errps, "ErrPs");
+    assert_eq!(
+        driven.windows, episode.windows,
+        "p(error), detections, belief"
+    );
+    assert_eq!(committed, want.committed);
+    assert_eq!(detections, want.detections);
+    assert_eq!(env.time_secs().to_bits(), want.time_secs.to_bits());
+}
+
+fn bits(x: &[f64]) -> Vec<u64> {
+    x.iter().map(|v| v.to_bits()).collect()
+}
+
+/// Everything an observer sees, as bits.
+#[derive(Default)]
+struct Log {
+    physics: Vec<Vec<u64>>,
+    errps: Vec<Vec<u64>>,
+    windows: Vec<Vec<u64>>,
+    last_pose: [f64; 2],
+}
+
+impl EpuckObserver for Log {
+    fn on_physics(&mut self, f: &PhysicsFrame) {
+        let (p, t, w) = (f.pose, f.tracked, f.wheels);
+        self.physics.push(bits(&[
+            f.time_secs,
+            p.x_m,
+            p.y_m,
+            p.heading_rad,
+            t.x_m,
+            t.y_m,
+            t.heading_rad,
+            w.left_m_per_s,
+            w.right_m_per_s,
+            f.phase as f64,
+            f.target as f64,
+        ]));
+        self.last_pose = [p.x_m, p.y_m];
+    }
+    fn on_errp(&mut self, time_secs: f64, onset_secs: f64, phase: usize) {
+        self.errps
+            .push(bits(&[time_secs, onset_secs, phase as f64]));
+    }
+    fn on_window(&mut self, f: &WindowFrame) {
+        let mut row = vec![
+            f.time_secs,
+            f.p_error,
+            f.evidence,
+            f64::from(u8::from(f.detected)),
+        ];
+        row.extend(&f.belief);
+        self.windows.push(bits(&row));
+    }
 }
 
 /// The city the scenario's robot starts on.

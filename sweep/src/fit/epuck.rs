@@ -226,7 +226,6 @@ pub enum FitOutcome {
 /// Runs the sweeps into `out` (resuming what is there), computes the fit
 /// and writes [`FIT_FILES`]. `before_sweep(i, n, run, seed)` is called
 /// before sweep i of n, for progress.
-#[allow(clippy::too_many_arguments)]
 pub fn run_epuck_fit(
     spec: &EpuckFitSpec,
     out: &Path,

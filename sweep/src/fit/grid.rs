@@ -27,7 +27,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use errp_bci::rng::{derive_seed, stream};
 use errp_bci::{GoalSet, subjects};
-use errp_robot::{Cell, Grid, QTable};
+use errp_robot::{Cell, Grid, GridControlParams, QTable};
 use errp_sim::grid::{
     AssessmentDecoder, DecoderChoice, EegMode, FIXED_PAIRS, GridEpisodeResult, GridScenario,
     GridShared, GridTaskParams, PErrorChoice, free_pairs, prepare_grid_decoder, run_grid_episode,
@@ -436,9 +436,11 @@ pub fn run_grid_fit(
     let mut runs: Vec<Vec<Vec<Vec<Run>>>> = Vec::with_capacity(points);
     for &g in &spec.goal_rewards {
         let mut params = base;
-        params.control.goal_reward = g;
-        params.control.epsilon = spec.epsilon;
-        let table = QTable::compute(Grid::paper(), &params.control.q())?;
+        params.control = base.control.with(|c| {
+            c.goal_reward = g;
+            c.epsilon = spec.epsilon;
+        })?;
+        let table = QTable::compute(Grid::paper(), &params.control.part(GridControlParams::q))?;
         let at_point: Vec<Vec<Vec<Run>>> = calibrations
             .par_iter()
             .map(|c| {
