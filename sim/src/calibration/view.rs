@@ -73,7 +73,6 @@ fn log_calibration(
     montage: &Montage,
     path: &Path,
 ) -> Result<()> {
-    let err = record_error(path);
     let ga = report
         .calibrated
         .session
@@ -84,7 +83,21 @@ fn log_calibration(
             message: "the calibration was run without grand averages".into(),
         })?;
     let diff = ga.difference();
+    log_grand_averages(rec, ga, &diff, path)?;
+    rec.reset_time();
+    let (peak_ms, limit) = log_topography(rec, ga, &diff, montage, path)?;
+    log_summary(rec, report, peak_ms, limit, path)
+}
 
+/// The grand averages of Fig. 1 on the latency timeline: error, correct and
+/// their difference at each channel of [`GA_CHANNELS`].
+fn log_grand_averages(
+    rec: &rerun::RecordingStream,
+    ga: &GrandAverage,
+    diff: &impl std::ops::Index<(usize, usize), Output = f64>,
+    path: &Path,
+) -> Result<()> {
+    let err = record_error(path);
     for name in GA_CHANNELS {
         let row = channel_row(ga, name, path)?;
         let base = paths::grand_average(name);
@@ -120,9 +133,19 @@ fn log_calibration(
             .map_err(&err)?;
         }
     }
-    rec.reset_time();
+    Ok(())
+}
 
-    // Topography of the difference at its largest |value| at FCz, 150-600 ms.
+/// The scalp map of the difference at its largest |value| at FCz within
+/// 150-600 ms; returns that time (ms) and the colour range (uV).
+fn log_topography(
+    rec: &rerun::RecordingStream,
+    ga: &GrandAverage,
+    diff: &impl std::ops::Index<(usize, usize), Output = f64>,
+    montage: &Montage,
+    path: &Path,
+) -> Result<(f64, f64)> {
+    let err = record_error(path);
     let fcz = channel_row(ga, "FCz", path)?;
     let peak = (0..ga.times_ms.len())
         .filter(|&t| (150.0..=600.0).contains(&ga.times_ms[t]))
@@ -183,6 +206,19 @@ fn log_calibration(
     )
     .map_err(&err)?;
 
+    Ok((ga.times_ms[peak], limit))
+}
+
+/// The calibration in words: the accuracy requested and reached, the
+/// decoder, the topography's time and range, the targeting steps.
+fn log_summary(
+    rec: &rerun::RecordingStream,
+    report: &CalibrationReport,
+    peak_ms: f64,
+    limit: f64,
+    path: &Path,
+) -> Result<()> {
+    let err = record_error(path);
     let t = &report.targeting;
     let a = &report.calibrated.accuracy;
     let mut md = format!(
@@ -203,7 +239,7 @@ fn log_calibration(
         100.0 * a.mean(),
         report.calibrated.model.n_components(),
         report.calibrated.model.shrinkage(),
-        ga.times_ms[peak],
+        peak_ms,
         limit,
     );
     for s in &t.steps {

@@ -6,12 +6,12 @@
 //! the window is scored against the ErrPs the user produced.
 
 use errp_bci::{Accuracy, ResponseSpan};
-use errp_robot::{ContinuousController, Pose, StepKind};
+use errp_robot::{ContinuousController, StepKind};
 use serde::{Deserialize, Serialize};
 
 use crate::epuck::decoder::ContinuousDecoder;
 use crate::epuck::observer::EpuckObserver;
-use crate::epuck::plant::{EpuckPlant, PlantWindow, WINDOW_STEP_SECS, WindowDecoder};
+use crate::epuck::plant::{EpuckPlant, WINDOW_STEP_SECS, WindowDecoder};
 use crate::epuck::scenario::EpuckScenario;
 use crate::error::Result;
 
@@ -109,7 +109,7 @@ pub fn run_epuck_episode_with(
     let names = scenario.layout.goals();
     let mut plant = EpuckPlant::new(scenario, goal, decoder, window_decoder.is_some(), seed)?;
     let mut controller = shared_control(scenario, decoder)?;
-    let mut score = Score::new(decoder, plant.t_e());
+    let mut score = Score::new(decoder.detection_span(), decoder.window_span(), plant.t_e());
     let watching = observer.watches();
     if watching {
         observer.on_start(&plant.start(decoder));
@@ -125,7 +125,12 @@ pub fn run_epuck_episode_with(
         let obs = controller.observe(w.decision.detected, &plant.tracked(), time_secs)?;
         let used = obs.step != StepKind::Idle;
         let detected = w.decision.detected && used;
-        let real = score.window(&w, time_secs, obs.step, detected, plant.pose());
+        for &(onset, phase) in &w.errps {
+            score.errp(onset, phase);
+        }
+        let pose = plant.pose();
+        let step = step_index(obs.step);
+        let real = score.window(time_secs, w.p_error, step, detected, [pose.x_m, pose.y_m]);
         if watching {
             if detected {
                 let what = if obs.detected {
@@ -180,7 +185,14 @@ pub fn run_epuck_episode_with(
         }
         observer.on_end(plant.time_secs(), committed);
     }
-    Ok(score.finish(goal, committed, &plant))
+    let (time_secs, path_m) = (plant.time_secs(), plant.path_m());
+    Ok(score.finish(
+        goal,
+        committed,
+        time_secs,
+        path_m,
+        plant.max_lateral_m_per_s(),
+    ))
 }
 
 /// The shared control of an episode of `scenario` with `decoder`. Left
@@ -216,8 +228,9 @@ fn step_index(step: StepKind) -> usize {
 }
 
 /// An episode's windows and detections scored against the ErrPs the user
-/// produced.
-struct Score {
+/// produced: by the episode as it runs, and by `errp inspect` from a
+/// recording's tables.
+pub(crate) struct Score {
     span: ResponseSpan,
     window_span: ResponseSpan,
     t_e: f64,
@@ -240,9 +253,9 @@ struct Score {
 }
 
 impl Score {
-    fn new(decoder: &ContinuousDecoder, t_e: f64) -> Self {
-        let span = decoder.detection_span();
-        let window_span = decoder.window_span();
+    /// Scoring over the detector's response `span` and the windows'
+    /// `window_span`, with the detector at `t_e`.
+    pub(crate) fn new(span: ResponseSpan, window_span: ResponseSpan, t_e: f64) -> Self {
         Self {
             span,
             window_span,
@@ -263,24 +276,30 @@ impl Score {
         }
     }
 
-    /// Scores window `w`, which ended at `time_secs` with the controller's
-    /// `step`, and the detection the controller used (`detected`) at the
-    /// true `pose`. True if an ErrP's detection span holds the window.
-    fn window(
+    /// The user produced an ErrP with time zero `onset`, judging a move in
+    /// `phase` ([`crate::epuck::PHASE_NAMES`]).
+    pub(crate) fn errp(&mut self, onset: f64, phase: usize) {
+        self.errps.push((onset, phase));
+    }
+
+    /// Scores the window that ended at `time_secs` with `p_error` and the
+    /// controller's `step` ([`crate::epuck::STEP_NAMES`]), and the
+    /// detection the controller used (`detected`) with the robot `at` (m).
+    /// True if an ErrP's detection span holds the window.
+    pub(crate) fn window(
         &mut self,
-        w: &PlantWindow,
         time_secs: f64,
-        step: StepKind,
+        p_error: f64,
+        step: usize,
         detected: bool,
-        pose: Pose,
+        at: [f64; 2],
     ) -> bool {
-        self.errps.extend_from_slice(&w.errps);
         while self.recent < self.errps.len() && self.errps[self.recent].0 < time_secs - self.horizon
         {
             self.recent += 1;
         }
         let near = &self.errps[self.recent..];
-        let says_error = w.p_error >= self.t_e;
+        let says_error = p_error >= self.t_e;
         let window_span = self.window_span;
         let in_window_span = near
             .iter()
@@ -302,13 +321,14 @@ impl Score {
             .find(|&&(o, _)| self.span.contains(o, time_secs))
             .map(|&(_, phase)| phase);
         let real = judged.is_some();
-        if step != StepKind::Idle && !real {
+        // Step 3 is idle: stopped after a detection, not error-free time.
+        if step != 3 && !real {
             self.clean_windows += 1;
         }
         if detected {
             self.detections.push(time_secs);
-            self.detected_at.push([pose.x_m, pose.y_m]);
-            self.by_phase[step_index(step).min(2)] += 1;
+            self.detected_at.push(at);
+            self.by_phase[step.min(2)] += 1;
             match judged {
                 Some(k) => self.by_judged[k] += 1,
                 None => self.false_detections += 1,
@@ -317,15 +337,17 @@ impl Score {
         real
     }
 
-    /// The result of the episode that ended as `plant` stands, committed to
-    /// `committed` (or timed out).
-    fn finish(
+    /// The result of the episode that ended at `time_secs`, committed to
+    /// `committed` (or timed out), after driving `path_m` with sideways
+    /// speeds up to `max_lateral_m_per_s`.
+    pub(crate) fn finish(
         self,
         goal: usize,
         committed: Option<usize>,
-        plant: &EpuckPlant,
+        time_secs: f64,
+        path_m: f64,
+        max_lateral_m_per_s: f64,
     ) -> EpuckEpisodeResult {
-        let time_secs = plant.time_secs();
         // ErrPs whose detection span closed within the episode, and those of
         // them with no detection in it.
         let span = self.span;
@@ -357,8 +379,8 @@ impl Score {
                 n_correct: self.n_clean_windows,
                 n_error: self.n_err_windows,
             },
-            path_m: plant.path_m(),
-            max_lateral_m_per_s: plant.max_lateral_m_per_s(),
+            path_m,
+            max_lateral_m_per_s,
             detections: self.detected_at,
         }
     }

@@ -35,6 +35,16 @@ pub const WINDOW_STEP_SECS: f64 = errp_bci::WINDOW_STEP_SECS;
 /// The physics time step (s).
 pub const PHYSICS_DT_SECS: f64 = WINDOW_STEP_SECS / STEPS_PER_WINDOW as f64;
 
+/// The distance (m) and the sideways speed (m/s, its size) of one physics
+/// step from `from` to `to`: what an episode measures of the motion, and
+/// what `errp inspect` measures again from a recording's frames.
+pub(crate) fn step_motion(from: Pose, to: Pose) -> (f64, f64) {
+    let (dx, dy) = (to.x_m - from.x_m, to.y_m - from.y_m);
+    let mid = from.heading_rad + 0.5 * wrap_angle(to.heading_rad - from.heading_rad);
+    let lateral = (-mid.sin() * dx + mid.cos() * dy) / PHYSICS_DT_SECS;
+    ((dx * dx + dy * dy).sqrt(), lateral.abs())
+}
+
 /// A decoder of the user's own for the e-puck: given the sliding window
 /// every 62.5 ms (the last 800 ms of preprocessed EEG, `(n_channels,
 /// n_samples)`), it returns p(error), a number from 0 to 1.
@@ -220,12 +230,10 @@ impl EpuckPlant {
         let applied = safe.apply_noise(&self.epuck, &mut self.wheels_rng);
         self.world.step(applied.to_twist(&self.epuck));
         self.time_secs += PHYSICS_DT_SECS;
-        let (pose, next) = (self.pose, self.world.pose());
-        let (dx, dy) = (next.x_m - pose.x_m, next.y_m - pose.y_m);
-        let mid = pose.heading_rad + 0.5 * wrap_angle(next.heading_rad - pose.heading_rad);
-        let lateral = (-mid.sin() * dx + mid.cos() * dy) / PHYSICS_DT_SECS;
-        self.max_lateral_m_per_s = self.max_lateral_m_per_s.max(lateral.abs());
-        self.path_m += (dx * dx + dy * dy).sqrt();
+        let next = self.world.pose();
+        let (distance, lateral) = step_motion(self.pose, next);
+        self.max_lateral_m_per_s = self.max_lateral_m_per_s.max(lateral);
+        self.path_m += distance;
         self.pose = next;
         self.tracked = self.tracker.observe(self.time_secs, &next);
         applied

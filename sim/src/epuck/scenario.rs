@@ -9,7 +9,11 @@ use errp_bci::{DetectorMode, DetectorParams, MeanAccuracy, OnlineTarget};
 use errp_robot::{ContinuousControlParams, GoalLayout, Pose, Valid};
 
 use crate::epuck::params::{EpuckEpisode, EpuckTaskParams};
-use crate::epuck::schema::{EpuckFile, StartFile};
+use crate::epuck::schema::{
+    DetectorFile, EpuckFile, ObstacleFile, StartFile, TrackerFile, UserFile,
+};
+use crate::epuck::tracker::TrackerParams;
+use crate::epuck::user::UserParams;
 use crate::epuck::world::{ArenaSpec, Obstacle};
 use crate::error::{Result, SimError};
 use crate::scenario_file::{
@@ -129,8 +133,6 @@ impl EpuckScenario {
             return Err(bad("task", format!("{:?}", file.task), "\"epuck\""));
         }
         let layout = GoalLayout::cities();
-        let size_m = layout.arena_size_m();
-        let size_cm = size_m * 100.0;
         let cities = || layout.names().join(", ");
         let goal = layout.index_of(&file.goal).ok_or_else(|| {
             bad(
@@ -142,46 +144,7 @@ impl EpuckScenario {
 
         let mut params = EpuckTaskParams::default();
         let radius_m = params.control.epuck.body_diameter_m / 2.0;
-        let (sx, sy) = match &file.start {
-            StartFile::City(name) => {
-                let i = layout.index_of(name).ok_or_else(|| {
-                    bad(
-                        "start",
-                        format!("{name:?}"),
-                        &format!("a city ({}) or a position [x_cm, y_cm]", cities()),
-                    )
-                })?;
-                (layout.goals()[i].x_m, layout.goals()[i].y_m)
-            }
-            StartFile::Cm([x, y]) => {
-                let lo = radius_m * 100.0;
-                let inside = |v: f64| v.is_finite() && v >= lo && v <= size_cm - lo;
-                if !(inside(*x) && inside(*y)) {
-                    return Err(bad(
-                        "start",
-                        format!("[{x}, {y}]"),
-                        &format!(
-                            "a position [x_cm, y_cm] with both in [{lo:.1}, {:.1}] so the \
-                             e-puck's body is inside the {size_cm} cm arena",
-                            size_cm - lo
-                        ),
-                    ));
-                }
-                (x / 100.0, y / 100.0)
-            }
-        };
-        if !file.start_heading_deg.is_finite() {
-            return Err(bad(
-                "start_heading_deg",
-                file.start_heading_deg.to_string(),
-                "an angle in degrees (0 = +x, 90 = up)",
-            ));
-        }
-        let start = Pose {
-            x_m: sx,
-            y_m: sy,
-            heading_rad: errp_robot::wrap_angle(file.start_heading_deg.to_radians()),
-        };
+        let start = start_pose(&file, &layout, radius_m, path)?;
         if start.distance_to(layout.goals()[goal].x_m, layout.goals()[goal].y_m) < 0.05 {
             return Err(bad(
                 "goal",
@@ -189,135 +152,10 @@ impl EpuckScenario {
                 "a goal away from the start",
             ));
         }
-
-        let u = &file.user;
-        // The accuracy the device assumes (info gain): the cross-validated
-        // accuracy, or the targeted hit rate.
-        let (online_target, accuracy) = match (u.accuracy, u.hit_rate, u.false_alarms_per_min) {
-            (Some(a), None, None) => {
-                let a = MeanAccuracy::new(a).map_err(|_| {
-                    bad(
-                        "user.accuracy",
-                        a.to_string(),
-                        "a mean accuracy strictly between 0.5 (chance) and 1, e.g. 0.95 \
-                             (the mean of the decoder's two cross-validated class rates)",
-                    )
-                })?;
-                (None, a)
-            }
-            (None, Some(h), fa) => {
-                let target = OnlineTarget {
-                    hit_rate: h,
-                    false_alarms_per_min: fa,
-                };
-                target
-                    .validate()
-                    .map_err(|e| table_error(path, "user", e))?;
-                if fa.is_some() && given("control", "t_e") {
-                    return Err(bad(
-                        "control.t_e",
-                        "given".into(),
-                        "no t_e when user.false_alarms_per_min is given: T_e is then \
-                         calibrated to meet that false-alarm rate",
-                    ));
-                }
-                // A hit rate is below 1, so this is a mean accuracy.
-                let assumed = MeanAccuracy::new(h.max(0.51))
-                    .map_err(|_| bad("user.hit_rate", h.to_string(), "a hit rate in (0, 1)"))?;
-                (Some(target), assumed)
-            }
-            (None, None, Some(f)) => {
-                return Err(bad(
-                    "user.false_alarms_per_min",
-                    f.to_string(),
-                    "user.hit_rate beside it (an online operating point is a hit rate and, \
-                     optionally, a false-alarm rate)",
-                ));
-            }
-            (None, None, None) => {
-                return Err(bad(
-                    "user.accuracy",
-                    "missing".into(),
-                    "the decoder: accuracy = A (cross-validated mean accuracy in (0.5, 1)) or \
-                     hit_rate = H [and false_alarms_per_min = F] (the online operating point)",
-                ));
-            }
-            (Some(a), _, _) => {
-                return Err(bad(
-                    "user.accuracy",
-                    a.to_string(),
-                    "either accuracy or hit_rate [and false_alarms_per_min], not both",
-                ));
-            }
-        };
-        if let Some(v) = file.user.fov_deg {
-            params.user.fov_rad = v.to_radians();
-        }
-        if let Some(v) = file.user.reaction_latency_ms {
-            if !(v.is_finite() && (0.0..=MAX_REACTION_LATENCY_MS).contains(&v)) {
-                return Err(bad(
-                    "user.reaction_latency_ms",
-                    v.to_string(),
-                    &format!(
-                        "a delay from 0 to {MAX_REACTION_LATENCY_MS} ms (default {})",
-                        params.user.reaction_latency_secs * 1000.0
-                    ),
-                ));
-            }
-            params.user.reaction_latency_secs = v / 1000.0;
-        }
-        if let Some(v) = file.user.reelicit_secs {
-            if !(v.is_finite() && (0.5..=MAX_REELICIT_SECS).contains(&v)) {
-                return Err(bad(
-                    "user.reelicit_secs",
-                    v.to_string(),
-                    &format!(
-                        "a time from 0.5 s (an ErrP lasts about that long) to \
-                         {MAX_REELICIT_SECS} s (default {})",
-                        params.user.reelicit_secs
-                    ),
-                ));
-            }
-            params.user.reelicit_secs = v;
-        }
-        params
-            .user
-            .validate()
-            .map_err(|e| SimError::Scenario(format!("{}: {e}", path.display())))?;
-
+        let (online_target, accuracy) = decoder_target(&file.user, given("control", "t_e"), path)?;
+        params.user = user_params(&file.user, path)?;
         if let Some(d) = &file.detector {
-            let mut p = DetectorParams::default();
-            if let Some(m) = d.mode {
-                p = match m {
-                    DetectorMode::Literal => DetectorParams::literal().into_inner(),
-                    DetectorMode::Smoothed => DetectorParams::default(),
-                };
-            }
-            if let Some(n) = d.smooth_windows {
-                p.smooth_windows = whole(
-                    path,
-                    "detector.smooth_windows",
-                    n,
-                    1,
-                    16,
-                    " windows (up to 1 s of 62.5 ms steps)",
-                )?;
-            }
-            if let Some(r) = d.refractory_secs {
-                p.refractory_secs = r;
-            }
-            if p.mode == DetectorMode::Literal
-                && (d.smooth_windows.is_some() || d.refractory_secs.is_some())
-            {
-                return Err(bad(
-                    "detector.mode",
-                    "\"literal\"".into(),
-                    "\"smoothed\" when smooth_windows or refractory_secs is given (the \
-                     literal reading compares each window with T_e on its own)",
-                ));
-            }
-            // Checked here, once: episodes and detectors take it checked.
-            params.detector = Valid::new(p).map_err(|e| table_error(path, "detector", e))?;
+            params.detector = detector_params(d, path)?;
         }
         // The device knows its decoder's accuracy from the calibration.
         let control = ContinuousControlParams {
@@ -325,43 +163,7 @@ impl EpuckScenario {
             ..file.control.clone()
         };
         params.control = Valid::new(control).map_err(|e| robot_error(path, "control", e))?;
-
-        if let Some(t) = &file.tracker {
-            if let Some(v) = t.rate_hz {
-                if !(v.is_finite() && (1.0..=MAX_TRACKER_HZ).contains(&v)) {
-                    return Err(bad(
-                        "tracker.rate_hz",
-                        v.to_string(),
-                        &format!("a frame rate from 1 to {MAX_TRACKER_HZ} Hz (default 30)"),
-                    ));
-                }
-                params.tracker.rate_hz = v;
-            }
-            if let Some(v) = t.position_noise_cm {
-                if !(v.is_finite() && (0.0..=50.0).contains(&v)) {
-                    return Err(bad(
-                        "tracker.position_noise_cm",
-                        v.to_string(),
-                        "a standard deviation from 0 to 50 cm (default 0.2)",
-                    ));
-                }
-                params.tracker.position_noise_m = v / 100.0;
-            }
-            if let Some(v) = t.heading_noise_deg {
-                if !(v.is_finite() && (0.0..=180.0).contains(&v)) {
-                    return Err(bad(
-                        "tracker.heading_noise_deg",
-                        v.to_string(),
-                        "a standard deviation from 0 to 180 degrees (default 1)",
-                    ));
-                }
-                params.tracker.heading_noise_rad = v.to_radians();
-            }
-        }
-        params
-            .tracker
-            .validate()
-            .map_err(|e| SimError::Scenario(format!("{}: {e}", path.display())))?;
+        params.tracker = tracker_params(file.tracker.as_ref(), path)?;
         if let Some(v) = file.avoidance.as_ref().and_then(|a| a.enabled) {
             params.avoidance.enabled = v;
         }
@@ -377,133 +179,7 @@ impl EpuckScenario {
             Some(n) => whole(path, "runs", n, 1, MAX_RUNS, " (default 1)")?,
             None => 1,
         };
-        let obstacles = file.arena.as_ref().map_or(0, |a| a.obstacle.len());
-        if obstacles > MAX_OBSTACLES {
-            return Err(bad(
-                "arena.obstacle",
-                format!("{obstacles} obstacles"),
-                &format!("at most {MAX_OBSTACLES} [[arena.obstacle]] tables"),
-            ));
-        }
-
-        let mut arena = ArenaSpec {
-            size_m,
-            ..ArenaSpec::paper()
-        };
-        for (k, o) in file
-            .arena
-            .iter()
-            .flat_map(|a| a.obstacle.iter())
-            .enumerate()
-        {
-            let field = |f: &str| format!("arena.obstacle[{k}].{f}");
-            let [cx, cy] = o.center_cm.0;
-            if !(cx.is_finite()
-                && cy.is_finite()
-                && (0.0..=size_cm).contains(&cx)
-                && (0.0..=size_cm).contains(&cy))
-            {
-                return Err(bad(
-                    &field("center_cm"),
-                    format!("[{cx}, {cy}]"),
-                    &format!("a point inside the arena, both coordinates in [0, {size_cm}]"),
-                ));
-            }
-            let obstacle = match o.shape.as_str() {
-                "box" => {
-                    let [w, h] = o
-                        .size_cm
-                        .ok_or_else(|| {
-                            bad(&field("size_cm"), "missing".into(), "[width_cm, height_cm]")
-                        })?
-                        .0;
-                    if !(w.is_finite() && h.is_finite() && w > 0.0 && h > 0.0) {
-                        return Err(bad(
-                            &field("size_cm"),
-                            format!("[{w}, {h}]"),
-                            "two sizes > 0 cm",
-                        ));
-                    }
-                    if !o.angle_deg.is_finite() {
-                        return Err(bad(
-                            &field("angle_deg"),
-                            o.angle_deg.to_string(),
-                            "an angle in degrees",
-                        ));
-                    }
-                    Obstacle::Box {
-                        x_m: cx / 100.0,
-                        y_m: cy / 100.0,
-                        half_width_m: w / 200.0,
-                        half_height_m: h / 200.0,
-                        angle_rad: o.angle_deg.to_radians(),
-                    }
-                }
-                "circle" => {
-                    let r = o.radius_cm.ok_or_else(|| {
-                        bad(&field("radius_cm"), "missing".into(), "a radius in cm")
-                    })?;
-                    if !(r.is_finite() && r > 0.0) {
-                        return Err(bad(&field("radius_cm"), r.to_string(), "a radius > 0 cm"));
-                    }
-                    Obstacle::Circle {
-                        x_m: cx / 100.0,
-                        y_m: cy / 100.0,
-                        radius_m: r / 100.0,
-                    }
-                }
-                other => {
-                    return Err(bad(
-                        &field("shape"),
-                        format!("{other:?}"),
-                        "\"box\" or \"circle\"",
-                    ));
-                }
-            };
-            // Inside the walls: an obstacle through a wall is a wall the
-            // arena does not have.
-            let (lo, hi) = obstacle.bounds();
-            let inside = |v: f64| (-1e-9..=size_m + 1e-9).contains(&v);
-            if !(inside(lo.0) && inside(lo.1) && inside(hi.0) && inside(hi.1)) {
-                return Err(bad(
-                    &field("center_cm"),
-                    format!("[{cx}, {cy}]"),
-                    &format!(
-                        "an obstacle inside the walls: this one spans x {:.1} to {:.1} cm and \
-                         y {:.1} to {:.1} cm, beyond the arena's 0 to {size_cm} cm",
-                        100.0 * lo.0,
-                        100.0 * hi.0,
-                        100.0 * lo.1,
-                        100.0 * hi.1
-                    ),
-                ));
-            }
-            // Every goal must stay reachable: the robot has to fit on it.
-            if let Some(g) = layout
-                .goals()
-                .iter()
-                .find(|g| obstacle.signed_distance(g.x_m, g.y_m) < radius_m + 0.01)
-            {
-                return Err(bad(
-                    &field("center_cm"),
-                    format!("[{cx}, {cy}]"),
-                    &format!(
-                        "an obstacle clear of every goal: this one covers {} (keep its edge \
-                         at least {:.1} cm from the goal)",
-                        g.name,
-                        (radius_m + 0.01) * 100.0
-                    ),
-                ));
-            }
-            if obstacle.signed_distance(start.x_m, start.y_m) < radius_m {
-                return Err(bad(
-                    &field("center_cm"),
-                    format!("[{cx}, {cy}]"),
-                    "an obstacle clear of the e-puck's start",
-                ));
-            }
-            arena.obstacles.push(obstacle);
-        }
+        let arena = arena(&file, &layout, start, radius_m, path)?;
 
         Ok(Self {
             path: path.to_path_buf(),
@@ -520,6 +196,392 @@ impl EpuckScenario {
             params,
         })
     }
+}
+
+/// Where the e-puck starts: a city or a position inside the arena (the
+/// body clear of the walls), and its heading.
+fn start_pose(file: &EpuckFile, layout: &GoalLayout, radius_m: f64, path: &Path) -> Result<Pose> {
+    let bad =
+        |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
+    let size_cm = layout.arena_size_m() * 100.0;
+    let cities = || layout.names().join(", ");
+    let (sx, sy) = match &file.start {
+        StartFile::City(name) => {
+            let i = layout.index_of(name).ok_or_else(|| {
+                bad(
+                    "start",
+                    format!("{name:?}"),
+                    &format!("a city ({}) or a position [x_cm, y_cm]", cities()),
+                )
+            })?;
+            (layout.goals()[i].x_m, layout.goals()[i].y_m)
+        }
+        StartFile::Cm([x, y]) => {
+            let lo = radius_m * 100.0;
+            let inside = |v: f64| v.is_finite() && v >= lo && v <= size_cm - lo;
+            if !(inside(*x) && inside(*y)) {
+                return Err(bad(
+                    "start",
+                    format!("[{x}, {y}]"),
+                    &format!(
+                        "a position [x_cm, y_cm] with both in [{lo:.1}, {:.1}] so the \
+                         e-puck's body is inside the {size_cm} cm arena",
+                        size_cm - lo
+                    ),
+                ));
+            }
+            (x / 100.0, y / 100.0)
+        }
+    };
+    if !file.start_heading_deg.is_finite() {
+        return Err(bad(
+            "start_heading_deg",
+            file.start_heading_deg.to_string(),
+            "an angle in degrees (0 = +x, 90 = up)",
+        ));
+    }
+    Ok(Pose {
+        x_m: sx,
+        y_m: sy,
+        heading_rad: errp_robot::wrap_angle(file.start_heading_deg.to_radians()),
+    })
+}
+
+/// The decoder a `[user]` table asks for: a cross-validated accuracy, or an
+/// online operating point (a hit rate and, optionally, false alarms per
+/// minute, when the file sets no `control.t_e`: `t_e_given`), with the
+/// accuracy the device assumes (info gain).
+fn decoder_target(
+    u: &UserFile,
+    t_e_given: bool,
+    path: &Path,
+) -> Result<(Option<OnlineTarget>, MeanAccuracy)> {
+    let bad =
+        |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
+    // The accuracy the device assumes (info gain): the cross-validated
+    // accuracy, or the targeted hit rate.
+    match (u.accuracy, u.hit_rate, u.false_alarms_per_min) {
+        (Some(a), None, None) => {
+            let a = MeanAccuracy::new(a).map_err(|_| {
+                bad(
+                    "user.accuracy",
+                    a.to_string(),
+                    "a mean accuracy strictly between 0.5 (chance) and 1, e.g. 0.95 \
+                         (the mean of the decoder's two cross-validated class rates)",
+                )
+            })?;
+            Ok((None, a))
+        }
+        (None, Some(h), fa) => {
+            let target = OnlineTarget {
+                hit_rate: h,
+                false_alarms_per_min: fa,
+            };
+            target
+                .validate()
+                .map_err(|e| table_error(path, "user", e))?;
+            if fa.is_some() && t_e_given {
+                return Err(bad(
+                    "control.t_e",
+                    "given".into(),
+                    "no t_e when user.false_alarms_per_min is given: T_e is then \
+                     calibrated to meet that false-alarm rate",
+                ));
+            }
+            // A hit rate is below 1, so this is a mean accuracy.
+            let assumed = MeanAccuracy::new(h.max(0.51))
+                .map_err(|_| bad("user.hit_rate", h.to_string(), "a hit rate in (0, 1)"))?;
+            Ok((Some(target), assumed))
+        }
+        (None, None, Some(f)) => Err(bad(
+            "user.false_alarms_per_min",
+            f.to_string(),
+            "user.hit_rate beside it (an online operating point is a hit rate and, \
+                 optionally, a false-alarm rate)",
+        )),
+        (None, None, None) => Err(bad(
+            "user.accuracy",
+            "missing".into(),
+            "the decoder: accuracy = A (cross-validated mean accuracy in (0.5, 1)) or \
+                 hit_rate = H [and false_alarms_per_min = F] (the online operating point)",
+        )),
+        (Some(a), _, _) => Err(bad(
+            "user.accuracy",
+            a.to_string(),
+            "either accuracy or hit_rate [and false_alarms_per_min], not both",
+        )),
+    }
+}
+
+/// The synthetic user of a `[user]` table: field of view, reaction latency,
+/// re-elicitation, on the defaults.
+fn user_params(u: &UserFile, path: &Path) -> Result<UserParams> {
+    let bad =
+        |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
+    let mut user = UserParams::default();
+    if let Some(v) = u.fov_deg {
+        user.fov_rad = v.to_radians();
+    }
+    if let Some(v) = u.reaction_latency_ms {
+        if !(v.is_finite() && (0.0..=MAX_REACTION_LATENCY_MS).contains(&v)) {
+            return Err(bad(
+                "user.reaction_latency_ms",
+                v.to_string(),
+                &format!(
+                    "a delay from 0 to {MAX_REACTION_LATENCY_MS} ms (default {})",
+                    user.reaction_latency_secs * 1000.0
+                ),
+            ));
+        }
+        user.reaction_latency_secs = v / 1000.0;
+    }
+    if let Some(v) = u.reelicit_secs {
+        if !(v.is_finite() && (0.5..=MAX_REELICIT_SECS).contains(&v)) {
+            return Err(bad(
+                "user.reelicit_secs",
+                v.to_string(),
+                &format!(
+                    "a time from 0.5 s (an ErrP lasts about that long) to \
+                     {MAX_REELICIT_SECS} s (default {})",
+                    user.reelicit_secs
+                ),
+            ));
+        }
+        user.reelicit_secs = v;
+    }
+    user.validate()
+        .map_err(|e| SimError::Scenario(format!("{}: {e}", path.display())))?;
+    Ok(user)
+}
+
+/// The detector of a `[detector]` table (literal or smoothed, on the
+/// defaults), checked once.
+fn detector_params(d: &DetectorFile, path: &Path) -> Result<Valid<DetectorParams>> {
+    let bad =
+        |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
+    let mut p = DetectorParams::default();
+    if let Some(m) = d.mode {
+        p = match m {
+            DetectorMode::Literal => DetectorParams::literal().into_inner(),
+            DetectorMode::Smoothed => DetectorParams::default(),
+        };
+    }
+    if let Some(n) = d.smooth_windows {
+        p.smooth_windows = whole(
+            path,
+            "detector.smooth_windows",
+            n,
+            1,
+            16,
+            " windows (up to 1 s of 62.5 ms steps)",
+        )?;
+    }
+    if let Some(r) = d.refractory_secs {
+        p.refractory_secs = r;
+    }
+    if p.mode == DetectorMode::Literal
+        && (d.smooth_windows.is_some() || d.refractory_secs.is_some())
+    {
+        return Err(bad(
+            "detector.mode",
+            "\"literal\"".into(),
+            "\"smoothed\" when smooth_windows or refractory_secs is given (the \
+             literal reading compares each window with T_e on its own)",
+        ));
+    }
+    // Checked here, once: episodes and detectors take it checked.
+    Valid::new(p).map_err(|e| table_error(path, "detector", e))
+}
+
+/// The ceiling camera of a `[tracker]` table, on the defaults.
+fn tracker_params(t: Option<&TrackerFile>, path: &Path) -> Result<TrackerParams> {
+    let bad =
+        |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
+    let mut tracker = TrackerParams::default();
+    if let Some(t) = t {
+        if let Some(v) = t.rate_hz {
+            if !(v.is_finite() && (1.0..=MAX_TRACKER_HZ).contains(&v)) {
+                return Err(bad(
+                    "tracker.rate_hz",
+                    v.to_string(),
+                    &format!("a frame rate from 1 to {MAX_TRACKER_HZ} Hz (default 30)"),
+                ));
+            }
+            tracker.rate_hz = v;
+        }
+        if let Some(v) = t.position_noise_cm {
+            if !(v.is_finite() && (0.0..=50.0).contains(&v)) {
+                return Err(bad(
+                    "tracker.position_noise_cm",
+                    v.to_string(),
+                    "a standard deviation from 0 to 50 cm (default 0.2)",
+                ));
+            }
+            tracker.position_noise_m = v / 100.0;
+        }
+        if let Some(v) = t.heading_noise_deg {
+            if !(v.is_finite() && (0.0..=180.0).contains(&v)) {
+                return Err(bad(
+                    "tracker.heading_noise_deg",
+                    v.to_string(),
+                    "a standard deviation from 0 to 180 degrees (default 1)",
+                ));
+            }
+            tracker.heading_noise_rad = v.to_radians();
+        }
+    }
+    tracker
+        .validate()
+        .map_err(|e| SimError::Scenario(format!("{}: {e}", path.display())))?;
+    Ok(tracker)
+}
+
+/// Obstacle `k` of `[[arena.obstacle]]`: a box or a circle whose centre is
+/// inside an arena of `size_cm`, in metres.
+fn obstacle(k: usize, o: &ObstacleFile, size_cm: f64, path: &Path) -> Result<Obstacle> {
+    let bad =
+        |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
+    let field = |f: &str| format!("arena.obstacle[{k}].{f}");
+    let [cx, cy] = o.center_cm.0;
+    if !(cx.is_finite()
+        && cy.is_finite()
+        && (0.0..=size_cm).contains(&cx)
+        && (0.0..=size_cm).contains(&cy))
+    {
+        return Err(bad(
+            &field("center_cm"),
+            format!("[{cx}, {cy}]"),
+            &format!("a point inside the arena, both coordinates in [0, {size_cm}]"),
+        ));
+    }
+    match o.shape.as_str() {
+        "box" => {
+            let [w, h] = o
+                .size_cm
+                .ok_or_else(|| bad(&field("size_cm"), "missing".into(), "[width_cm, height_cm]"))?
+                .0;
+            if !(w.is_finite() && h.is_finite() && w > 0.0 && h > 0.0) {
+                return Err(bad(
+                    &field("size_cm"),
+                    format!("[{w}, {h}]"),
+                    "two sizes > 0 cm",
+                ));
+            }
+            if !o.angle_deg.is_finite() {
+                return Err(bad(
+                    &field("angle_deg"),
+                    o.angle_deg.to_string(),
+                    "an angle in degrees",
+                ));
+            }
+            Ok(Obstacle::Box {
+                x_m: cx / 100.0,
+                y_m: cy / 100.0,
+                half_width_m: w / 200.0,
+                half_height_m: h / 200.0,
+                angle_rad: o.angle_deg.to_radians(),
+            })
+        }
+        "circle" => {
+            let r = o
+                .radius_cm
+                .ok_or_else(|| bad(&field("radius_cm"), "missing".into(), "a radius in cm"))?;
+            if !(r.is_finite() && r > 0.0) {
+                return Err(bad(&field("radius_cm"), r.to_string(), "a radius > 0 cm"));
+            }
+            Ok(Obstacle::Circle {
+                x_m: cx / 100.0,
+                y_m: cy / 100.0,
+                radius_m: r / 100.0,
+            })
+        }
+        other => Err(bad(
+            &field("shape"),
+            format!("{other:?}"),
+            "\"box\" or \"circle\"",
+        )),
+    }
+}
+
+/// The arena of `[[arena.obstacle]]`: the paper's walls and the obstacles,
+/// each inside the walls and clear of every goal and of the start.
+fn arena(
+    file: &EpuckFile,
+    layout: &GoalLayout,
+    start: Pose,
+    radius_m: f64,
+    path: &Path,
+) -> Result<ArenaSpec> {
+    let bad =
+        |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
+    let size_m = layout.arena_size_m();
+    let size_cm = size_m * 100.0;
+    let obstacles = file.arena.as_ref().map_or(0, |a| a.obstacle.len());
+    if obstacles > MAX_OBSTACLES {
+        return Err(bad(
+            "arena.obstacle",
+            format!("{obstacles} obstacles"),
+            &format!("at most {MAX_OBSTACLES} [[arena.obstacle]] tables"),
+        ));
+    }
+    let mut arena = ArenaSpec {
+        size_m,
+        ..ArenaSpec::paper()
+    };
+    for (k, o) in file
+        .arena
+        .iter()
+        .flat_map(|a| a.obstacle.iter())
+        .enumerate()
+    {
+        let field = |f: &str| format!("arena.obstacle[{k}].{f}");
+        let [cx, cy] = o.center_cm.0;
+        let obstacle = obstacle(k, o, size_cm, path)?;
+        // Inside the walls: an obstacle through a wall is a wall the
+        // arena does not have.
+        let (lo, hi) = obstacle.bounds();
+        let inside = |v: f64| (-1e-9..=size_m + 1e-9).contains(&v);
+        if !(inside(lo.0) && inside(lo.1) && inside(hi.0) && inside(hi.1)) {
+            return Err(bad(
+                &field("center_cm"),
+                format!("[{cx}, {cy}]"),
+                &format!(
+                    "an obstacle inside the walls: this one spans x {:.1} to {:.1} cm and \
+                     y {:.1} to {:.1} cm, beyond the arena's 0 to {size_cm} cm",
+                    100.0 * lo.0,
+                    100.0 * hi.0,
+                    100.0 * lo.1,
+                    100.0 * hi.1
+                ),
+            ));
+        }
+        // Every goal must stay reachable: the robot has to fit on it.
+        if let Some(g) = layout
+            .goals()
+            .iter()
+            .find(|g| obstacle.signed_distance(g.x_m, g.y_m) < radius_m + 0.01)
+        {
+            return Err(bad(
+                &field("center_cm"),
+                format!("[{cx}, {cy}]"),
+                &format!(
+                    "an obstacle clear of every goal: this one covers {} (keep its edge \
+                     at least {:.1} cm from the goal)",
+                    g.name,
+                    (radius_m + 0.01) * 100.0
+                ),
+            ));
+        }
+        if obstacle.signed_distance(start.x_m, start.y_m) < radius_m {
+            return Err(bad(
+                &field("center_cm"),
+                format!("[{cx}, {cy}]"),
+                "an obstacle clear of the e-puck's start",
+            ));
+        }
+        arena.obstacles.push(obstacle);
+    }
+    Ok(arena)
 }
 
 #[cfg(test)]

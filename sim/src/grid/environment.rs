@@ -5,14 +5,16 @@
 
 use std::sync::Arc;
 
-use errp_bci::{Accuracy, EegBlock, rng::stream};
+use errp_bci::{EegBlock, rng::stream};
 use errp_robot::{Cell, Grid, GridAction};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 use crate::error::{Result, SimError};
 use crate::grid::decoder::AssessmentDecoder;
-use crate::grid::episode::{ActionDecoder, Decoded, GridDecoding, GridEpisodeResult, GridStep};
+use crate::grid::episode::{
+    ActionDecoder, Decoded, GridDecoding, GridEpisodeResult, GridStep, GridTally,
+};
 use crate::grid::params::GridTaskParams;
 
 /// What one action gave the agent.
@@ -45,14 +47,12 @@ pub struct GridEnvironment {
     cell: Cell,
     goal: Cell,
     rng_user: ChaCha8Rng,
-    actions: usize,
-    start: Cell,
+    tally: GridTally,
     total_secs: f64,
     committed: Option<Cell>,
     ended: bool,
     /// Every action, kept for a recording ([`GridEnvironment::keep_steps`]).
     steps: Option<Vec<GridStep>>,
-    visits: Vec<u32>,
 }
 
 impl GridEnvironment {
@@ -94,17 +94,11 @@ impl GridEnvironment {
             cell: start,
             goal,
             rng_user: stream(seed, "grid/user"),
-            actions: 0,
-            start,
+            tally: GridTally::new(&grid, start),
             total_secs: 0.0,
             committed: None,
             ended: false,
             steps: None,
-            visits: {
-                let mut v = vec![0; grid.n_cells()];
-                v[grid.index(start)] += 1;
-                v
-            },
         })
     }
 
@@ -120,7 +114,7 @@ impl GridEnvironment {
 
     /// Actions taken so far.
     pub fn actions(&self) -> usize {
-        self.actions
+        self.tally.actions()
     }
 
     /// Keeps every action from now on, for [`GridEnvironment::result`].
@@ -140,19 +134,13 @@ impl GridEnvironment {
     /// is its own.
     pub fn result(&self) -> GridEpisodeResult {
         let steps = self.steps.clone().unwrap_or_default();
-        let labels: Vec<bool> = steps.iter().map(|s| s.error).collect();
-        let decoded: Vec<bool> = steps.iter().map(|s| s.decoded_error).collect();
-        GridEpisodeResult {
-            start: self.start,
-            goal: self.goal,
-            committed: self.committed,
-            actions: self.actions,
-            net_secs: self.actions as f64 * self.params.epoch_secs,
-            total_secs: self.total_secs,
-            online: Accuracy::score(&labels, &decoded),
-            visits: self.visits.clone(),
+        self.tally.clone().result(
+            self.goal,
+            self.committed,
+            self.params.epoch_secs,
+            self.total_secs,
             steps,
-        }
+        )
     }
 
     /// True if the decoder streams EEG, so that epochs can be returned.
@@ -192,8 +180,7 @@ impl GridEnvironment {
         let reached = action == GridAction::GoalReached && self.cell == self.goal;
         let from = self.cell;
         self.cell = self.grid.step(self.cell, action);
-        self.actions += 1;
-        self.visits[self.grid.index(self.cell)] += 1;
+        self.tally.action(&self.grid, self.cell, error, says_error);
         if let Some(steps) = self.steps.as_mut() {
             steps.push(GridStep {
                 onset_secs: self.total_secs,

@@ -65,6 +65,69 @@ impl GridEpisodeResult {
     }
 }
 
+/// What a grid episode counts as it goes, the one scoring of the episode,
+/// the environment an agent steps and `errp inspect`: the cells visited
+/// and, per action, the user's verdict and the decoder's.
+#[derive(Debug, Clone)]
+pub(crate) struct GridTally {
+    start: Cell,
+    visits: Vec<u32>,
+    labels: Vec<bool>,
+    decoded: Vec<bool>,
+}
+
+impl GridTally {
+    /// An episode starting on `start` of `grid`.
+    pub(crate) fn new(grid: &Grid, start: Cell) -> Self {
+        let mut visits = vec![0u32; grid.n_cells()];
+        visits[grid.index(start)] += 1;
+        Self {
+            start,
+            visits,
+            labels: Vec::new(),
+            decoded: Vec::new(),
+        }
+    }
+
+    /// An action that moved the cursor `to`, an error to the user
+    /// (`error`), decoded as one (`decoded`) or not.
+    pub(crate) fn action(&mut self, grid: &Grid, to: Cell, error: bool, decoded: bool) {
+        self.visits[grid.index(to)] += 1;
+        self.labels.push(error);
+        self.decoded.push(decoded);
+    }
+
+    /// Actions so far.
+    pub(crate) fn actions(&self) -> usize {
+        self.labels.len()
+    }
+
+    /// The result of the episode towards `goal` that ended `committed` (or
+    /// not) after `total_secs`, with `epoch_secs` of EEG per action and the
+    /// `steps` kept.
+    pub(crate) fn result(
+        self,
+        goal: Cell,
+        committed: Option<Cell>,
+        epoch_secs: f64,
+        total_secs: f64,
+        steps: Vec<GridStep>,
+    ) -> GridEpisodeResult {
+        let actions = self.actions();
+        GridEpisodeResult {
+            start: self.start,
+            goal,
+            committed,
+            actions,
+            net_secs: actions as f64 * epoch_secs,
+            total_secs,
+            online: Accuracy::score(&self.labels, &self.decoded),
+            visits: self.visits,
+            steps,
+        }
+    }
+}
+
 /// Runs one episode from `start` towards the user's `goal`. Everything random
 /// derives from `seed`: the same seed gives the same episode, bit for bit.
 pub fn run_grid_episode(
@@ -156,10 +219,7 @@ pub fn run_grid_episode_with(
     let mut decoder = ActionDecoder::start(&decoding, seed)?;
 
     let mut cell = start;
-    let mut visits = vec![0u32; grid.n_cells()];
-    visits[grid.index(cell)] += 1;
-    let mut labels = Vec::new();
-    let mut decoded = Vec::new();
+    let mut tally = GridTally::new(&grid, start);
     let mut steps = Vec::new();
     let mut total_secs = 0.0;
     let mut committed = None;
@@ -175,8 +235,7 @@ pub fn run_grid_episode_with(
         } = decoder.decode(&mut decoding, error, interval, record_steps, false)?;
         controller.observe(cell, action, p_error)?;
         let to = grid.step(cell, action);
-        labels.push(error);
-        decoded.push(says_error);
+        tally.action(&grid, to, error, says_error);
         if record_steps {
             steps.push(GridStep {
                 onset_secs: total_secs,
@@ -192,24 +251,12 @@ pub fn run_grid_episode_with(
         }
         total_secs += interval;
         cell = to;
-        visits[grid.index(cell)] += 1;
         if let Some(found) = controller.converged() {
             committed = Some(found);
             break;
         }
     }
-    let actions = labels.len();
-    Ok(GridEpisodeResult {
-        start,
-        goal,
-        committed,
-        actions,
-        net_secs: actions as f64 * params.epoch_secs,
-        total_secs,
-        online: Accuracy::score(&labels, &decoded),
-        visits,
-        steps,
-    })
+    Ok(tally.result(goal, committed, params.epoch_secs, total_secs, steps))
 }
 
 /// What a decoded action gives: p(error), the decoder's class, the FCz

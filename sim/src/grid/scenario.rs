@@ -195,50 +195,7 @@ impl GridScenario {
             ));
         }
 
-        // The user: an accuracy, or a subject of Table 1 with a goal set.
-        let (accuracy, user) = match (&file.user.accuracy, &file.user.subject) {
-            (Some(_), Some(_)) => {
-                return Err(bad(
-                    "user",
-                    "both accuracy and subject".into(),
-                    "one of `user.accuracy` or `user.subject`",
-                ));
-            }
-            (Some(a), None) => (*a, format!("accuracy {a}")),
-            (None, Some(name)) => {
-                let s = subject(name)
-                    .map_err(|e| bad("user.subject", format!("{name:?}"), &e.to_string()))?;
-                let (set, label) = match file.user.goals.unwrap_or(GoalSetFile::Fixed) {
-                    GoalSetFile::Fixed => (GoalSet::Fixed, "fixed"),
-                    GoalSetFile::Free => (GoalSet::Free, "free"),
-                };
-                (
-                    s.accuracy(set),
-                    format!("subject {}, {label} goals", s.name),
-                )
-            }
-            (None, None) => {
-                return Err(bad(
-                    "user",
-                    "empty".into(),
-                    "`user.accuracy = 0.7438` or `user.subject = \"S1\"`",
-                ));
-            }
-        };
-        // A real decoder is targeted at a mean accuracy; the oracle may also
-        // be perfect.
-        let ok = matches!(
-            (RequestedAccuracy::new(accuracy), file.decoder),
-            (Ok(RequestedAccuracy::Targeted(_)), _)
-                | (Ok(RequestedAccuracy::Perfect), DecoderChoice::Oracle)
-        );
-        if !ok {
-            return Err(bad(
-                "user.accuracy",
-                accuracy.to_string(),
-                "a mean accuracy in (0.5, 1) for the EEG decoder, (0.5, 1] for the oracle",
-            ));
-        }
+        let (accuracy, user) = user_accuracy(&file, path)?;
 
         // Strategy and timing, on top of the paper's defaults.
         // The device knows its decoder's accuracy from the calibration.
@@ -251,97 +208,9 @@ impl GridScenario {
             control: Valid::new(control).map_err(|e| robot_error(path, "control", e))?,
             ..GridTaskParams::default()
         };
-        if let Some(t) = &file.timing {
-            let d = GridTaskParams::default();
-            params.interval_min_secs = t.interval_min_secs.unwrap_or(d.interval_min_secs);
-            params.interval_max_secs = t.interval_max_secs.unwrap_or(d.interval_max_secs);
-            params.epoch_secs = t.epoch_secs.unwrap_or(d.epoch_secs);
-            if let Some(n) = t.max_actions {
-                params.max_actions = whole(
-                    path,
-                    "timing.max_actions",
-                    n,
-                    1,
-                    MAX_ACTIONS,
-                    &format!(" (default {})", d.max_actions),
-                )?;
-            }
-        }
-        let (min, max) = (params.interval_min_secs, params.interval_max_secs);
-        if !(min.is_finite() && (0.8..=MAX_INTERVAL_SECS).contains(&min)) {
-            return Err(bad(
-                "timing.interval_min_secs",
-                min.to_string(),
-                &format!("a time from 0.8 s (an epoch) to {MAX_INTERVAL_SECS} s (the paper: 3)"),
-            ));
-        }
-        if !(max.is_finite() && max >= min && max <= MAX_INTERVAL_SECS) {
-            return Err(bad(
-                "timing.interval_max_secs",
-                max.to_string(),
-                &format!(
-                    "a time from interval_min_secs ({min} s) to {MAX_INTERVAL_SECS} s (the \
-                     paper: 3.5)"
-                ),
-            ));
-        }
-        if !(params.epoch_secs.is_finite() && params.epoch_secs > 0.0 && params.epoch_secs <= min) {
-            return Err(bad(
-                "timing.epoch_secs",
-                params.epoch_secs.to_string(),
-                &format!(
-                    "a time > 0 s and at most interval_min_secs ({min} s): the EEG counted \
-                     per action fits between two actions (the paper: 0.8)"
-                ),
-            ));
-        }
+        set_timing(&mut params, file.timing.as_ref(), path)?;
 
-        // Episodes: fixed pairs and/or free goals drawn from the seed.
-        let grid = errp_robot::Grid::paper();
-        if file.episode.len() as u64 > MAX_PAIRS {
-            return Err(bad(
-                "episode",
-                format!("{} tables", file.episode.len()),
-                &format!("at most {MAX_PAIRS} [[episode]] tables (use `repeats`)"),
-            ));
-        }
-        let mut pairs = Vec::new();
-        for (k, e) in file.episode.iter().enumerate() {
-            let cell = |field: &str, v: [i64; 2]| -> Result<Cell> {
-                let inside = (0..grid.width as i64).contains(&v[0])
-                    && (0..grid.height as i64).contains(&v[1]);
-                if inside {
-                    Ok(Cell::new(v[0] as usize, v[1] as usize))
-                } else {
-                    Err(bad(
-                        &format!("episode[{k}].{field}"),
-                        format!("[{}, {}]", v[0], v[1]),
-                        "a cell [x, y] with 0 <= x, y <= 4 on the 5x5 grid",
-                    ))
-                }
-            };
-            let (s, g) = (cell("start", e.start.0)?, cell("goal", e.goal.0)?);
-            if s == g {
-                return Err(bad(
-                    &format!("episode[{k}].goal"),
-                    format!("[{}, {}]", g.x, g.y),
-                    "a goal different from the start",
-                ));
-            }
-            pairs.push((s, g));
-        }
-        if let Some(free) = &file.free_goals {
-            let count = whole(path, "free_goals.count", free.count, 1, MAX_PAIRS, "")?;
-            let mut rng = errp_bci::rng::stream(file.seed, "scenario/free-goals");
-            pairs.extend(free_pairs(&grid, count, &mut rng));
-        }
-        if pairs.is_empty() {
-            return Err(bad(
-                "episode",
-                "none".into(),
-                "at least one [[episode]] with start and goal, or a [free_goals] table",
-            ));
-        }
+        let pairs = start_goal_pairs(&file, path)?;
         let bank_per_class = match file.bank_per_class {
             Some(n) => whole(
                 path,
@@ -385,6 +254,164 @@ impl GridScenario {
             params,
         })
     }
+}
+
+/// The user of a `[user]` table, an accuracy or a subject of Table 1 with
+/// a goal set, in words too; an accuracy `decoder` can be asked for.
+fn user_accuracy(file: &ScenarioFile, path: &Path) -> Result<(f64, String)> {
+    let bad =
+        |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
+    // The user: an accuracy, or a subject of Table 1 with a goal set.
+    let (accuracy, user) = match (&file.user.accuracy, &file.user.subject) {
+        (Some(_), Some(_)) => {
+            return Err(bad(
+                "user",
+                "both accuracy and subject".into(),
+                "one of `user.accuracy` or `user.subject`",
+            ));
+        }
+        (Some(a), None) => (*a, format!("accuracy {a}")),
+        (None, Some(name)) => {
+            let s = subject(name)
+                .map_err(|e| bad("user.subject", format!("{name:?}"), &e.to_string()))?;
+            let (set, label) = match file.user.goals.unwrap_or(GoalSetFile::Fixed) {
+                GoalSetFile::Fixed => (GoalSet::Fixed, "fixed"),
+                GoalSetFile::Free => (GoalSet::Free, "free"),
+            };
+            (
+                s.accuracy(set),
+                format!("subject {}, {label} goals", s.name),
+            )
+        }
+        (None, None) => {
+            return Err(bad(
+                "user",
+                "empty".into(),
+                "`user.accuracy = 0.7438` or `user.subject = \"S1\"`",
+            ));
+        }
+    };
+    // A real decoder is targeted at a mean accuracy; the oracle may also
+    // be perfect.
+    let ok = matches!(
+        (RequestedAccuracy::new(accuracy), file.decoder),
+        (Ok(RequestedAccuracy::Targeted(_)), _)
+            | (Ok(RequestedAccuracy::Perfect), DecoderChoice::Oracle)
+    );
+    if !ok {
+        return Err(bad(
+            "user.accuracy",
+            accuracy.to_string(),
+            "a mean accuracy in (0.5, 1) for the EEG decoder, (0.5, 1] for the oracle",
+        ));
+    }
+    Ok((accuracy, user))
+}
+
+/// The timing of a `[timing]` table set in `p`, on the paper's defaults:
+/// intervals, the EEG per action, the most actions.
+fn set_timing(p: &mut GridTaskParams, t: Option<&TimingFile>, path: &Path) -> Result<()> {
+    let bad =
+        |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
+    if let Some(t) = t {
+        let d = GridTaskParams::default();
+        p.interval_min_secs = t.interval_min_secs.unwrap_or(d.interval_min_secs);
+        p.interval_max_secs = t.interval_max_secs.unwrap_or(d.interval_max_secs);
+        p.epoch_secs = t.epoch_secs.unwrap_or(d.epoch_secs);
+        if let Some(n) = t.max_actions {
+            p.max_actions = whole(
+                path,
+                "timing.max_actions",
+                n,
+                1,
+                MAX_ACTIONS,
+                &format!(" (default {})", d.max_actions),
+            )?;
+        }
+    }
+    let (min, max) = (p.interval_min_secs, p.interval_max_secs);
+    if !(min.is_finite() && (0.8..=MAX_INTERVAL_SECS).contains(&min)) {
+        return Err(bad(
+            "timing.interval_min_secs",
+            min.to_string(),
+            &format!("a time from 0.8 s (an epoch) to {MAX_INTERVAL_SECS} s (the paper: 3)"),
+        ));
+    }
+    if !(max.is_finite() && max >= min && max <= MAX_INTERVAL_SECS) {
+        return Err(bad(
+            "timing.interval_max_secs",
+            max.to_string(),
+            &format!(
+                "a time from interval_min_secs ({min} s) to {MAX_INTERVAL_SECS} s (the \
+                 paper: 3.5)"
+            ),
+        ));
+    }
+    if !(p.epoch_secs.is_finite() && p.epoch_secs > 0.0 && p.epoch_secs <= min) {
+        return Err(bad(
+            "timing.epoch_secs",
+            p.epoch_secs.to_string(),
+            &format!(
+                "a time > 0 s and at most interval_min_secs ({min} s): the EEG counted \
+                 per action fits between two actions (the paper: 0.8)"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The start/goal pairs of the `[[episode]]` tables, then the free goals
+/// drawn from the scenario's seed.
+fn start_goal_pairs(file: &ScenarioFile, path: &Path) -> Result<Vec<(Cell, Cell)>> {
+    let bad =
+        |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
+    // Episodes: fixed pairs and/or free goals drawn from the seed.
+    let grid = errp_robot::Grid::paper();
+    if file.episode.len() as u64 > MAX_PAIRS {
+        return Err(bad(
+            "episode",
+            format!("{} tables", file.episode.len()),
+            &format!("at most {MAX_PAIRS} [[episode]] tables (use `repeats`)"),
+        ));
+    }
+    let mut pairs = Vec::new();
+    for (k, e) in file.episode.iter().enumerate() {
+        let cell = |field: &str, v: [i64; 2]| -> Result<Cell> {
+            let inside =
+                (0..grid.width as i64).contains(&v[0]) && (0..grid.height as i64).contains(&v[1]);
+            if inside {
+                Ok(Cell::new(v[0] as usize, v[1] as usize))
+            } else {
+                Err(bad(
+                    &format!("episode[{k}].{field}"),
+                    format!("[{}, {}]", v[0], v[1]),
+                    "a cell [x, y] with 0 <= x, y <= 4 on the 5x5 grid",
+                ))
+            }
+        };
+        let (s, g) = (cell("start", e.start.0)?, cell("goal", e.goal.0)?);
+        if s == g {
+            return Err(bad(
+                &format!("episode[{k}].goal"),
+                format!("[{}, {}]", g.x, g.y),
+                "a goal different from the start",
+            ));
+        }
+        pairs.push((s, g));
+    }
+    if let Some(free) = &file.free_goals {
+        let count = whole(path, "free_goals.count", free.count, 1, MAX_PAIRS, "")?;
+        let mut rng = errp_bci::rng::stream(file.seed, "scenario/free-goals");
+        pairs.extend(free_pairs(&grid, count, &mut rng));
+    }
+    if pairs.is_empty() {
+        return Err(bad(
+            "episode",
+            "none".into(),
+            "at least one [[episode]] with start and goal, or a [free_goals] table",
+        ));
+    }
+    Ok(pairs)
 }
 
 /// `count` start/goal pairs as a user choosing freely might: both cells

@@ -6,10 +6,12 @@
 
 use std::path::{Path, PathBuf};
 
-use errp_bci::Accuracy;
-use errp_robot::{Cell, Grid, GridAction};
+use errp_robot::{Cell, Grid, GridAction, Pose};
 
-use crate::epuck::{EpuckEpisodeResult, EpuckScenario, PHYSICS_DT_SECS, WINDOW_STEP_SECS};
+use crate::epuck::episode::Score;
+use crate::epuck::plant::step_motion;
+use crate::epuck::{EpuckEpisodeResult, EpuckScenario};
+use crate::grid::episode::GridTally;
 use crate::grid::{GridEpisodeResult, GridScenario, GridStep};
 use crate::record::data::{Column, Provenance};
 use crate::record::paths;
@@ -213,6 +215,43 @@ fn index(v: i64, n: usize, what: &str) -> Result<usize, String> {
         .ok_or_else(|| format!("{what} {v} is out of range (0 to {})", n.saturating_sub(1)))
 }
 
+/// A pose from a recording's centimetres and degrees.
+fn cm_deg(x: f64, y: f64, heading_deg: f64) -> Pose {
+    Pose::new(x / 100.0, y / 100.0, heading_deg.to_radians())
+}
+
+/// The path driven (m), the largest sideways speed (m/s) and each frame's
+/// time and true position (m).
+type Replayed = (f64, f64, Vec<(f64, [f64; 2])>);
+
+/// The frames `rows` of a run from `start`, measured as the episode measured
+/// them.
+fn replay_frames(
+    frames: &View<'_>,
+    rows: std::ops::Range<usize>,
+    start: Pose,
+) -> Result<Replayed, String> {
+    let (t, x, y, h) = (
+        frames.f64("t_s")?,
+        frames.f64("x_cm")?,
+        frames.f64("y_cm")?,
+        frames.f64("heading_deg")?,
+    );
+    let mut pose = start;
+    let mut path_m = 0.0;
+    let mut max_lateral: f64 = 0.0;
+    let mut frame_at = Vec::with_capacity(rows.len());
+    for i in rows {
+        let next = cm_deg(x[i], y[i], h[i]);
+        let (distance, lateral) = step_motion(pose, next);
+        max_lateral = max_lateral.max(lateral);
+        path_m += distance;
+        pose = next;
+        frame_at.push((t[i], [pose.x_m, pose.y_m]));
+    }
+    Ok((path_m, max_lateral, frame_at))
+}
+
 /// The e-puck runs recomputed as `run_epuck_episode` scores them.
 fn epuck_results(
     tables: &std::collections::BTreeMap<String, Table>,
@@ -224,16 +263,10 @@ fn epuck_results(
     let windows = View::of(tables, paths::WINDOWS)?;
     let ends = View::of(tables, paths::ENDS)?;
     let empty = Table::default();
-    let errps = tables.get(paths::ERRPS).map_or(
-        View {
-            name: paths::ERRPS,
-            table: &empty,
-        },
-        |table| View {
-            name: paths::ERRPS,
-            table,
-        },
-    );
+    let errps = View {
+        name: paths::ERRPS,
+        table: tables.get(paths::ERRPS).unwrap_or(&empty),
+    };
     let run_col = runs.i64("run")?;
     let f_run = frames.i64("run")?;
     let w_run = windows.i64("run")?;
@@ -252,12 +285,6 @@ fn epuck_results(
     ] {
         check_run_order(name, r)?;
     }
-    let (f_t, f_x, f_y, f_h) = (
-        frames.f64("t_s")?,
-        frames.f64("x_cm")?,
-        frames.f64("y_cm")?,
-        frames.f64("heading_deg")?,
-    );
     let (w_t, w_p, w_detected, w_step) = (
         windows.f64("t_s")?,
         windows.f64("p_error")?,
@@ -317,109 +344,42 @@ fn epuck_results(
             .map(|i| Ok((e_t[i], e_onset[i], index(e_phase[i], 3, "ErrP phase")?)))
             .collect::<Result<_, String>>()?;
 
-        // The true pose at each frame (m, rad), from the start.
-        let mut pose = (sx[k] / 100.0, sy[k] / 100.0, sh[k].to_radians());
-        let mut path_m = 0.0;
-        let mut max_lateral: f64 = 0.0;
-        let mut frame_at = Vec::with_capacity(fr.len());
-        for i in fr.clone() {
-            let next = (f_x[i] / 100.0, f_y[i] / 100.0, f_h[i].to_radians());
-            let (dx, dy) = (next.0 - pose.0, next.1 - pose.1);
-            let mid = pose.2 + 0.5 * errp_robot::wrap_angle(next.2 - pose.2);
-            let lateral = (-mid.sin() * dx + mid.cos() * dy) / PHYSICS_DT_SECS;
-            max_lateral = max_lateral.max(lateral.abs());
-            path_m += (dx * dx + dy * dy).sqrt();
-            pose = next;
-            frame_at.push((f_t[i], [pose.0, pose.1]));
-        }
+        let start = cm_deg(sx[k], sy[k], sh[k]);
+        let (path_m, max_lateral, frame_at) = replay_frames(&frames, fr, start)?;
 
-        let mut detections = Vec::new();
-        let mut detected_at = Vec::new();
-        let mut by_phase = [0usize; 3];
-        let mut by_judged = [0usize; 3];
-        let mut false_detections = 0usize;
-        let (mut hits, mut n_err, mut false_alarms, mut n_clean) = (0usize, 0usize, 0, 0);
-        let mut clean_windows = 0usize;
+        // The episode's own scoring, fed from the tables: each ErrP once the
+        // user produced it (before the window that ends after it), each
+        // window with the pose at its end.
+        let mut score = Score::new(span, window_span, t_e[k]);
+        let mut known = 0usize;
         let mut frame = 0usize;
         for i in wr {
             let t = w_t[i];
-            // The ErrPs the episode knew of at this window: seen before it.
-            let known: Vec<(f64, usize)> = errps_run
-                .iter()
-                .filter(|&&(seen, _, _)| seen < t)
-                .map(|&(_, o, p)| (o, p))
-                .collect();
-            let says_error = w_p[i] >= t_e[k];
-            let in_window_span = known.iter().any(|&(o, _)| window_span.contains(o, t));
-            let near = known
-                .iter()
-                .any(|&(o, _)| o <= t && t - o <= window_span.to_secs + WINDOW_STEP_SECS);
-            if in_window_span {
-                n_err += 1;
-                hits += usize::from(says_error);
-            } else if !near {
-                n_clean += 1;
-                false_alarms += usize::from(says_error);
+            while known < errps_run.len() && errps_run[known].0 < t {
+                score.errp(errps_run[known].1, errps_run[known].2);
+                known += 1;
             }
-            let judged = known
-                .iter()
-                .rev()
-                .find(|&&(o, _)| span.contains(o, t))
-                .map(|&(_, p)| p);
             let step = index(w_step[i], 4, "window step")?;
-            if step != 3 && judged.is_none() {
-                clean_windows += 1;
-            }
+            let mut at = [f64::NAN; 2];
             if w_detected[i] {
-                detections.push(t);
                 while frame + 1 < frame_at.len() && frame_at[frame + 1].0 <= t {
                     frame += 1;
                 }
                 if let Some(&(_, xy)) = frame_at.get(frame) {
-                    detected_at.push(xy);
-                }
-                by_phase[step.min(2)] += 1;
-                match judged {
-                    Some(p) => by_judged[p] += 1,
-                    None => false_detections += 1,
+                    at = xy;
                 }
             }
+            score.window(t, w_p[i], step, w_detected[i], at);
         }
-        let scored: Vec<f64> = errps_run
-            .iter()
-            .map(|&(_, o, _)| o)
-            .filter(|&o| o + span.to_secs <= time_secs)
-            .collect();
-        let missed_errors = scored
-            .iter()
-            .filter(|&&o| !detections.iter().any(|&t| span.contains(o, t)))
-            .count();
+        for &(_, onset, phase) in &errps_run[known..] {
+            score.errp(onset, phase);
+        }
         let committed = match end_committed[e] {
             -1 => None,
             c => Some(index(c, n_goals, "committed goal")?),
         };
-        out.push(EpuckEpisodeResult {
-            goal: index(goal[k], n_goals, "goal")?,
-            committed,
-            time_secs,
-            detected_errors: detections.len(),
-            detected_by_phase: by_phase,
-            true_by_judged_phase: by_judged,
-            false_detections,
-            missed_errors,
-            errps: errps_run.len(),
-            errps_scored: scored.len(),
-            clean_secs: clean_windows as f64 * WINDOW_STEP_SECS,
-            online: Accuracy {
-                correct: 1.0 - false_alarms as f64 / n_clean.max(1) as f64,
-                error: hits as f64 / n_err.max(1) as f64,
-                n_correct: n_clean,
-                n_error: n_err,
-            },
-            path_m,
-            max_lateral_m_per_s: max_lateral,
-            detections: detected_at,
-        });
+        let goal = index(goal[k], n_goals, "goal")?;
+        out.push(score.finish(goal, committed, time_secs, path_m, max_lateral));
     }
     Ok(out)
 }
@@ -519,12 +479,12 @@ fn grid_results(
         };
         let start = cell(sx[k], sy[k])?;
         let goal = cell(gx[k], gy[k])?;
-        let mut visits = vec![0u32; grid.n_cells()];
-        visits[grid.index(start)] += 1;
+        // The episode's own tally, fed from the table of actions.
+        let mut tally = GridTally::new(&grid, start);
         let mut steps = Vec::new();
         for i in actions.run_rows(a_run, k) {
             let to = cell(tx[i], ty[i])?;
-            visits[grid.index(to)] += 1;
+            tally.action(&grid, to, err[i], dec[i]);
             let action = GridAction::ALL
                 .into_iter()
                 .find(|a| a.name() == names[i])
@@ -541,23 +501,11 @@ fn grid_results(
                 fcz: Vec::new(),
             });
         }
-        let labels: Vec<bool> = steps.iter().map(|s| s.error).collect();
-        let decoded: Vec<bool> = steps.iter().map(|s| s.decoded_error).collect();
         let committed = match end_committed[e] {
             -1 => None,
             c => Some(grid.cell(index(c, grid.n_cells(), "committed cell")?)),
         };
-        out.push(GridEpisodeResult {
-            start,
-            goal,
-            committed,
-            actions: steps.len(),
-            net_secs: steps.len() as f64 * epoch[k],
-            total_secs: end_t[e],
-            online: Accuracy::score(&labels, &decoded),
-            visits,
-            steps,
-        });
+        out.push(tally.result(goal, committed, epoch[k], end_t[e], steps));
     }
     Ok(out)
 }

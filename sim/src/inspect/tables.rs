@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 use errp_robot::Grid;
 
 use crate::epuck::{EpuckEpisodeResult, PHASE_NAMES, PHYSICS_DT_SECS, STEP_NAMES};
-use crate::inspect::{Recording, Runs};
+use crate::inspect::{Recording, Runs, Table};
 use crate::record::data::Column;
 use crate::record::paths;
 
@@ -196,10 +196,29 @@ fn epuck_tables(
     results: &[EpuckEpisodeResult],
     names: &[String],
 ) -> Vec<CsvTable> {
+    let empty = Table::default();
+    let frames = get(rec, paths::FRAMES).unwrap_or(&empty);
+    let windows = get(rec, paths::WINDOWS).unwrap_or(&empty);
+    vec![
+        epuck_runs_table(rec, results, names),
+        trajectory_table(frames, windows, names),
+        detections_table(windows, results),
+        belief_table(windows, names),
+        errps_table(get(rec, paths::ERRPS).unwrap_or(&empty)),
+        events_table(get(rec, paths::EVENTS).unwrap_or(&empty)),
+    ]
+}
+
+/// A run index column, numbered from 1.
+fn run1(v: &[i64]) -> Column {
+    Column::I64(v.iter().map(|r| r + 1).collect())
+}
+
+/// One row per run: the result recomputed, and the time in each phase.
+fn epuck_runs_table(rec: &Recording, results: &[EpuckEpisodeResult], names: &[String]) -> CsvTable {
     let n = results.len();
-    let run1 = |v: &[i64]| Column::I64(v.iter().map(|r| r + 1).collect());
     let phases = phase_secs(rec);
-    let runs = CsvTable {
+    CsvTable {
         name: "runs",
         columns: vec![
             ("run", Column::I64((1..=n as i64).collect())),
@@ -278,11 +297,12 @@ fn epuck_tables(
                 Column::F64(phases.iter().map(|p| p[2]).collect()),
             ),
         ],
-    };
-    let mut out = vec![runs];
-    let empty = crate::inspect::Table::default();
-    let frames = get(rec, paths::FRAMES).unwrap_or(&empty);
-    let windows = get(rec, paths::WINDOWS).unwrap_or(&empty);
+    }
+}
+
+/// One row per physics step, with p(error) and the evidence of the
+/// latest window.
+fn trajectory_table(frames: &Table, windows: &Table, names: &[String]) -> CsvTable {
     // p(error) and the evidence of the latest window at each frame.
     let (w_run, w_t) = (i64s(windows, "run"), f64s(windows, "t_s"));
     let (w_p, w_ev) = (f64s(windows, "p_error"), f64s(windows, "evidence"));
@@ -302,7 +322,7 @@ fn epuck_tables(
         p.push(latest.map_or(f64::NAN, |l| w_p[l]));
         ev.push(latest.map_or(f64::NAN, |l| w_ev[l]));
     }
-    out.push(CsvTable {
+    CsvTable {
         name: "trajectory",
         columns: vec![
             ("run", run1(f_run)),
@@ -346,7 +366,13 @@ fn epuck_tables(
             ("p_error", Column::F64(p)),
             ("evidence", Column::F64(ev)),
         ],
-    });
+    }
+}
+
+/// One row per detection, where the robot was and the controller's step.
+fn detections_table(windows: &Table, results: &[EpuckEpisodeResult]) -> CsvTable {
+    let (w_run, w_t) = (i64s(windows, "run"), f64s(windows, "t_s"));
+    let (w_p, w_ev) = (f64s(windows, "p_error"), f64s(windows, "evidence"));
     // Detections, with where the robot was and whether an ErrP explains it.
     let mut d = (
         Vec::new(),
@@ -383,7 +409,7 @@ fn epuck_tables(
                 .map_or(String::new(), |s| s.to_string()),
         );
     }
-    out.push(CsvTable {
+    CsvTable {
         name: "detections",
         columns: vec![
             ("run", Column::I64(d.0)),
@@ -394,7 +420,12 @@ fn epuck_tables(
             ("evidence", Column::F64(d.5)),
             ("step", Column::Str(d.6)),
         ],
-    });
+    }
+}
+
+/// The belief per goal after each window, long.
+fn belief_table(windows: &Table, names: &[String]) -> CsvTable {
+    let (w_run, w_t) = (i64s(windows, "run"), f64s(windows, "t_s"));
     // Belief per goal, long.
     let (belief, width) = match windows.column("belief") {
         Some(Column::F64Rows(v, w)) => (&v[..], *w),
@@ -415,7 +446,7 @@ fn epuck_tables(
             b.3.push(belief[i * width + g]);
         }
     }
-    out.push(CsvTable {
+    CsvTable {
         name: "belief",
         columns: vec![
             ("run", Column::I64(b.0)),
@@ -423,9 +454,12 @@ fn epuck_tables(
             ("goal", Column::Str(b.2)),
             ("p", Column::F64(b.3)),
         ],
-    });
-    let errps = get(rec, paths::ERRPS).unwrap_or(&empty);
-    out.push(CsvTable {
+    }
+}
+
+/// One row per ErrP of the user.
+fn errps_table(errps: &Table) -> CsvTable {
+    CsvTable {
         name: "errps",
         columns: vec![
             ("run", run1(i64s(errps, "run"))),
@@ -445,9 +479,12 @@ fn epuck_tables(
                 ),
             ),
         ],
-    });
-    let events = get(rec, paths::EVENTS).unwrap_or(&empty);
-    out.push(CsvTable {
+    }
+}
+
+/// The event log.
+fn events_table(events: &Table) -> CsvTable {
+    CsvTable {
         name: "events",
         columns: vec![
             ("run", run1(i64s(events, "run"))),
@@ -469,15 +506,14 @@ fn epuck_tables(
                 },
             ),
         ],
-    });
-    out
+    }
 }
 
-fn grid_tables(results: &[crate::grid::GridEpisodeResult]) -> Vec<CsvTable> {
-    let grid = Grid::paper();
+/// One row per grid episode.
+fn grid_runs_table(results: &[crate::grid::GridEpisodeResult]) -> CsvTable {
     let n = results.len() as i64;
     let cell_text = |c: errp_robot::Cell| c.to_string();
-    let runs = CsvTable {
+    CsvTable {
         name: "runs",
         columns: vec![
             ("run", Column::I64((1..=n).collect())),
@@ -523,7 +559,12 @@ fn grid_tables(results: &[crate::grid::GridEpisodeResult]) -> Vec<CsvTable> {
                 Column::F64(results.iter().map(|r| r.online.error).collect()),
             ),
         ],
-    };
+    }
+}
+
+fn grid_tables(results: &[crate::grid::GridEpisodeResult]) -> Vec<CsvTable> {
+    let grid = Grid::paper();
+    let runs = grid_runs_table(results);
     let mut a: (Vec<i64>, Vec<i64>, Vec<f64>) = Default::default();
     let mut cells: [Vec<i64>; 4] = Default::default();
     let mut act = Vec::new();
