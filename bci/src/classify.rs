@@ -2,7 +2,10 @@
 
 use nalgebra::DMatrix;
 
+use rand::seq::SliceRandom;
+
 use crate::error::Result;
+use crate::rng::stream;
 
 /// Feature matrix, one trial per row: shape `(n_trials, n_features)`.
 pub type Features = DMatrix<f64>;
@@ -84,4 +87,19 @@ pub(crate) fn check_training_set(x: &Features, labels: &[bool]) -> Result<(usize
         ));
     }
     Ok((n_cor, n_err))
+}
+
+/// Fold index of every trial, for cross-validation: each class shuffled
+/// and dealt round-robin.
+pub fn stratified_folds(labels: &[bool], folds: usize, seed: u64) -> Vec<usize> {
+    let mut rng = stream(seed, "cv/folds");
+    let mut fold_of = vec![0; labels.len()];
+    for class in [false, true] {
+        let mut idx: Vec<usize> = (0..labels.len()).filter(|&i| labels[i] == class).collect();
+        idx.shuffle(&mut rng);
+        for (k, i) in idx.into_iter().enumerate() {
+            fold_of[i] = k % folds;
+        }
+    }
+    fold_of
 }

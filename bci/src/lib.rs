@@ -27,7 +27,6 @@
 mod calibration;
 mod classify;
 mod continuous;
-mod continuous_calibration;
 mod edf;
 mod erp;
 mod error;
@@ -45,20 +44,24 @@ pub mod rng;
 mod smo;
 mod subjects;
 mod svm;
-mod targeting;
 
+pub use calibration::continuous::{
+    ContinuousCalibrationParams, ContinuousSetup, calibrate_continuous, continuous_schedule,
+    simulate_continuous_session,
+};
+pub use calibration::targeting::{
+    MeanAccuracy, RequestedAccuracy, SessionParts, TargetingResult, TargetingStep,
+    inverse_normal_cdf, ratio_text, search_ratio, target_accuracy, target_accuracy_on,
+    target_continuous_accuracy,
+};
 pub use calibration::{
     Accuracy, Calibrated, CalibrationParams, CalibrationSession, CalibrationSetup, GrandAverage,
     Protocol, RawSink, SessionOptions, Setup, TargetingParams, calibrate, calibrate_session,
     cross_validate, cv_seed, eog_session, out_of_fold_decisions, schedule, simulate_session,
-    simulate_session_with, stratified_folds,
+    simulate_session_with,
 };
-pub use classify::{Classifier, ErrorModel, Features, sigmoid};
+pub use classify::{Classifier, ErrorModel, Features, sigmoid, stratified_folds};
 pub use continuous::ContinuousFeatures;
-pub use continuous_calibration::{
-    ContinuousCalibrationParams, ContinuousSetup, calibrate_continuous, continuous_schedule,
-    simulate_continuous_session,
-};
 pub use edf::EdfWriter;
 pub use erp::{AssessmentKind, Component, ErpTemplates};
 pub use error::{BciError, Result};
@@ -80,8 +83,3 @@ pub use preprocess::{PreprocessParams, Preprocessor};
 pub use psd::ThetaPsd;
 pub use subjects::{GoalSet, Subject, subject, subjects};
 pub use svm::{SvmDecoder, SvmModel};
-pub use targeting::{
-    MeanAccuracy, RequestedAccuracy, SessionParts, TargetingResult, TargetingStep,
-    inverse_normal_cdf, ratio_text, search_ratio, target_accuracy, target_accuracy_on,
-    target_continuous_accuracy,
-};

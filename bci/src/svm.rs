@@ -4,8 +4,9 @@
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
-use crate::calibration::stratified_folds;
-use crate::classify::{Classifier, ErrorModel, Features, check_training_set, dot_f32};
+use crate::classify::{
+    Classifier, ErrorModel, Features, check_training_set, dot_f32, stratified_folds,
+};
 use crate::error::{Result, check};
 use crate::platt::PlattScaling;
 use crate::rng::derive_seed;

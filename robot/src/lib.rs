@@ -23,31 +23,23 @@
 
 #![warn(clippy::unwrap_used, clippy::print_stdout, clippy::iter_over_hash_type)]
 
-mod avoidance;
 mod belief;
-mod continuous_control;
-mod continuous_likelihood;
-mod epuck;
+mod continuous;
 mod error;
 mod grid;
-mod grid_control;
-mod layout;
-mod pose;
-mod potential;
-mod qvalues;
 mod strategy;
 
-pub use avoidance::AvoidanceParams;
 pub use belief::{Belief, log_sum_exp};
-pub use continuous_control::{ContinuousController, Observation, Phase, StepKind, StopReason};
-pub use continuous_likelihood::{ContinuousControlParams, linear_likelihood, turn_likelihood};
-pub use epuck::{EpuckParams, Twist, WheelSpeeds, integrate};
+pub use continuous::avoidance::AvoidanceParams;
+pub use continuous::control::{ContinuousController, Observation, Phase, StepKind, StopReason};
+pub use continuous::epuck::{EpuckParams, Twist, WheelSpeeds, integrate};
+pub use continuous::layout::{Goal, GoalLayout, LAYOUT_GRID_CELLS};
+pub use continuous::likelihood::{ContinuousControlParams, linear_likelihood, turn_likelihood};
+pub use continuous::pose::{Pose, wrap_angle};
+pub use continuous::potential::QuadraticPotential;
 pub use error::{Result, RobotError};
 pub use errp_valid::{Check, Valid};
+pub use grid::control::{GridControlParams, GridController, policy_likelihood};
+pub use grid::qvalues::{QParams, QTable, softmax};
 pub use grid::{Cell, Grid, GridAction};
-pub use grid_control::{GridControlParams, GridController, policy_likelihood};
-pub use layout::{Goal, GoalLayout, LAYOUT_GRID_CELLS};
-pub use pose::{Pose, wrap_angle};
-pub use potential::QuadraticPotential;
-pub use qvalues::{QParams, QTable, softmax};
 pub use strategy::{Strategy, entropy_nats, expected_information_gain};

@@ -1,14 +1,12 @@
 //! Scoring and training on a session: stratified folds, cross-validation, and
 //! the calibrated decoder.
 
-use rand::seq::SliceRandom;
-
 use super::session::{CalibrationSession, SessionOptions, simulate_session};
 use super::{Accuracy, CalibrationSetup};
-use crate::classify::{Classifier, ErrorModel, Features};
+use crate::classify::{Classifier, ErrorModel, Features, stratified_folds};
 use crate::error::Result;
 use crate::platt::PlattScaling;
-use crate::rng::{derive_seed, stream};
+use crate::rng::derive_seed;
 
 /// The seed of the cross-validation folds of a session simulated from `seed`
 /// (shared by [`calibrate`] and accuracy targeting, so both score alike).
@@ -118,18 +116,4 @@ pub fn out_of_fold_decisions<C: Classifier>(
         }
     }
     Ok(decisions)
-}
-
-/// Fold index of every trial: each class shuffled and dealt round-robin.
-pub fn stratified_folds(labels: &[bool], folds: usize, seed: u64) -> Vec<usize> {
-    let mut rng = stream(seed, "cv/folds");
-    let mut fold_of = vec![0; labels.len()];
-    for class in [false, true] {
-        let mut idx: Vec<usize> = (0..labels.len()).filter(|&i| labels[i] == class).collect();
-        idx.shuffle(&mut rng);
-        for (k, i) in idx.into_iter().enumerate() {
-            fold_of[i] = k % folds;
-        }
-    }
-    fold_of
 }

@@ -8,8 +8,10 @@ use crate::generator::GeneratorParams;
 use crate::montage::Montage;
 use crate::preprocess::PreprocessParams;
 
+pub(crate) mod continuous;
 mod cv;
 mod session;
+pub(crate) mod targeting;
 
 pub use cv::*;
 pub use session::*;
@@ -281,6 +283,7 @@ pub(crate) fn check_intervals(min_secs: f64, max_secs: f64, why: &str) -> Result
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::classify::stratified_folds;
     use crate::erp::AssessmentKind;
 
     #[test]

@@ -8,8 +8,8 @@
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
+use crate::continuous::pose::{Pose, wrap_angle};
 use crate::error::{Result, check};
-use crate::pose::{Pose, wrap_angle};
 
 /// Physical constants of the e-puck (Mondada et al. 2009; GCtronic e-puck
 /// documentation, <https://www.gctronic.com/doc/index.php/E-Puck>; e-puck.org

@@ -4,7 +4,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, RobotError};
 
-const CITIES_TOML: &str = include_str!("../../assets/cities.toml");
+const CITIES_TOML: &str = include_str!("../../../assets/cities.toml");
 
 /// Cells per side of the grid on which a layout file places its goals (the
 /// paper's 5 x 5 discretisation of the arena, sec. 5.1).

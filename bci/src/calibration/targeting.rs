@@ -3,12 +3,12 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::calibration::continuous::{ContinuousSetup, simulate_continuous_session};
 use crate::calibration::{
     Accuracy, CalibrationSession, CalibrationSetup, SessionOptions, TargetingParams,
     cross_validate, cv_seed, simulate_session,
 };
 use crate::classify::{Classifier, Features};
-use crate::continuous_calibration::{ContinuousSetup, simulate_continuous_session};
 use crate::error::{BciError, Result, check};
 use crate::generator::Components;
 use crate::svm::SvmDecoder;

@@ -7,9 +7,9 @@ use serde::{Deserialize, Serialize};
 
 use errp_valid::Check;
 
-use crate::epuck::EpuckParams;
+use crate::continuous::epuck::EpuckParams;
+use crate::continuous::pose::wrap_angle;
 use crate::error::{Result, RobotError, check};
-use crate::pose::wrap_angle;
 use crate::strategy::Strategy;
 
 /// Parameters of the continuous strategy (sec. 5.2) and of the motion
@@ -261,7 +261,7 @@ pub fn linear_likelihood(params: &ContinuousControlParams, error: bool, bearing_
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::pose::Pose;
+    use crate::continuous::pose::Pose;
 
     fn params() -> ContinuousControlParams {
         ContinuousControlParams::default()

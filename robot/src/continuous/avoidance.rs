@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::epuck::{EpuckParams, Twist, WheelSpeeds};
+use crate::continuous::epuck::{EpuckParams, Twist, WheelSpeeds};
 
 /// Obstacle avoidance from the proximity sensors, layered under the shared
 /// control (a Braitenberg reflex, as classic e-puck controllers do): the

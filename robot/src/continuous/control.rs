@@ -70,12 +70,12 @@ use serde::{Deserialize, Serialize};
 use errp_valid::Valid;
 
 use crate::belief::Belief;
-use crate::continuous_likelihood::{ContinuousControlParams, linear_likelihood, turn_likelihood};
-use crate::epuck::{Twist, WheelSpeeds};
+use crate::continuous::epuck::{Twist, WheelSpeeds};
+use crate::continuous::layout::GoalLayout;
+use crate::continuous::likelihood::{ContinuousControlParams, linear_likelihood, turn_likelihood};
+use crate::continuous::pose::{Pose, wrap_angle};
+use crate::continuous::potential::QuadraticPotential;
 use crate::error::{Result, RobotError};
-use crate::layout::GoalLayout;
-use crate::pose::{Pose, wrap_angle};
-use crate::potential::QuadraticPotential;
 use crate::strategy::{Strategy, expected_information_gain};
 
 /// Why the robot is stopped.
@@ -561,7 +561,7 @@ impl ContinuousController {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::epuck::EpuckParams;
+    use crate::continuous::epuck::EpuckParams;
     use crate::strategy::Strategy;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;

@@ -1,5 +1,8 @@
 //! The 5x5 grid world of the discrete task (sec. 4 of the paper).
 
+pub(crate) mod control;
+pub(crate) mod qvalues;
+
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, RobotError};

@@ -8,8 +8,8 @@ use errp_valid::{Check, Valid};
 
 use crate::belief::Belief;
 use crate::error::{Result, RobotError, check};
+use crate::grid::qvalues::{QParams, QTable};
 use crate::grid::{Cell, Grid, GridAction};
-use crate::qvalues::{QParams, QTable};
 use crate::strategy::{Strategy, gain_from_logs};
 
 /// The Q-value scale of the shipped grid strategy (`goal_reward`, at the
