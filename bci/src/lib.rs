@@ -23,6 +23,8 @@
 //! * the subjects of Table 1 ([`subject`]) and EDF+ export ([`EdfWriter`]).
 
 #![warn(clippy::unwrap_used, clippy::print_stdout, clippy::iter_over_hash_type)]
+// No function over 120 lines of code (clippy.toml) outside the tests.
+#![cfg_attr(not(test), warn(clippy::too_many_lines))]
 
 mod calibration;
 mod classify;

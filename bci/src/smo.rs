@@ -36,61 +36,14 @@ pub(crate) fn solve_dual(kernel: &[f64], y: &[f64], c: f64, eps: f64) -> Result<
     let mut grad = vec![-1.0; n];
     let max_iterations = ITERATIONS_PER_EXAMPLE * n.max(100);
     let mut iterations = 0;
-    loop {
-        // i: the maximal violator of the first-order condition.
-        let mut g_max = f64::NEG_INFINITY;
-        let mut i_best = None;
-        for t in 0..n {
-            let v = if y[t] > 0.0 {
-                (alpha[t] < c).then_some(-grad[t])
-            } else {
-                (alpha[t] > 0.0).then_some(grad[t])
-            };
-            if let Some(v) = v
-                && v >= g_max
-            {
-                g_max = v;
-                i_best = Some(t);
-            }
-        }
-        // j: the largest decrease of the objective with i (second order).
-        let mut g_max2 = f64::NEG_INFINITY;
-        let mut j_best = None;
-        let mut obj_min = f64::INFINITY;
-        if let Some(i) = i_best {
-            for t in 0..n {
-                let (movable, g) = if y[t] > 0.0 {
-                    (alpha[t] > 0.0, grad[t])
-                } else {
-                    (alpha[t] < c, -grad[t])
-                };
-                if !movable {
-                    continue;
-                }
-                g_max2 = g_max2.max(g);
-                let grad_diff = g_max + g;
-                if grad_diff > 0.0 {
-                    // |phi(x_i) - phi(x_t)|^2 whatever the labels.
-                    let quad = kernel[i * n + i] + kernel[t * n + t] - 2.0 * kernel[i * n + t];
-                    let obj = -(grad_diff * grad_diff) / if quad > 0.0 { quad } else { TAU };
-                    if obj <= obj_min {
-                        obj_min = obj;
-                        j_best = Some(t);
-                    }
-                }
-            }
-        }
-        let (Some(i), Some(j)) = (i_best, j_best) else {
-            break;
-        };
-        if g_max + g_max2 < eps {
+    while let Some((i, j, violation)) = working_set(kernel, y, &alpha, &grad, c) {
+        if violation < eps {
             break;
         }
         if iterations >= max_iterations {
             return Err(BciError::Training(format!(
                 "the SVM solver did not converge in {max_iterations} iterations \
-                 (KKT violation {:.3e}, tolerance {eps:e})",
-                g_max + g_max2
+                 (KKT violation {violation:.3e}, tolerance {eps:e})"
             )));
         }
         iterations += 1;
@@ -153,6 +106,79 @@ pub(crate) fn solve_dual(kernel: &[f64], y: &[f64], c: f64, eps: f64) -> Result<
         }
     }
 
+    let rho = rho(&alpha, &grad, y, c);
+    Ok(DualSolution {
+        alpha,
+        rho,
+        iterations,
+    })
+}
+
+/// libsvm's second-order working-set selection (WSS2): `i`, the maximal
+/// violator of the first-order condition, and `j`, the largest decrease of
+/// the objective with it, with the KKT violation m(a) - M(a); `None` when
+/// no pair can move.
+fn working_set(
+    kernel: &[f64],
+    y: &[f64],
+    alpha: &[f64],
+    grad: &[f64],
+    c: f64,
+) -> Option<(usize, usize, f64)> {
+    let n = y.len();
+    // i: the maximal violator of the first-order condition.
+    let mut g_max = f64::NEG_INFINITY;
+    let mut i_best = None;
+    for t in 0..n {
+        let v = if y[t] > 0.0 {
+            (alpha[t] < c).then_some(-grad[t])
+        } else {
+            (alpha[t] > 0.0).then_some(grad[t])
+        };
+        if let Some(v) = v
+            && v >= g_max
+        {
+            g_max = v;
+            i_best = Some(t);
+        }
+    }
+    // j: the largest decrease of the objective with i (second order).
+    let mut g_max2 = f64::NEG_INFINITY;
+    let mut j_best = None;
+    let mut obj_min = f64::INFINITY;
+    if let Some(i) = i_best {
+        for t in 0..n {
+            let (movable, g) = if y[t] > 0.0 {
+                (alpha[t] > 0.0, grad[t])
+            } else {
+                (alpha[t] < c, -grad[t])
+            };
+            if !movable {
+                continue;
+            }
+            g_max2 = g_max2.max(g);
+            let grad_diff = g_max + g;
+            if grad_diff > 0.0 {
+                // |phi(x_i) - phi(x_t)|^2 whatever the labels.
+                let quad = kernel[i * n + i] + kernel[t * n + t] - 2.0 * kernel[i * n + t];
+                let obj = -(grad_diff * grad_diff) / if quad > 0.0 { quad } else { TAU };
+                if obj <= obj_min {
+                    obj_min = obj;
+                    j_best = Some(t);
+                }
+            }
+        }
+    }
+    match (i_best, j_best) {
+        (Some(i), Some(j)) => Some((i, j, g_max + g_max2)),
+        _ => None,
+    }
+}
+
+/// The bias rho of the decision function: the mean of y_i grad_i over the
+/// free variables, else the middle of the feasible interval.
+fn rho(alpha: &[f64], grad: &[f64], y: &[f64], c: f64) -> f64 {
+    let n = y.len();
     // rho: the mean of y_i grad_i over free variables, else the middle of
     // the feasible interval.
     let (mut upper, mut lower) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -170,16 +196,11 @@ pub(crate) fn solve_dual(kernel: &[f64], y: &[f64], c: f64, eps: f64) -> Result<
             sum_free += yg;
         }
     }
-    let rho = if n_free > 0 {
+    if n_free > 0 {
         sum_free / n_free as f64
     } else {
         (upper + lower) / 2.0
-    };
-    Ok(DualSolution {
-        alpha,
-        rho,
-        iterations,
-    })
+    }
 }
 
 #[cfg(test)]

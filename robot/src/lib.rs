@@ -22,6 +22,8 @@
 //! moves away from it).
 
 #![warn(clippy::unwrap_used, clippy::print_stdout, clippy::iter_over_hash_type)]
+// No function over 120 lines of code (clippy.toml) outside the tests.
+#![cfg_attr(not(test), warn(clippy::too_many_lines))]
 
 mod belief;
 mod continuous;

@@ -20,6 +20,8 @@
 //!   (`host`) and the error type.
 
 #![warn(clippy::unwrap_used, clippy::print_stdout, clippy::iter_over_hash_type)]
+// No function over 120 lines of code (clippy.toml) outside the tests.
+#![cfg_attr(not(test), warn(clippy::too_many_lines))]
 
 pub mod calibration;
 pub mod epuck;

@@ -297,30 +297,12 @@ pub fn prepare_sweep(
     }
 }
 
-/// Prepares the levels' decoders (one per distinct calibration, in
-/// parallel), lists them in the manifest, then runs the slice's episodes.
-fn run_levels<T: Task>(
-    spec: &SweepSpec,
-    opts: &SweepOptions,
-    levels: &[Level],
-    fresh: Manifest,
-    made_with: &[DecoderInfo],
-    cancel: &AtomicBool,
-    observer: &dyn SweepObserver,
-) -> Result<SweepOutcome> {
-    let out = &opts.out;
-    let episodes_path = out.join(EPISODES);
-    let plan = Plan::<T>::new(spec, levels)?;
-    let prepared = plan.prepare(&opts.cache, observer)?;
-    let (decoders, infos): (Vec<_>, Vec<_>) = prepared
-        .into_iter()
-        .map(|(decoder, info)| (Arc::new(decoder), info))
-        .unzip();
-    // Rows already on disk were made with the decoders `sweep.json` lists:
-    // the rest must be made with the same (a cache that changed between
-    // the runs, another version) or the file would mix two sweeps.
-    if episodes_path.exists()
-        && !made_with.is_empty()
+/// Refuses to resume rows made with decoders (`made_with`, from
+/// `sweep.json`) other than the ones this run prepared (`infos`): a cache
+/// that changed between the runs, another version. The file would mix two
+/// sweeps.
+fn check_made_with(out: &Path, made_with: &[DecoderInfo], infos: &[DecoderInfo]) -> Result<()> {
+    if !made_with.is_empty()
         && let Some(i) = (0..infos.len().max(made_with.len())).find(|&i| {
             let now = infos.get(i).map(|d| DecoderInfo {
                 cached: false,
@@ -349,6 +331,64 @@ fn run_levels<T: Task>(
             show(infos.get(i)),
         )));
     }
+    Ok(())
+}
+
+/// The rows of this slice already in `episodes.csv` (`usize::MAX` for a
+/// new file), telling `observer` what `--repair` dropped.
+fn resumed_count(
+    resumed: Resumed,
+    slice_len: usize,
+    episodes_path: &Path,
+    observer: &dyn SweepObserver,
+) -> usize {
+    match resumed {
+        Resumed::Empty => usize::MAX,
+        Resumed::Rows { rows, dropped } => {
+            if let Some((line, why, n)) = dropped {
+                let after = match n - 1 {
+                    0 => String::new(),
+                    k => format!(" and the {k} row(s) after it"),
+                };
+                let again = if rows < slice_len {
+                    ", to run again what the sweep needs"
+                } else {
+                    ""
+                };
+                observer.note(&format!(
+                    "--repair: {} line {line}: {why}; dropped it{after}{again}",
+                    episodes_path.display(),
+                ));
+            }
+            rows
+        }
+    }
+}
+
+/// Prepares the levels' decoders (one per distinct calibration, in
+/// parallel), lists them in the manifest, then runs the slice's episodes.
+fn run_levels<T: Task>(
+    spec: &SweepSpec,
+    opts: &SweepOptions,
+    levels: &[Level],
+    fresh: Manifest,
+    made_with: &[DecoderInfo],
+    cancel: &AtomicBool,
+    observer: &dyn SweepObserver,
+) -> Result<SweepOutcome> {
+    let out = &opts.out;
+    let episodes_path = out.join(EPISODES);
+    let plan = Plan::<T>::new(spec, levels)?;
+    let prepared = plan.prepare(&opts.cache, observer)?;
+    let (decoders, infos): (Vec<_>, Vec<_>) = prepared
+        .into_iter()
+        .map(|(decoder, info)| (Arc::new(decoder), info))
+        .unzip();
+    // Rows already on disk were made with the decoders `sweep.json` lists:
+    // the rest must be made with the same.
+    if episodes_path.exists() {
+        check_made_with(out, made_with, &infos)?;
+    }
     let manifest = Manifest {
         decoders: infos,
         ..fresh
@@ -370,27 +410,7 @@ fn run_levels<T: Task>(
     } else {
         Resumed::Empty
     };
-    let mut done = match resumed {
-        Resumed::Empty => usize::MAX,
-        Resumed::Rows { rows, dropped } => {
-            if let Some((line, why, n)) = dropped {
-                let after = match n - 1 {
-                    0 => String::new(),
-                    k => format!(" and the {k} row(s) after it"),
-                };
-                let again = if rows < items.len {
-                    ", to run again what the sweep needs"
-                } else {
-                    ""
-                };
-                observer.note(&format!(
-                    "--repair: {} line {line}: {why}; dropped it{after}{again}",
-                    episodes_path.display(),
-                ));
-            }
-            rows
-        }
-    };
+    let mut done = resumed_count(resumed, items.len, &episodes_path, observer);
     forget_if_interrupted(out);
     let mut file =
         errp_sim::open_regular_with(OpenOptions::new().create(true).append(true), &episodes_path)

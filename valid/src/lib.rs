@@ -8,6 +8,8 @@
 //! The parameter structs keep their public fields and their `Default`, for
 //! building them; [`Check`] is what makes them valid.
 
+#![cfg_attr(not(test), warn(clippy::too_many_lines))]
+
 use std::fmt;
 use std::ops::Deref;
 

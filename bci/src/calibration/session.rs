@@ -101,24 +101,9 @@ pub fn simulate_session(
     simulate_session_with(setup, seed, &assessments, &onsets, &window, options)
 }
 
-/// Simulates a session with a given schedule and feature extractor: EOG
-/// recording, preprocessor fit, then `assessments` (sorted by onset) streamed
-/// through the generator and the preprocessor in 1 s blocks, and one feature
-/// vector per assessment from the window that starts at the matching entry of
-/// `window_onsets_secs` (rounded to samples), labelled by the assessment.
-///
-/// Only `eog_session_secs` of `setup.calibration` is used (and validated with
-/// the rest); the schedule is the one given. Grand averages are locked to the
-/// assessment onsets.
-pub fn simulate_session_with(
-    setup: &CalibrationSetup,
-    seed: u64,
-    assessments: &[Assessment],
-    window_onsets_secs: &[f64],
-    features: &dyn FeatureExtractor,
-    mut options: SessionOptions<'_>,
-) -> Result<CalibrationSession> {
-    setup.validate()?;
+/// Checks that there is one window per assessment and that the onsets are
+/// finite, non-negative and sorted.
+fn check_schedule(assessments: &[Assessment], window_onsets_secs: &[f64]) -> Result<()> {
     check(
         window_onsets_secs.len() == assessments.len(),
         "window_onsets_secs",
@@ -141,7 +126,83 @@ pub fn simulate_session_with(
         "window_onsets_secs",
         "not finite",
         "finite onsets (s)",
-    )?;
+    )
+}
+
+/// The grand averages' window at `fs`: the samples before the onset
+/// (200 ms), and in all (1 s).
+fn ga_window(fs: f64) -> (usize, usize) {
+    let before = (0.2 * fs).round() as usize;
+    (before, before + (0.8 * fs).round() as usize)
+}
+
+/// The grand averages of Fig. 1 over every EEG channel (`full_chunks`,
+/// spatially preprocessed), from `onsets` (samples) with their `labels`.
+/// Offline analysis, as for Fig. 1: zero-phase filtering, so that the
+/// latencies are not delayed by the causal online filter.
+fn grand_average(
+    full_chunks: Vec<EegBlock>,
+    pre: &Preprocessor,
+    onsets: &[usize],
+    labels: &[bool],
+    montage: &Montage,
+    fs: f64,
+) -> GrandAverage {
+    let n_eeg = montage.n_eeg();
+    let (ga_before, ga_len) = ga_window(fs);
+    let mut full = EegBlock::zeros(n_eeg, 0);
+    concat_into(&mut full, &full_chunks);
+    drop(full_chunks);
+    let filter = pre.filter();
+    for ch in 0..full.n_channels {
+        filter.filtfilt(full.channel_mut(ch));
+    }
+    let mut sums = [DMatrix::zeros(n_eeg, ga_len), DMatrix::zeros(n_eeg, ga_len)];
+    let mut counts = [0usize; 2];
+    for (&o, &l) in onsets.iter().zip(labels) {
+        if o < ga_before {
+            continue;
+        }
+        counts[usize::from(l)] += 1;
+        for ch in 0..n_eeg {
+            let x = &full.channel(ch)[o - ga_before..o - ga_before + ga_len];
+            for (t, v) in x.iter().enumerate() {
+                sums[usize::from(l)][(ch, t)] += v;
+            }
+        }
+    }
+    let [c, e] = sums;
+    GrandAverage {
+        channels: (0..n_eeg)
+            .map(|i| montage.channels()[i].name.clone())
+            .collect(),
+        times_ms: (0..ga_len)
+            .map(|t| (t as f64 - ga_before as f64) / fs * 1000.0)
+            .collect(),
+        error: e / counts[1].max(1) as f64,
+        correct: c / counts[0].max(1) as f64,
+    }
+}
+
+/// Simulates a session with a given schedule and feature extractor: EOG
+/// recording, preprocessor fit, then `assessments` (sorted by onset) streamed
+/// through the generator and the preprocessor in 1 s blocks, and one feature
+/// vector per assessment from the window that starts at the matching entry of
+/// `window_onsets_secs` (rounded to samples), labelled by the assessment.
+///
+/// Only `eog_session_secs` of `setup.calibration` is used (and validated with
+/// the rest); the schedule is the one given. Grand averages are locked to the
+/// assessment onsets.
+pub fn simulate_session_with(
+    setup: &CalibrationSetup,
+    seed: u64,
+    assessments: &[Assessment],
+    window_onsets_secs: &[f64],
+    features: &dyn FeatureExtractor,
+    mut options: SessionOptions<'_>,
+) -> Result<CalibrationSession> {
+    setup.validate()?;
+    check_schedule(assessments, window_onsets_secs)?;
     let (params, calib, preprocess, montage) = (
         &setup.generator,
         &setup.calibration,
@@ -160,8 +221,7 @@ pub fn simulate_session_with(
         None
     };
 
-    let ga_before = (0.2 * fs).round() as usize;
-    let ga_len = ga_before + (0.8 * fs).round() as usize;
+    let (_, ga_len) = ga_window(fs);
     let last_onset = assessments
         .iter()
         .map(|a| a.onset_secs)
@@ -214,48 +274,9 @@ pub fn simulate_session_with(
         .map(|a| a.kind == AssessmentKind::Error)
         .collect();
 
-    let grand_average = if options.grand_average {
-        // Offline analysis, as for Fig. 1: zero-phase filtering, so that the
-        // latencies are not delayed by the causal online filter.
-        let mut full = EegBlock::zeros(all_eeg.len(), 0);
-        concat_into(&mut full, &full_chunks);
-        drop(full_chunks);
-        let filter = pre.filter();
-        for ch in 0..full.n_channels {
-            filter.filtfilt(full.channel_mut(ch));
-        }
-        let mut sums = [
-            DMatrix::zeros(all_eeg.len(), ga_len),
-            DMatrix::zeros(all_eeg.len(), ga_len),
-        ];
-        let mut counts = [0usize; 2];
-        for (&o, &l) in onsets.iter().zip(&labels) {
-            if o < ga_before {
-                continue;
-            }
-            counts[usize::from(l)] += 1;
-            for ch in 0..all_eeg.len() {
-                let x = &full.channel(ch)[o - ga_before..o - ga_before + ga_len];
-                for (t, v) in x.iter().enumerate() {
-                    sums[usize::from(l)][(ch, t)] += v;
-                }
-            }
-        }
-        let [c, e] = sums;
-        Some(GrandAverage {
-            channels: all_eeg
-                .iter()
-                .map(|&i| montage.channels()[i].name.clone())
-                .collect(),
-            times_ms: (0..ga_len)
-                .map(|t| (t as f64 - ga_before as f64) / fs * 1000.0)
-                .collect(),
-            error: e / counts[1].max(1) as f64,
-            correct: c / counts[0].max(1) as f64,
-        })
-    } else {
-        None
-    };
+    let grand_average = options
+        .grand_average
+        .then(|| grand_average(full_chunks, &pre, &onsets, &labels, montage, fs));
 
     Ok(CalibrationSession {
         features,

@@ -290,8 +290,6 @@ impl EegGenerator {
         let fs = self.params.sfreq_hz;
         let c = self.components;
         let bg = if c.background { 1.0 } else { 0.0 };
-        let art = if c.artifacts { 1.0 } else { 0.0 };
-        let erp_on = if c.erp { 1.0 } else { 0.0 };
 
         // 1. White noise: per sample, n_ch drivers of the 1/f sources and
         //    n_ch sensor-noise values, as 16-bit uniforms scaled to unit
@@ -351,6 +349,49 @@ impl EegGenerator {
         }
 
         // 4. Sources shared by all channels, one value per sample.
+        self.shared_sources(n);
+
+        // 5. Per channel: add everything with that channel's weights.
+        let sensor = bg * self.params.sensor_noise_uv;
+        let alpha = &self.alpha_buf[..n];
+        let blink = &self.blink_buf[..n];
+        let gaze = &self.gaze_buf[..n];
+        let line_c = &self.line_c_buf[..n];
+        let line_s = &self.line_s_buf[..n];
+        let erp = &self.erp_buf[..n];
+        for ch in 0..n_ch {
+            let row = &mut block.data[ch * n..(ch + 1) * n];
+            let noise = &self.scratch[(n_ch + ch) * n..(n_ch + ch + 1) * n];
+            let (aw, lc, ls) = (self.alpha_weight[ch], self.line_cos[ch], -self.line_sin[ch]);
+            let (bw, gw, tw) = (
+                self.blink_coeff[ch],
+                self.gaze_coeff[ch],
+                self.topography[ch],
+            );
+            for t in 0..n {
+                row[t] += aw * alpha[t]
+                    + sensor * noise[t]
+                    + lc * line_c[t]
+                    + ls * line_s[t]
+                    + bw * blink[t]
+                    + gw * gaze[t]
+                    + tw * erp[t];
+            }
+        }
+        let now = self.sample as f64;
+        let erp_len = ERP_LENGTH_SECS * fs;
+        self.erps.retain(|e| now < e.onset_sample + erp_len);
+    }
+
+    /// Stage 4 of [`generate_into`](Self::generate_into): the sources all
+    /// channels share (alpha, blinks, gaze, line noise, the ERPs), one value
+    /// per sample of the next `n`, into their buffers.
+    fn shared_sources(&mut self, n: usize) {
+        let fs = self.params.sfreq_hz;
+        let c = self.components;
+        let bg = if c.background { 1.0 } else { 0.0 };
+        let art = if c.artifacts { 1.0 } else { 0.0 };
+        let erp_on = if c.erp { 1.0 } else { 0.0 };
         for buf in [
             &mut self.alpha_buf,
             &mut self.blink_buf,
@@ -413,36 +454,6 @@ impl EegGenerator {
             self.erp_buf.push(erp_on * self.erp_scale * erp);
             self.sample += 1;
         }
-
-        // 5. Per channel: add everything with that channel's weights.
-        let sensor = bg * self.params.sensor_noise_uv;
-        let alpha = &self.alpha_buf[..n];
-        let blink = &self.blink_buf[..n];
-        let gaze = &self.gaze_buf[..n];
-        let line_c = &self.line_c_buf[..n];
-        let line_s = &self.line_s_buf[..n];
-        let erp = &self.erp_buf[..n];
-        for ch in 0..n_ch {
-            let row = &mut block.data[ch * n..(ch + 1) * n];
-            let noise = &self.scratch[(n_ch + ch) * n..(n_ch + ch + 1) * n];
-            let (aw, lc, ls) = (self.alpha_weight[ch], self.line_cos[ch], -self.line_sin[ch]);
-            let (bw, gw, tw) = (
-                self.blink_coeff[ch],
-                self.gaze_coeff[ch],
-                self.topography[ch],
-            );
-            for t in 0..n {
-                row[t] += aw * alpha[t]
-                    + sensor * noise[t]
-                    + lc * line_c[t]
-                    + ls * line_s[t]
-                    + bw * blink[t]
-                    + gw * gaze[t]
-                    + tw * erp[t];
-            }
-        }
-        let now = self.sample as f64;
-        self.erps.retain(|e| now < e.onset_sample + erp_len);
     }
 
     fn gaze_at(&self, s: u64, saccade_len: u64) -> f64 {

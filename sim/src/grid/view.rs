@@ -4,11 +4,11 @@ use std::path::{Path, PathBuf};
 
 use errp_robot::{Cell, Grid};
 use rerun::blueprint::{Blueprint, Spatial2DView, TimeSeriesView};
-use rerun::{Boxes2D, Color, Image, Points2D, Scalars, SeriesLines, TextLog};
+use rerun::{Boxes2D, Color, Image, Points2D, RecordingStream, Scalars, SeriesLines, TextLog};
 
 use crate::error::Result;
-use crate::grid::GridEpisodeResult;
 use crate::grid::run::GridRunReport;
+use crate::grid::{GridEpisodeResult, GridStep};
 use crate::record::data::{Column, Provenance, send_table};
 use crate::record::{
     RrdFile, SIM_TIME, eeg_channel, log_decoder_series, paths, record_error, task_blueprint,
@@ -141,7 +141,6 @@ impl GridRecorder {
         let t0 = self.t0;
         let rec = self.file.stream();
         let err = record_error(self.file.path());
-        let fs = 256.0;
         send_episode_tables(rec, &grid, k, t0, seed, epoch_secs, ep).map_err(&err)?;
         rec.set_duration_secs(SIM_TIME, t0);
         rec.log(
@@ -176,62 +175,7 @@ impl GridRecorder {
         )
         .map_err(&err)?;
         for step in &ep.steps {
-            let t = t0 + step.onset_secs;
-            rec.set_duration_secs(SIM_TIME, t);
-            let has_belief = step.belief.iter().all(|p| p.is_finite());
-            if has_belief {
-                rec.log(paths::GRID_POSTERIOR, &heat_map(&grid, &step.belief))
-                    .map_err(&err)?;
-            }
-            rec.log(
-                paths::GRID_CURSOR,
-                &Points2D::new([centre(&grid, step.to)])
-                    .with_radii([0.25])
-                    .with_colors([Color::from_rgb(30, 30, 30)]),
-            )
-            .map_err(&err)?;
-            rec.log(paths::P_ERROR, &Scalars::single(step.p_error))
-                .map_err(&err)?;
-            rec.log(paths::THRESHOLD, &Scalars::single(0.5))
-                .map_err(&err)?;
-            if has_belief {
-                rec.log(
-                    paths::BELIEF_TRUE_GOAL,
-                    &Scalars::single(step.belief[grid.index(ep.goal)]),
-                )
-                .map_err(&err)?;
-                let max = step.belief.iter().copied().fold(0.0, f64::max);
-                rec.log(paths::BELIEF_MAX, &Scalars::single(max))
-                    .map_err(&err)?;
-            }
-            let decoded = if step.p_error >= 0.5 {
-                "error"
-            } else {
-                "correct"
-            };
-            let truth = if step.error { "error" } else { "correct" };
-            let level = if (step.p_error >= 0.5) == step.error {
-                "INFO"
-            } else {
-                "WARN"
-            };
-            rec.log(
-                paths::LOG,
-                &TextLog::new(format!(
-                    "{} {} -> {}: user {truth}, decoded {decoded} (p = {:.2})",
-                    step.action.name(),
-                    step.from,
-                    step.to,
-                    step.p_error
-                ))
-                .with_level(level),
-            )
-            .map_err(&err)?;
-            for (i, v) in step.fcz.iter().enumerate() {
-                rec.set_duration_secs(SIM_TIME, t + i as f64 / fs);
-                rec.log(eeg_channel("FCz"), &Scalars::single(*v))
-                    .map_err(&err)?;
-            }
+            log_step(rec, &grid, ep.goal, t0, step).map_err(&err)?;
         }
         let end = t0 + ep.total_secs;
         rec.set_duration_secs(SIM_TIME, end);
@@ -358,4 +302,66 @@ fn send_episode_tables(
             ),
         ],
     )
+}
+
+/// One action of a grid episode that started at `t0` on the timeline: the
+/// posterior, the cursor, p(error), the belief in the user's `goal`, the
+/// action in words and the EEG at FCz.
+fn log_step(
+    rec: &RecordingStream,
+    grid: &Grid,
+    goal: Cell,
+    t0: f64,
+    step: &GridStep,
+) -> rerun::RecordingStreamResult<()> {
+    let fs = 256.0;
+    let t = t0 + step.onset_secs;
+    rec.set_duration_secs(SIM_TIME, t);
+    let has_belief = step.belief.iter().all(|p| p.is_finite());
+    if has_belief {
+        rec.log(paths::GRID_POSTERIOR, &heat_map(grid, &step.belief))?;
+    }
+    rec.log(
+        paths::GRID_CURSOR,
+        &Points2D::new([centre(grid, step.to)])
+            .with_radii([0.25])
+            .with_colors([Color::from_rgb(30, 30, 30)]),
+    )?;
+    rec.log(paths::P_ERROR, &Scalars::single(step.p_error))?;
+    rec.log(paths::THRESHOLD, &Scalars::single(0.5))?;
+    if has_belief {
+        rec.log(
+            paths::BELIEF_TRUE_GOAL,
+            &Scalars::single(step.belief[grid.index(goal)]),
+        )?;
+        let max = step.belief.iter().copied().fold(0.0, f64::max);
+        rec.log(paths::BELIEF_MAX, &Scalars::single(max))?;
+    }
+    let decoded = if step.p_error >= 0.5 {
+        "error"
+    } else {
+        "correct"
+    };
+    let truth = if step.error { "error" } else { "correct" };
+    let level = if (step.p_error >= 0.5) == step.error {
+        "INFO"
+    } else {
+        "WARN"
+    };
+    rec.log(
+        paths::LOG,
+        &TextLog::new(format!(
+            "{} {} -> {}: user {truth}, decoded {decoded} (p = {:.2})",
+            step.action.name(),
+            step.from,
+            step.to,
+            step.p_error
+        ))
+        .with_level(level),
+    )?;
+    for (i, v) in step.fcz.iter().enumerate() {
+        rec.set_duration_secs(SIM_TIME, t + i as f64 / fs);
+        rec.log(eeg_channel("FCz"), &Scalars::single(*v))?;
+    }
+    Ok(())
 }

@@ -111,15 +111,9 @@ fn draw_fit<DB: DrawingBackend>(
     Ok(())
 }
 
-fn draw_fit_panel<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    plot: &FitPlot,
-    fit: &FitPanel,
-    x_range: std::ops::Range<f64>,
-    x_decimals: usize,
-) -> Result<(), PlotError> {
-    let bars: Vec<Vec<Bar>> = fit
-        .curves
+/// Each curve's finite points as bars, in x order.
+fn fit_bars(fit: &FitPanel) -> Vec<Vec<Bar>> {
+    fit.curves
         .iter()
         .map(|c| {
             let mut v: Vec<Bar> = c
@@ -136,7 +130,12 @@ fn draw_fit_panel<DB: DrawingBackend>(
             v.sort_by(|a, b| a.x.total_cmp(&b.x));
             v
         })
-        .collect();
+        .collect()
+}
+
+/// The y axis of a panel: every bar, interval and reference line, above
+/// the panel's floor, with a margin.
+fn fit_y_range(bars: &[Vec<Bar>], fit: &FitPanel) -> std::ops::Range<f64> {
     let ys = bars
         .iter()
         .flatten()
@@ -156,7 +155,18 @@ fn draw_fit_panel<DB: DrawingBackend>(
         }
     }
     let pad = 0.06 * (y_hi - y_lo);
-    let y_range = (y_lo - pad)..(y_hi + pad);
+    (y_lo - pad)..(y_hi + pad)
+}
+
+fn draw_fit_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    plot: &FitPlot,
+    fit: &FitPanel,
+    x_range: std::ops::Range<f64>,
+    x_decimals: usize,
+) -> Result<(), PlotError> {
+    let bars = fit_bars(fit);
+    let y_range = fit_y_range(&bars, fit);
     let (x0, x1) = (x_range.start, x_range.end);
     let mut chart = panel(
         area,
