@@ -255,7 +255,7 @@ mod tests {
             hit_rate: 1.5,
             false_alarms_per_min: None,
         }
-        .validate()
+        .check()
         .unwrap_err()
         .to_string();
         assert!(bad.contains("hit_rate") && bad.contains("(0, 1)"), "{bad}");

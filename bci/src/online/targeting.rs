@@ -3,12 +3,12 @@
 
 use serde::{Deserialize, Serialize};
 
-use errp_valid::Valid;
+use errp_valid::{Check, Valid};
 
 use super::detector::{Detector, DetectorParams};
 use super::recording::{OnlineRecording, OperatingPoint, detector_span, operating_point};
 use crate::calibration::TargetingParams;
-use crate::error::{Result, check};
+use crate::error::{BciError, Result, check};
 
 /// An online operating point to calibrate for, instead of a cross-validated
 /// accuracy: the detector's hit rate per ErrP on the held-out recording, and
@@ -23,9 +23,18 @@ pub struct OnlineTarget {
     pub false_alarms_per_min: Option<f64>,
 }
 
+/// Checked where a scenario enters; the search takes it checked.
+impl Check for OnlineTarget {
+    type Error = BciError;
+
+    fn check(&self) -> Result<()> {
+        self.validate()
+    }
+}
+
 impl OnlineTarget {
     /// Checks both fields; names them as the scenario's `[user]` does.
-    pub fn validate(&self) -> Result<()> {
+    fn validate(&self) -> Result<()> {
         check(
             self.hit_rate.is_finite() && self.hit_rate > 0.0 && self.hit_rate < 1.0,
             "hit_rate",
@@ -119,14 +128,13 @@ pub fn threshold_for_false_alarms(
 ///
 /// [`BciError`]: crate::BciError
 pub fn target_online<E: From<crate::error::BciError>>(
-    target: OnlineTarget,
+    target: Valid<OnlineTarget>,
     detector: Valid<DetectorParams>,
     t_e: f64,
     search: &TargetingParams,
     mut evaluate: impl FnMut(f64) -> std::result::Result<OnlineRecording, E>,
     mut progress: impl FnMut(&OnlineStep),
 ) -> std::result::Result<OnlineTargeting, E> {
-    target.validate()?;
     let mut steps: Vec<OnlineStep> = Vec::new();
     let mut eval = |ratio: f64, steps: &mut Vec<OnlineStep>| -> std::result::Result<f64, E> {
         let recording = evaluate(ratio)?;
@@ -212,7 +220,7 @@ pub fn target_online<E: From<crate::error::BciError>>(
         .into());
     }
     Ok(OnlineTargeting {
-        target,
+        target: *target,
         ratio: best.ratio,
         t_e: best.t_e,
         point: best.point,

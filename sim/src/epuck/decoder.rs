@@ -156,7 +156,7 @@ impl std::fmt::Display for OnlineReport {
 /// found) and the report, so nothing is calibrated or recorded twice.
 pub fn run_online_calibration(
     request: &ContinuousRequest,
-    target: OnlineTarget,
+    target: Valid<OnlineTarget>,
     detector: Valid<DetectorParams>,
     t_e: f64,
     progress: impl FnMut(&OnlineStep),

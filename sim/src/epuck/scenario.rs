@@ -68,7 +68,7 @@ pub struct EpuckScenario {
     /// online target: its hit rate, as the device assumes it).
     pub accuracy: MeanAccuracy,
     /// Calibrate for this online operating point instead of the accuracy.
-    pub online_target: Option<OnlineTarget>,
+    pub online_target: Option<Valid<OnlineTarget>>,
     /// Runs of the episode, each from its own derived seed.
     pub runs: usize,
     /// Start pose and goal.
@@ -255,7 +255,7 @@ fn decoder_target(
     u: &UserFile,
     t_e_given: bool,
     path: &Path,
-) -> Result<(Option<OnlineTarget>, MeanAccuracy)> {
+) -> Result<(Option<Valid<OnlineTarget>>, MeanAccuracy)> {
     let bad =
         |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
     // The accuracy the device assumes (info gain): the cross-validated
@@ -277,9 +277,8 @@ fn decoder_target(
                 hit_rate: h,
                 false_alarms_per_min: fa,
             };
-            target
-                .validate()
-                .map_err(|e| table_error(path, "user", e))?;
+            // Checked here, once: the search takes it checked.
+            let target = Valid::new(target).map_err(|e| table_error(path, "user", e))?;
             if fa.is_some() && t_e_given {
                 return Err(bad(
                     "control.t_e",

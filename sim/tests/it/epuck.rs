@@ -312,10 +312,13 @@ fn detections_are_scored_over_the_span_where_the_decoder_responds() {
 #[test]
 fn an_online_operating_point_is_calibrated_for() {
     let mut s = scenario("mexico_to_pisa.toml");
-    s.online_target = Some(errp_bci::OnlineTarget {
-        hit_rate: 0.7,
-        false_alarms_per_min: Some(1.0),
-    });
+    s.online_target = Some(
+        errp_bci::Valid::new(errp_bci::OnlineTarget {
+            hit_rate: 0.7,
+            false_alarms_per_min: Some(1.0),
+        })
+        .unwrap(),
+    );
     let (decoder, _) = prepare_continuous_decoder(&s, |_| {}).unwrap();
     let online = decoder.online.as_ref().unwrap();
     assert!((online.point.hit_rate - 0.7).abs() <= 0.05, "{online}");
