@@ -56,7 +56,7 @@ pub use scenario::{
     parse_scenario_table, parse_scenario_with, scenario_text_with,
 };
 pub use scenario_file::{
-    MAX_KEY_PARTS, MAX_SCENARIO_BYTES, parse_toml, read_scenario, set_key, table_into, truncate,
+    MAX_KEY_PARTS, MAX_SCENARIO_BYTES, key_parts, parse_toml, read_scenario, table_into, truncate,
 };
 pub use stats::{
     StreamingPearson, correlation_p_value, incomplete_beta, mean_sd, median, pearson,

@@ -8,7 +8,7 @@ use serde::Deserialize;
 use crate::epuck::scenario::EpuckScenario;
 use crate::error::{Result, SimError};
 use crate::grid::scenario::GridScenario;
-use crate::scenario_file::{parse_toml, read_scenario, set_key};
+use crate::scenario_file::{key_parts, parse_toml, read_scenario};
 
 /// A scenario of either task, as `errp run` takes it.
 #[derive(Debug, Clone)]
@@ -113,23 +113,18 @@ pub fn apply_overrides(
     Ok(doc.to_string())
 }
 
-/// Sets dotted `key` to `value` in `doc`, creating the tables on the way,
-/// with the rules of [`crate::set_key`].
+/// Sets dotted `key` ([`crate::key_parts`]) to `value` in `doc`, creating
+/// the tables on the way.
 fn set_edit_key(
     doc: &mut toml_edit::DocumentMut,
     key: &str,
     value: &toml::Value,
 ) -> std::result::Result<(), String> {
-    // The checks and the error of the plain table's setter.
-    set_key(&mut toml::Table::new(), key, value.clone())?;
+    let (tables, last) = key_parts(key)?;
     let item: toml_edit::Value = value
         .to_string()
         .parse()
         .map_err(|_| format!("{value} cannot be written in a scenario"))?;
-    let parts: Vec<&str> = key.split('.').collect();
-    let (last, tables) = parts
-        .split_last()
-        .ok_or_else(|| format!("`{key}` is empty"))?;
     let mut t: &mut dyn toml_edit::TableLike = doc.as_table_mut();
     for part in tables {
         let entry = t

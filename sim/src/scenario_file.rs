@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use serde::de::DeserializeOwned;
-use toml::{Table, Value};
+use toml::Table;
 
 use crate::error::{Result, SimError};
 
@@ -182,31 +182,20 @@ fn value_and_expected(message: &str) -> Option<(String, String)> {
     Some((value, expected))
 }
 
-/// Sets `key` (dotted) in `table` to `value`, creating tables on the way.
-pub fn set_key(table: &mut Table, key: &str, value: Value) -> std::result::Result<(), String> {
-    let n = key.split('.').count();
-    if n > MAX_KEY_PARTS || key.split('.').any(|p| p.is_empty()) {
+/// The parts of a dotted scenario field (`control.tau`): 1 to
+/// [`MAX_KEY_PARTS`] non-empty ones, the last the field's own name.
+pub fn key_parts(key: &str) -> std::result::Result<(Vec<&str>, &str), String> {
+    let mut parts: Vec<&str> = key.split('.').collect();
+    if parts.len() > MAX_KEY_PARTS || parts.iter().any(|p| p.is_empty()) {
         return Err(format!(
             "`{}` is not a scenario field: a field is a dotted key of 1 to {MAX_KEY_PARTS} \
              non-empty parts (e.g. control.tau)",
             truncate(key, 80)
         ));
     }
-    let mut parts = key.split('.').peekable();
-    let mut t = table;
-    while let Some(part) = parts.next() {
-        if parts.peek().is_none() {
-            t.insert(part.to_string(), value);
-            return Ok(());
-        }
-        let entry = t
-            .entry(part.to_string())
-            .or_insert_with(|| Value::Table(Table::new()));
-        t = entry
-            .as_table_mut()
-            .ok_or_else(|| format!("`{part}` in `{key}` is not a table in the scenario"))?;
-    }
-    Err(format!("`{key}` is empty"))
+    // `split` yields at least one part, and none is empty.
+    let last = parts.pop().unwrap_or(key);
+    Ok((parts, last))
 }
 
 /// Two values `[x, y]`, exactly: an array of any other length is an error
