@@ -8,7 +8,8 @@ use divan::{Bencher, black_box};
 use errp_bci::{
     Assessment, AssessmentKind, CalibrationParams, CalibrationSetup, ContinuousFeatures,
     ContinuousSetup, EegGenerator, EpochWindow, ErrorModel, GeneratorParams, LdaDecoder, LdaModel,
-    Montage, Preprocessor, SessionOptions, SvmDecoder, SvmModel, calibrate, calibrate_continuous,
+    Montage, Preprocessor, SessionOptions, SvmDecoder, SvmModel, Valid, calibrate,
+    calibrate_continuous,
 };
 
 fn main() {
@@ -18,19 +19,20 @@ fn main() {
 const FS: usize = 256;
 
 struct Trained {
-    setup: CalibrationSetup,
+    setup: Valid<CalibrationSetup>,
     pre: Preprocessor,
     model: LdaModel,
 }
 
 static TRAINED: LazyLock<Trained> = LazyLock::new(|| {
-    let setup = CalibrationSetup {
+    let setup = Valid::new(CalibrationSetup {
         calibration: CalibrationParams {
             n_actions: 120,
             ..CalibrationParams::default()
         },
-        ..CalibrationSetup::with_ratio(0.8)
-    };
+        ..CalibrationSetup::with_ratio(0.8).unwrap()
+    })
+    .unwrap();
     let c = calibrate(&LdaDecoder::default(), &setup, 1, SessionOptions::default()).unwrap();
     Trained {
         pre: c.session.preprocessor.clone(),
@@ -42,7 +44,12 @@ static TRAINED: LazyLock<Trained> = LazyLock::new(|| {
 /// One second of all 40 channels (34 EEG + 6 EOG) at 256 Hz.
 #[divan::bench]
 fn generate_one_second(bencher: Bencher) {
-    let mut g = EegGenerator::new(GeneratorParams::default(), &Montage::standard(), 1).unwrap();
+    let mut g = EegGenerator::new(
+        &Valid::<GeneratorParams>::default(),
+        &Montage::standard(),
+        1,
+    )
+    .unwrap();
     bencher.bench_local(|| black_box(g.generate(FS)));
 }
 
@@ -52,7 +59,7 @@ fn generate_one_second(bencher: Bencher) {
 fn decode_epoch(bencher: Bencher) {
     let t = &*TRAINED;
     let window = EpochWindow::paper(FS as f64);
-    let mut g = EegGenerator::new(t.setup.generator.clone(), &t.setup.montage, 2).unwrap();
+    let mut g = EegGenerator::new(&t.setup.generator, &t.setup.montage, 2).unwrap();
     let raw = g.generate(window.span());
     let mut pre = t.pre.clone();
     bencher.bench_local(|| {
@@ -80,7 +87,7 @@ fn action(bencher: Bencher, secs: f64) {
     let t = &*TRAINED;
     let window = EpochWindow::paper(FS as f64);
     let n = ((secs * FS as f64) as usize).max(window.span());
-    let mut g = EegGenerator::new(t.setup.generator.clone(), &t.setup.montage, 3).unwrap();
+    let mut g = EegGenerator::new(&t.setup.generator, &t.setup.montage, 3).unwrap();
     let mut pre = t.pre.clone();
     let mut k = 0u64;
     bencher.bench_local(|| {
@@ -106,9 +113,9 @@ struct TrainedContinuous {
 }
 
 static TRAINED_CONTINUOUS: LazyLock<TrainedContinuous> = LazyLock::new(|| {
-    let setup = ContinuousSetup::with_ratio(1.0);
+    let setup = Valid::new(ContinuousSetup::with_ratio(1.0).unwrap()).unwrap();
     let c = calibrate_continuous(&SvmDecoder::default(), &setup, 1).unwrap();
-    let mut g = EegGenerator::new(setup.generator.clone(), &setup.montage, 4).unwrap();
+    let mut g = EegGenerator::new(&setup.generator, &setup.montage, 4).unwrap();
     let mut pre = c.session.preprocessor.clone();
     let window = pre.process(&g.generate(ContinuousFeatures::paper(FS as f64).span()));
     TrainedContinuous {

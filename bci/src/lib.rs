@@ -81,7 +81,7 @@ pub use online::{
     operating_point, record_online, response_span, target_online, threshold_for_false_alarms,
 };
 pub use platt::PlattScaling;
-pub use preprocess::{PreprocessParams, Preprocessor};
+pub use preprocess::{PreprocessParams, Preprocessing, Preprocessor};
 pub use psd::ThetaPsd;
 pub use subjects::{GoalSet, Subject, subject, subjects};
 pub use svm::{SvmDecoder, SvmModel};

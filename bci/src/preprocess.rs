@@ -1,5 +1,6 @@
 //! Preprocessing as in sec. 2.1: notch, band-pass, CAR and EOG regression.
 
+use errp_valid::{Check, Valid};
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
@@ -30,9 +31,27 @@ impl Default for PreprocessParams {
     }
 }
 
+/// The preprocessing at a sampling rate: what [`Preprocessor::fit`] takes,
+/// checked (the band edges against the rate).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Preprocessing {
+    /// The filters.
+    pub params: PreprocessParams,
+    /// The sampling rate of the EEG it runs on (Hz).
+    pub sfreq_hz: f64,
+}
+
+impl Check for Preprocessing {
+    type Error = BciError;
+
+    fn check(&self) -> Result<()> {
+        self.params.validate(self.sfreq_hz)
+    }
+}
+
 impl PreprocessParams {
     /// Checks the band edges against the sampling rate.
-    pub fn validate(&self, sfreq_hz: f64) -> Result<()> {
+    fn validate(&self, sfreq_hz: f64) -> Result<()> {
         let nyq = sfreq_hz / 2.0;
         check(
             self.low_hz.is_finite() && self.low_hz > 0.0 && self.low_hz < self.high_hz,
@@ -83,12 +102,12 @@ impl Preprocessor {
     /// returns a preprocessor producing the EEG channels `outputs`.
     pub fn fit(
         montage: &Montage,
-        params: &PreprocessParams,
-        sfreq_hz: f64,
+        preprocessing: &Valid<Preprocessing>,
         eog_session: &EegBlock,
         outputs: &[usize],
     ) -> Result<Self> {
-        params.validate(sfreq_hz)?;
+        let Preprocessing { params, sfreq_hz } = preprocessing.get();
+        let sfreq_hz = *sfreq_hz;
         let n_eeg = montage.n_eeg();
         let n_ch = montage.len();
         if let Some(&bad) = outputs.iter().find(|&&o| o >= n_eeg) {
@@ -231,25 +250,34 @@ mod tests {
     use super::*;
     use crate::generator::{Components, EegGenerator, GeneratorParams};
 
-    fn eye_heavy() -> GeneratorParams {
-        GeneratorParams {
+    fn paper() -> Valid<Preprocessing> {
+        Valid::new(Preprocessing {
+            params: PreprocessParams::default(),
+            sfreq_hz: 256.0,
+        })
+        .unwrap()
+    }
+
+    fn eye_heavy() -> Valid<GeneratorParams> {
+        Valid::new(GeneratorParams {
             blink_rate_hz: 0.5,
             saccade_rate_hz: 1.0,
             ..GeneratorParams::default()
-        }
+        })
+        .unwrap()
     }
 
     #[test]
     fn eog_regression_removes_most_of_the_eye_artifacts() {
         let m = Montage::standard();
         let fs = 256.0;
-        let params = PreprocessParams::default();
-        let session = EegGenerator::new(eye_heavy(), &m, 1)
+        let params = paper();
+        let session = EegGenerator::new(&eye_heavy(), &m, 1)
             .unwrap()
             .generate(256 * 60);
         let fz = m.index("Fz").unwrap();
         let fp1 = m.index("Fp1").unwrap();
-        let mut pre = Preprocessor::fit(&m, &params, fs, &session, &[fp1, fz]).unwrap();
+        let mut pre = Preprocessor::fit(&m, &params, &session, &[fp1, fz]).unwrap();
 
         // Fresh data: the eye part alone, with and without regression.
         let only_eyes = Components {
@@ -257,7 +285,7 @@ mod tests {
             artifacts: true,
             erp: false,
         };
-        let eyes = EegGenerator::new(eye_heavy(), &m, 2)
+        let eyes = EegGenerator::new(&eye_heavy(), &m, 2)
             .unwrap()
             .with_components(only_eyes)
             .generate(256 * 60);
@@ -283,12 +311,10 @@ mod tests {
     #[test]
     fn streaming_equals_one_block() {
         let m = Montage::standard();
-        let mut g = EegGenerator::new(eye_heavy(), &m, 3).unwrap();
+        let mut g = EegGenerator::new(&eye_heavy(), &m, 3).unwrap();
         let session = g.generate(256 * 20);
         let outputs = m.decoding_indices();
-        let fit = || {
-            Preprocessor::fit(&m, &PreprocessParams::default(), 256.0, &session, &outputs).unwrap()
-        };
+        let fit = || Preprocessor::fit(&m, &paper(), &session, &outputs).unwrap();
         let data = g.generate(256 * 4);
         let whole = fit().process(&data);
         let mut pre = fit();
@@ -315,10 +341,14 @@ mod tests {
             ..PreprocessParams::default()
         };
         assert!(
-            p.validate(256.0)
-                .unwrap_err()
-                .to_string()
-                .contains("low_hz")
+            Preprocessing {
+                params: p,
+                sfreq_hz: 256.0
+            }
+            .check()
+            .unwrap_err()
+            .to_string()
+            .contains("low_hz")
         );
     }
 }

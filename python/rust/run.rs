@@ -392,7 +392,7 @@ pub(crate) fn sweep<'py>(
         episodes,
         seed,
     };
-    spec.levels().map_err(py_err)?;
+    let sweep = spec.checked().map_err(py_err)?;
     let opts = SweepOptions {
         out: out.clone(),
         cache: match cache {
@@ -409,7 +409,7 @@ pub(crate) fn sweep<'py>(
         .build()
         .map_err(|e| PyValueError::new_err(format!("threads: cannot start them: {e}")))?;
     let outcome = py
-        .detach(|| pool.install(|| errp_sweep::run_sweep(&spec, &opts, &cancel, &())))
+        .detach(|| pool.install(|| errp_sweep::run_sweep(&sweep, &opts, &cancel, &())))
         .map_err(py_err)?;
     match outcome {
         SweepOutcome::Interrupted { .. } => {

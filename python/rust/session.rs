@@ -166,7 +166,8 @@ impl EegGenerator {
                 e.to_string().lines().next().unwrap_or("")
             ))
         })?;
-        let inner = errp_bci::EegGenerator::new(gp, &Montage::standard(), seed)
+        let gp = errp_bci::Valid::new(gp).map_err(|e| py_err(e.into()))?;
+        let inner = errp_bci::EegGenerator::new(&gp, &Montage::standard(), seed)
             .map_err(|e| py_err(e.into()))?;
         Ok(Self { inner })
     }

@@ -21,10 +21,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         |_| {},
     )?;
     let d = ContinuousDecoder::from_report(&report);
-    let params = OnlineRecordingParams {
+    let params = Valid::new(OnlineRecordingParams {
         duration_secs: 1800.0,
         ..OnlineRecordingParams::default()
-    };
+    })?;
     let rec = record_online(
         &d.generator,
         &d.montage,

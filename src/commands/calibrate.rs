@@ -3,13 +3,14 @@
 use anyhow::{Context, Result, bail};
 use errp_bci::{EdfWriter, GoalSet, MeanAccuracy, SessionOptions, subject, subjects};
 use errp_sim::PendingFile;
-use errp_sim::calibration::{CalibrationRequest, run_calibration};
+use errp_sim::calibration::{CalibrationReport, CalibrationRequest, run_calibration};
 
 use crate::cli::{CalibrateArgs, Goals, check_extension};
 use crate::out::{errln, outln};
 use crate::save::check_save;
 
-pub(crate) fn calibrate(args: &CalibrateArgs) -> Result<()> {
+/// The accuracy to target, and whose it is (for the report).
+fn requested(args: &CalibrateArgs) -> Result<(MeanAccuracy, String)> {
     // (clap lets `requires` pass when the required flag conflicts with one
     // given, as --subject does with --accuracy.)
     if let (Some(_), None) = (args.goals, &args.subject) {
@@ -36,6 +37,11 @@ pub(crate) fn calibrate(args: &CalibrateArgs) -> Result<()> {
             "requested".to_string(),
         ),
     };
+    Ok((accuracy, who))
+}
+
+pub(crate) fn calibrate(args: &CalibrateArgs) -> Result<()> {
+    let (accuracy, who) = requested(args)?;
     check_save(args.save.as_deref())?;
     if let Some(p) = &args.export {
         check_extension(p, "edf", "--export")?;
@@ -103,7 +109,32 @@ pub(crate) fn calibrate(args: &CalibrateArgs) -> Result<()> {
         bail!("--export: cannot write {}: {e}", p.display());
     }
     let report = report.context("calibration failed")?;
+    print_report(&report, &request, &who)?;
 
+    if let (Some((pending, writer)), Some(p)) = (edf, &args.export) {
+        writer
+            .finish()
+            .with_context(|| format!("--export: cannot write {}", p.display()))?;
+        let path = pending.commit().context("--export")?;
+        outln!(
+            "Wrote {} (EDF+, raw EEG + EOG, 256 Hz, annotated)",
+            path.display()
+        )?;
+    }
+    #[cfg(feature = "rerun")]
+    if let Some(file) = rrd {
+        let montage = errp_bci::Montage::standard();
+        crate::save::wrote(
+            &errp_sim::calibration::record_calibration(file, &report, &montage)
+                .context("--save")?,
+        )?;
+    }
+    Ok(())
+}
+
+/// The calibration's scores, against what was asked (`who`'s accuracy).
+fn print_report(report: &CalibrationReport, request: &CalibrationRequest, who: &str) -> Result<()> {
+    let accuracy = request.accuracy;
     let a = &report.calibrated.accuracy;
     let m = &report.calibrated.model;
     outln!(
@@ -127,25 +158,6 @@ pub(crate) fn calibrate(args: &CalibrateArgs) -> Result<()> {
         m.n_components(),
         m.shrinkage()
     )?;
-
-    if let (Some((pending, writer)), Some(p)) = (edf, &args.export) {
-        writer
-            .finish()
-            .with_context(|| format!("--export: cannot write {}", p.display()))?;
-        let path = pending.commit().context("--export")?;
-        outln!(
-            "Wrote {} (EDF+, raw EEG + EOG, 256 Hz, annotated)",
-            path.display()
-        )?;
-    }
-    #[cfg(feature = "rerun")]
-    if let Some(file) = rrd {
-        let montage = errp_bci::Montage::standard();
-        crate::save::wrote(
-            &errp_sim::calibration::record_calibration(file, &report, &montage)
-                .context("--save")?,
-        )?;
-    }
     Ok(())
 }
 

@@ -9,9 +9,9 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use clap::ValueEnum;
 use errp_sweep::{
-    DecoderInfo, InputNames, MAX_EPISODES, Shard, SweepObserver, SweepOptions, SweepOutcome,
-    SweepReport, SweepSpec, SweepTask, TargetCache, aliases, merge_sweeps, parse_accuracies,
-    parse_axis, prepare_sweep, run_sweep, sweep_fixed, sweep_scenario,
+    CheckedSweep, DecoderInfo, InputNames, MAX_EPISODES, Shard, SweepObserver, SweepOptions,
+    SweepOutcome, SweepReport, SweepSpec, SweepTask, TargetCache, aliases, merge_sweeps,
+    parse_accuracies, parse_axis, prepare_sweep, run_sweep, sweep_fixed, sweep_scenario,
 };
 
 use crate::cli::parse_seed;
@@ -298,9 +298,10 @@ pub fn sweep(args: &SweepArgs) -> Result<bool> {
         None => Shard::ALL,
     };
     let cache = args.workers.cache();
-    // Validate every level before printing anything or starting work
-    // (`run_sweep` checks them again, before it creates the directory).
-    spec.levels()?;
+    // Every level is built and checked before anything is printed or
+    // started; the sweep takes them checked.
+    let sweep = spec.checked()?;
+    let spec = sweep.spec();
     // A cache that cannot be used is not an error, but the user is told.
     if let Some(why) = cache.problem() {
         if args.prepare_only {
@@ -311,7 +312,7 @@ pub fn sweep(args: &SweepArgs) -> Result<bool> {
     let (pool, threads) = args.workers.pool()?;
     let progress = Progress::new(args.quiet);
     if args.prepare_only {
-        return prepare(&spec, &cache, &pool, &progress).map(|()| true);
+        return prepare(&sweep, &cache, &pool, &progress).map(|()| true);
     }
     let out = args
         .out
@@ -340,7 +341,7 @@ pub fn sweep(args: &SweepArgs) -> Result<bool> {
     ));
     let started = wall_clock();
     let outcome = pool.install(|| {
-        run_sweep(&spec, &opts, &interrupt::CANCEL, &progress)
+        run_sweep(&sweep, &opts, &interrupt::CANCEL, &progress)
             .map_err(|e| name_flag(e, "--out", &opts.out))
     });
     interrupt::graceful(false);
@@ -398,11 +399,12 @@ fn slurm_cpus() -> Option<usize> {
 /// `errp sweep --prepare-only`: every level's decoder once, the targeting
 /// kept in the cache, a line per decoder printed.
 fn prepare(
-    spec: &SweepSpec,
+    sweep: &CheckedSweep,
     cache: &TargetCache,
     pool: &rayon::ThreadPool,
     progress: &Progress,
 ) -> Result<()> {
+    let spec = sweep.spec();
     let dir = cache.dir().expect("checked: a cache").to_path_buf();
     progress.line(&format!(
         "Preparing the decoders of {} ({}): {} levels, seed {}, targeting cached in {} on {} \
@@ -414,7 +416,7 @@ fn prepare(
         dir.display(),
         pool.current_num_threads()
     ));
-    let infos = pool.install(|| prepare_sweep(spec, cache, progress))?;
+    let infos = pool.install(|| prepare_sweep(sweep, cache, progress))?;
     if let Some(bar) = &progress.bar {
         bar.finish_and_clear();
     }

@@ -76,7 +76,10 @@ fn sweep(spec: &SweepSpec, threads: usize, cache: &TargetCache, name: &str) {
         .build()
         .unwrap();
     let outcome = pool
-        .install(|| run_sweep(spec, &opts, &AtomicBool::new(false), &()))
+        .install(|| {
+            let sweep = spec.clone().checked().unwrap();
+            run_sweep(&sweep, &opts, &AtomicBool::new(false), &())
+        })
         .unwrap();
     assert!(matches!(outcome, SweepOutcome::Complete { .. }));
     let _ = std::fs::remove_dir_all(&out);
@@ -122,9 +125,10 @@ fn recheck_40000_rows(bencher: Bencher) {
         repair: false,
     };
     let cancel = AtomicBool::new(false);
-    run_sweep(&spec, &opts, &cancel, &()).unwrap();
+    let sweep = spec.checked().unwrap();
+    run_sweep(&sweep, &opts, &cancel, &()).unwrap();
     bencher.bench_local(|| {
-        let outcome = run_sweep(&spec, &opts, &cancel, &()).unwrap();
+        let outcome = run_sweep(&sweep, &opts, &cancel, &()).unwrap();
         assert!(matches!(outcome, SweepOutcome::Complete { ran: 0, .. }));
     });
     let _ = std::fs::remove_dir_all(&out);

@@ -48,8 +48,8 @@ pub use plot::{
 pub use rows::{CHECKSUM, episodes_header};
 pub use run::{MAX_DECODER_BYTES, SweepOptions, SweepOutcome, prepare_sweep, run_sweep};
 pub use spec::{
-    Axis, BUILT_IN_EPUCK, BUILT_IN_GRID, InputNames, Level, MAX_EPISODES, MAX_LEVELS, Shard,
-    SweepSpec, SweepTask, aliases, parse_accuracies, parse_axis, parse_values, read_task,
+    Axis, BUILT_IN_EPUCK, BUILT_IN_GRID, CheckedSweep, InputNames, Level, MAX_EPISODES, MAX_LEVELS,
+    Shard, SweepSpec, SweepTask, aliases, parse_accuracies, parse_axis, parse_values, read_task,
     sweep_fixed, sweep_scenario, sweepable,
 };
 pub use summary::{LevelSummary, SweepReport, summarise_dir};

@@ -20,7 +20,7 @@ use crate::manifest::{EPISODES, MANIFEST, Manifest};
 use crate::observer::SweepObserver;
 use crate::prepare::prepare_all;
 use crate::rows::{RowCheck, episodes_header};
-use crate::spec::{Level, Shard, SweepSpec, SweepTask};
+use crate::spec::{CheckedSweep, Level, Shard, SweepSpec, SweepTask};
 use crate::summary::SweepReport;
 use crate::writer::{EpisodeJob, Resumed, Slice, resume_rows};
 
@@ -81,12 +81,12 @@ pub enum SweepOutcome {
 /// checked before it is kept. A refused or failed start leaves no new
 /// directory behind.
 pub fn run_sweep(
-    spec: &SweepSpec,
+    sweep: &CheckedSweep,
     opts: &SweepOptions,
     cancel: &AtomicBool,
     observer: &dyn SweepObserver,
 ) -> Result<SweepOutcome> {
-    let levels = spec.levels()?;
+    let (spec, levels) = (sweep.spec(), sweep.levels());
     let out = &opts.out;
     let created = create_dirs(out)?;
     // Undo the directories this call created, if it ends before any row.
@@ -130,10 +130,10 @@ pub fn run_sweep(
 
     let outcome = match spec.task {
         SweepTask::Grid => {
-            run_levels::<GridTask>(spec, opts, &levels, fresh, &made_with, cancel, observer)
+            run_levels::<GridTask>(spec, opts, levels, fresh, &made_with, cancel, observer)
         }
         SweepTask::Epuck => {
-            run_levels::<EpuckTask>(spec, opts, &levels, fresh, &made_with, cancel, observer)
+            run_levels::<EpuckTask>(spec, opts, levels, fresh, &made_with, cancel, observer)
         }
     };
     // A new directory that failed before its first row goes.
@@ -266,10 +266,11 @@ impl<'a, T: Task> Plan<'a, T> {
 /// that none of them searches the targeting again. Returns what each decoder
 /// reached.
 pub fn prepare_sweep(
-    spec: &SweepSpec,
+    sweep: &CheckedSweep,
     cache: &TargetCache,
     observer: &dyn SweepObserver,
 ) -> Result<Vec<DecoderInfo>> {
+    let (spec, levels) = (sweep.spec(), sweep.levels());
     if cache.dir().is_none() {
         return Err(SimError::Sweep(
             "preparing a sweep keeps its targeting in the cache: give --cache DIR (not \
@@ -277,7 +278,6 @@ pub fn prepare_sweep(
                 .into(),
         ));
     }
-    let levels = spec.levels()?;
     fn infos<T: Task>(
         spec: &SweepSpec,
         levels: &[Level],
@@ -292,8 +292,8 @@ pub fn prepare_sweep(
             .collect())
     }
     match spec.task {
-        SweepTask::Grid => infos::<GridTask>(spec, &levels, cache, observer),
-        SweepTask::Epuck => infos::<EpuckTask>(spec, &levels, cache, observer),
+        SweepTask::Grid => infos::<GridTask>(spec, levels, cache, observer),
+        SweepTask::Epuck => infos::<EpuckTask>(spec, levels, cache, observer),
     }
 }
 

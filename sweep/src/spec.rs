@@ -126,6 +126,27 @@ pub struct SweepSpec {
     pub seed: u64,
 }
 
+/// A sweep whose levels were built and checked, once
+/// ([`SweepSpec::checked`]): its size, that no level is given twice, and
+/// every level's scenario.
+#[derive(Debug, Clone)]
+pub struct CheckedSweep {
+    spec: SweepSpec,
+    levels: Vec<Level>,
+}
+
+impl CheckedSweep {
+    /// What the sweep runs.
+    pub fn spec(&self) -> &SweepSpec {
+        &self.spec
+    }
+
+    /// Its levels, each with its checked scenario.
+    pub fn levels(&self) -> &[Level] {
+        &self.levels
+    }
+}
+
 /// One level of a sweep: an accuracy and one value of every axis, with the
 /// validated scenario that results.
 #[derive(Debug, Clone)]
@@ -577,9 +598,17 @@ impl SweepSpec {
         Ok(())
     }
 
+    /// Builds and checks every level once: the sweep as
+    /// [`run_sweep`](crate::run_sweep) and
+    /// [`prepare_sweep`](crate::prepare_sweep) take it.
+    pub fn checked(self) -> Result<CheckedSweep> {
+        let levels = self.levels()?;
+        Ok(CheckedSweep { spec: self, levels })
+    }
+
     /// Builds and validates every level's scenario. An invalid swept value
     /// is reported with the level and the scenario's own field error.
-    pub fn levels(&self) -> Result<Vec<Level>> {
+    pub(crate) fn levels(&self) -> Result<Vec<Level>> {
         self.check()?;
         // The file's own errors quote its lines.
         let _: Table = parse_toml(&self.scenario_toml, &self.scenario_path)?;

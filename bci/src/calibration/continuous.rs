@@ -1,6 +1,7 @@
 //! The calibration of the continuous decoder (sec. 5.1): trigger-locked
 //! examples of each class, scored by cross-validation.
 
+use errp_valid::{Check, Valid};
 use rand::Rng;
 use rand_distr::StandardNormal;
 use serde::{Deserialize, Serialize};
@@ -13,7 +14,7 @@ use crate::calibration::{
 use crate::classify::Classifier;
 use crate::continuous::ContinuousFeatures;
 use crate::erp::AssessmentKind;
-use crate::error::{Result, check};
+use crate::error::{BciError, Result, check};
 use crate::generator::Assessment;
 use crate::rng::{derive_seed, stream};
 use crate::svm::{SvmDecoder, SvmModel};
@@ -57,7 +58,7 @@ impl Default for ContinuousCalibrationParams {
 
 impl ContinuousCalibrationParams {
     /// Checks every field.
-    pub fn validate(&self) -> Result<()> {
+    fn validate(&self) -> Result<()> {
         check(
             self.per_class >= 10,
             "per_class",
@@ -85,24 +86,30 @@ impl ContinuousCalibrationParams {
     }
 }
 
-impl Protocol for ContinuousCalibrationParams {
+impl Check for ContinuousCalibrationParams {
+    type Error = BciError;
+
     fn check(&self) -> Result<()> {
         self.validate()
     }
 }
 
+impl Protocol for ContinuousCalibrationParams {}
+
 /// A simulated user and recording for the continuous decoder: the EEG
 /// model, the button-locked protocol, the preprocessing and the montage.
 pub type ContinuousSetup = Setup<ContinuousCalibrationParams>;
 
-impl ContinuousSetup {
-    /// The same recording as a [`CalibrationSetup`] for
-    /// [`simulate_session_with`], which reads only the EOG session length of
-    /// its protocol.
-    fn session_setup(&self) -> CalibrationSetup {
-        let c = &self.calibration;
+/// The same recording as a [`CalibrationSetup`] for
+/// [`simulate_session_with`], which reads only the EOG session length of
+/// its protocol. The continuous protocol's checks include the discrete one's
+/// (at least 10 examples per class, so 20 actions; error rate 0.5; the same
+/// intervals, EOG session and folds), so the setup needs no check of its own.
+fn session_setup(setup: &Valid<ContinuousSetup>) -> Valid<CalibrationSetup> {
+    setup.part(|s| {
+        let c = &s.calibration;
         CalibrationSetup {
-            generator: self.generator.clone(),
+            generator: s.generator.clone(),
             calibration: CalibrationParams {
                 n_actions: 2 * c.per_class,
                 error_rate: 0.5,
@@ -111,10 +118,10 @@ impl ContinuousSetup {
                 eog_session_secs: c.eog_session_secs,
                 folds: c.folds,
             },
-            preprocess: self.preprocess.clone(),
-            montage: self.montage.clone(),
+            preprocess: s.preprocess.clone(),
+            montage: s.montage.clone(),
         }
-    }
+    })
 }
 
 /// The schedule of a continuous calibration (sec. 5.1): step one,
@@ -150,14 +157,13 @@ pub fn continuous_schedule(
 /// generator and the preprocessor, and the 512 features of
 /// [`ContinuousFeatures::paper`] of every example window.
 pub fn simulate_continuous_session(
-    setup: &ContinuousSetup,
+    setup: &Valid<ContinuousSetup>,
     seed: u64,
     options: SessionOptions<'_>,
 ) -> Result<CalibrationSession> {
-    setup.validate()?;
     let (assessments, windows) = continuous_schedule(&setup.calibration, seed);
     simulate_session_with(
-        &setup.session_setup(),
+        &session_setup(setup),
         seed,
         &assessments,
         &windows,
@@ -172,7 +178,7 @@ pub fn simulate_continuous_session(
 /// scaling (the classes are balanced, so there is no prior to remove).
 pub fn calibrate_continuous(
     classifier: &SvmDecoder,
-    setup: &ContinuousSetup,
+    setup: &Valid<ContinuousSetup>,
     seed: u64,
 ) -> Result<Calibrated<SvmModel>> {
     let session = simulate_continuous_session(setup, seed, SessionOptions::default())?;

@@ -1,6 +1,8 @@
 //! Scoring and training on a session: stratified folds, cross-validation, and
 //! the calibrated decoder.
 
+use errp_valid::Valid;
+
 use super::session::{CalibrationSession, SessionOptions, simulate_session};
 use super::{Accuracy, CalibrationSetup};
 use crate::classify::{Classifier, ErrorModel, Features, stratified_folds};
@@ -34,7 +36,7 @@ pub struct Calibrated<M> {
 /// decoder by k-fold cross-validation, train it on every trial.
 pub fn calibrate<C: Classifier>(
     classifier: &C,
-    setup: &CalibrationSetup,
+    setup: &Valid<CalibrationSetup>,
     seed: u64,
     options: SessionOptions<'_>,
 ) -> Result<Calibrated<C::Model>> {

@@ -1,12 +1,13 @@
 //! The calibration session of sec. 4.1 and its cross-validated score.
 
+use errp_valid::{Check, Valid};
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Result, check};
+use crate::error::{BciError, Result, check};
 use crate::generator::GeneratorParams;
 use crate::montage::Montage;
-use crate::preprocess::PreprocessParams;
+use crate::preprocess::{PreprocessParams, Preprocessing};
 
 pub(crate) mod continuous;
 mod cv;
@@ -50,7 +51,7 @@ impl Default for CalibrationParams {
 
 impl CalibrationParams {
     /// Checks every field.
-    pub fn validate(&self) -> Result<()> {
+    fn validate(&self) -> Result<()> {
         check(
             self.n_actions >= 20,
             "n_actions",
@@ -163,17 +164,21 @@ impl GrandAverage {
 /// A calibration protocol, the part of a [`Setup`] that says what is
 /// recorded: [`CalibrationParams`] (the discrete session) or
 /// [`ContinuousCalibrationParams`](crate::ContinuousCalibrationParams) (the
-/// button-locked one).
-pub trait Protocol: std::fmt::Debug + Clone + PartialEq + Default {
-    /// Checks the protocol's parameters.
-    fn check(&self) -> Result<()>;
+/// button-locked one). Its [`Check`] is part of the setup's.
+pub trait Protocol:
+    Check<Error = BciError> + std::fmt::Debug + Clone + PartialEq + Default
+{
 }
 
-impl Protocol for CalibrationParams {
+impl Check for CalibrationParams {
+    type Error = BciError;
+
     fn check(&self) -> Result<()> {
         self.validate()
     }
 }
+
+impl Protocol for CalibrationParams {}
 
 /// How closely and how hard to search for an ErrP-to-noise ratio (for an
 /// accuracy, or for an online hit rate).
@@ -200,10 +205,13 @@ impl Default for TargetingParams {
 
 /// Everything that defines a simulated user and recording: the EEG model,
 /// the calibration protocol `P`, the preprocessing and the montage.
+///
+/// The sessions take it checked, as a `Valid<Setup<P>>`; the EEG model in
+/// it is checked on its own, where it enters.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Setup<P> {
     /// The synthetic EEG.
-    pub generator: GeneratorParams,
+    pub generator: Valid<GeneratorParams>,
     /// The calibration protocol.
     pub calibration: P,
     /// The preprocessing.
@@ -215,7 +223,7 @@ pub struct Setup<P> {
 impl<P: Protocol> Default for Setup<P> {
     fn default() -> Self {
         Self {
-            generator: GeneratorParams::default(),
+            generator: Valid::default(),
             calibration: P::default(),
             preprocess: PreprocessParams::default(),
             montage: Montage::standard(),
@@ -223,28 +231,45 @@ impl<P: Protocol> Default for Setup<P> {
     }
 }
 
+/// The protocol, and the preprocessing against the EEG model's sampling
+/// rate (the EEG model is checked on its own).
+impl<P: Protocol> Check for Setup<P> {
+    type Error = BciError;
+
+    fn check(&self) -> Result<()> {
+        self.calibration.check()?;
+        self.preprocessing().check()
+    }
+}
+
+impl<P> Setup<P> {
+    /// The preprocessing at the EEG model's sampling rate.
+    fn preprocessing(&self) -> Preprocessing {
+        Preprocessing {
+            params: self.preprocess.clone(),
+            sfreq_hz: self.generator.sfreq_hz,
+        }
+    }
+}
+
+/// The preprocessing of a checked setup (the setup's check includes its).
+pub(crate) fn preprocessing<P>(setup: &Valid<Setup<P>>) -> Valid<Preprocessing> {
+    setup.part(Setup::preprocessing)
+}
+
 impl<P: Protocol> Setup<P> {
     /// The default setup with the EEG model at ErrP-to-noise `ratio`.
-    pub fn with_ratio(ratio: f64) -> Self {
+    pub fn with_ratio(ratio: f64) -> Result<Self> {
         Self::default().at_ratio(ratio)
     }
 
-    /// This setup with the EEG model at ErrP-to-noise `ratio`.
-    pub fn at_ratio(&self, ratio: f64) -> Self {
-        Self {
-            generator: GeneratorParams {
-                errp_to_noise: ratio,
-                ..self.generator.clone()
-            },
+    /// This setup with the EEG model at ErrP-to-noise `ratio` (the changed
+    /// EEG model is checked again).
+    pub fn at_ratio(&self, ratio: f64) -> Result<Self> {
+        Ok(Self {
+            generator: self.generator.with(|g| g.errp_to_noise = ratio)?,
             ..self.clone()
-        }
-    }
-
-    /// Checks every part.
-    pub fn validate(&self) -> Result<()> {
-        self.generator.validate()?;
-        self.calibration.check()?;
-        self.preprocess.validate(self.generator.sfreq_hz)
+        })
     }
 }
 
@@ -326,6 +351,6 @@ mod tests {
             error_rate: 1.5,
             ..CalibrationParams::default()
         };
-        assert!(c.validate().unwrap_err().to_string().contains("error_rate"));
+        assert!(c.check().unwrap_err().to_string().contains("error_rate"));
     }
 }

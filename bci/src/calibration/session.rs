@@ -1,10 +1,11 @@
 //! Simulating a calibration session: the schedule of assessments, the EEG
 //! streamed through it, preprocessed and cut into features.
 
+use errp_valid::Valid;
 use nalgebra::DMatrix;
 use rand::Rng;
 
-use super::{CalibrationParams, CalibrationSetup, GrandAverage};
+use super::{CalibrationParams, CalibrationSetup, GrandAverage, preprocessing};
 use crate::classify::Features;
 use crate::erp::AssessmentKind;
 use crate::error::{Result, check};
@@ -50,17 +51,16 @@ pub struct SessionOptions<'a> {
 /// asked to blink and look around (2 blinks and 1 saccade per second on
 /// average), no actions.
 pub fn eog_session(
-    params: &GeneratorParams,
+    params: &Valid<GeneratorParams>,
     calib: &CalibrationParams,
     montage: &Montage,
     seed: u64,
 ) -> Result<EegBlock> {
-    let eye = GeneratorParams {
-        blink_rate_hz: params.blink_rate_hz.max(0.5),
-        saccade_rate_hz: params.saccade_rate_hz.max(1.0),
-        ..params.clone()
-    };
-    let mut g = EegGenerator::new(eye, montage, derive_seed(seed, "calibration/eog", 0))?;
+    let eye = params.with(|p| {
+        p.blink_rate_hz = p.blink_rate_hz.max(0.5);
+        p.saccade_rate_hz = p.saccade_rate_hz.max(1.0);
+    })?;
+    let mut g = EegGenerator::new(&eye, montage, derive_seed(seed, "calibration/eog", 0))?;
     Ok(g.generate((calib.eog_session_secs * params.sfreq_hz) as usize))
 }
 
@@ -90,11 +90,10 @@ pub fn schedule(calib: &CalibrationParams, seed: u64) -> Vec<Assessment> {
 /// `n_actions` assessed actions streamed through the generator and the
 /// preprocessor in 1 s blocks, and the paper's temporal features.
 pub fn simulate_session(
-    setup: &CalibrationSetup,
+    setup: &Valid<CalibrationSetup>,
     seed: u64,
     options: SessionOptions<'_>,
 ) -> Result<CalibrationSession> {
-    setup.validate()?;
     let assessments = schedule(&setup.calibration, seed);
     let onsets: Vec<f64> = assessments.iter().map(|a| a.onset_secs).collect();
     let window = EpochWindow::paper(setup.generator.sfreq_hz);
@@ -190,33 +189,28 @@ fn grand_average(
 /// vector per assessment from the window that starts at the matching entry of
 /// `window_onsets_secs` (rounded to samples), labelled by the assessment.
 ///
-/// Only `eog_session_secs` of `setup.calibration` is used (and validated with
+/// Only `eog_session_secs` of `setup.calibration` is used (and checked with
 /// the rest); the schedule is the one given. Grand averages are locked to the
 /// assessment onsets.
 pub fn simulate_session_with(
-    setup: &CalibrationSetup,
+    setup: &Valid<CalibrationSetup>,
     seed: u64,
     assessments: &[Assessment],
     window_onsets_secs: &[f64],
     features: &dyn FeatureExtractor,
     mut options: SessionOptions<'_>,
 ) -> Result<CalibrationSession> {
-    setup.validate()?;
     check_schedule(assessments, window_onsets_secs)?;
-    let (params, calib, preprocess, montage) = (
-        &setup.generator,
-        &setup.calibration,
-        &setup.preprocess,
-        &setup.montage,
-    );
+    let (params, calib, montage) = (&setup.generator, &setup.calibration, &setup.montage);
+    let preprocess = &preprocessing(setup);
     let fs = params.sfreq_hz;
     let eog = eog_session(params, calib, montage, seed)?;
     let decoding = montage.decoding_indices();
-    let mut pre = Preprocessor::fit(montage, preprocess, fs, &eog, &decoding)?;
+    let mut pre = Preprocessor::fit(montage, preprocess, &eog, &decoding)?;
     let preprocessor = pre.clone();
     let all_eeg: Vec<usize> = (0..montage.n_eeg()).collect();
     let pre_all = if options.grand_average {
-        Some(Preprocessor::fit(montage, preprocess, fs, &eog, &all_eeg)?)
+        Some(Preprocessor::fit(montage, preprocess, &eog, &all_eeg)?)
     } else {
         None
     };
@@ -230,7 +224,7 @@ pub fn simulate_session_with(
     let total = ((last_onset * fs).ceil() as usize + features.span().max(ga_len) + 1).max(1);
 
     let mut generator =
-        EegGenerator::new(params.clone(), montage, seed)?.with_components(options.components);
+        EegGenerator::new(params, montage, seed)?.with_components(options.components);
     for a in assessments {
         generator.schedule(*a);
     }

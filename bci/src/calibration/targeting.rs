@@ -1,6 +1,7 @@
 //! Accuracy targeting: find the ErrP-to-noise ratio at which the real
 //! decoder's cross-validated mean accuracy equals a requested value.
 
+use errp_valid::Valid;
 use serde::{Deserialize, Serialize};
 
 use crate::calibration::continuous::{ContinuousSetup, simulate_continuous_session};
@@ -193,7 +194,7 @@ impl RequestedAccuracy {
 pub fn target_accuracy<C: Classifier>(
     requested: MeanAccuracy,
     classifier: &C,
-    setup: &CalibrationSetup,
+    setup: &Valid<CalibrationSetup>,
     search: &TargetingParams,
     seed: u64,
     progress: impl FnMut(&TargetingStep),
@@ -208,7 +209,7 @@ pub fn target_accuracy_on<C: Classifier>(
     parts: &SessionParts,
     requested: MeanAccuracy,
     classifier: &C,
-    setup: &CalibrationSetup,
+    setup: &Valid<CalibrationSetup>,
     search: &TargetingParams,
     seed: u64,
     progress: impl FnMut(&TargetingStep),
@@ -246,7 +247,7 @@ pub struct SessionParts {
 impl SessionParts {
     /// Simulates both parts of the session of `setup` (whose ratio is
     /// ignored) from `seed`.
-    pub fn simulate(setup: &CalibrationSetup, seed: u64) -> Result<Self> {
+    pub fn simulate(setup: &Valid<CalibrationSetup>, seed: u64) -> Result<Self> {
         Self::from_parts(
             Self::simulate_part(setup, seed, false)?,
             Self::simulate_part(setup, seed, true)?,
@@ -256,12 +257,12 @@ impl SessionParts {
     /// One part of [`SessionParts::simulate`]: the ERPs at ratio 1 if
     /// `erp`, else background + artifacts (the two can run in parallel).
     pub fn simulate_part(
-        setup: &CalibrationSetup,
+        setup: &Valid<CalibrationSetup>,
         seed: u64,
         erp: bool,
     ) -> Result<CalibrationSession> {
         simulate_session(
-            &setup.at_ratio(1.0),
+            &Valid::new(setup.at_ratio(1.0)?)?,
             seed,
             SessionOptions {
                 components: Components {
@@ -319,18 +320,17 @@ impl SessionParts {
 pub fn target_continuous_accuracy(
     requested: MeanAccuracy,
     classifier: &SvmDecoder,
-    setup: &ContinuousSetup,
+    setup: &Valid<ContinuousSetup>,
     search: &TargetingParams,
     seed: u64,
     progress: impl FnMut(&TargetingStep),
 ) -> Result<TargetingResult> {
-    setup.validate()?;
     let cv_seed = cv_seed(seed);
     search_ratio(
         requested,
         search,
         |ratio| {
-            let at = setup.at_ratio(ratio);
+            let at = Valid::new(setup.at_ratio(ratio)?)?;
             let s = simulate_continuous_session(&at, seed, SessionOptions::default())?;
             cross_validate(
                 classifier,

@@ -1,9 +1,10 @@
 //! The synthetic EEG generator: assessment events in, multichannel samples out.
 
+use errp_valid::Check;
 use serde::{Deserialize, Serialize};
 
 use crate::erp::AssessmentKind;
-use crate::error::{Result, check};
+use crate::error::{BciError, Result, check};
 
 mod stream;
 
@@ -75,9 +76,20 @@ impl Default for GeneratorParams {
     }
 }
 
+/// Checked where it enters (a scenario, a setup, a Python keyword) and
+/// carried as a [`Valid`](errp_valid::Valid); [`EegGenerator`] takes it
+/// checked.
+impl Check for GeneratorParams {
+    type Error = BciError;
+
+    fn check(&self) -> Result<()> {
+        self.validate()
+    }
+}
+
 impl GeneratorParams {
     /// Checks every field; the error names the field and the accepted range.
-    pub fn validate(&self) -> Result<()> {
+    fn validate(&self) -> Result<()> {
         let finite_nonneg = |v: f64| v.is_finite() && v >= 0.0;
         check(
             self.sfreq_hz.is_finite() && self.sfreq_hz >= 64.0,
@@ -236,9 +248,10 @@ impl Default for Components {
 mod tests {
     use super::*;
     use crate::montage::Montage;
+    use errp_valid::Valid;
 
     fn generator(seed: u64) -> EegGenerator {
-        EegGenerator::new(GeneratorParams::default(), &Montage::standard(), seed).unwrap()
+        EegGenerator::new(&Valid::default(), &Montage::standard(), seed).unwrap()
     }
 
     #[test]
@@ -357,7 +370,7 @@ mod tests {
             blink_rate_hz: 1.0,
             ..GeneratorParams::default()
         };
-        let mut g = EegGenerator::new(params, &m, 4)
+        let mut g = EegGenerator::new(&Valid::new(params).unwrap(), &m, 4)
             .unwrap()
             .with_components(Components {
                 background: false,
@@ -381,7 +394,7 @@ mod tests {
             errp_to_noise: f64::NAN,
             ..GeneratorParams::default()
         };
-        let err = EegGenerator::new(params, &Montage::standard(), 0).unwrap_err();
+        let err = Valid::new(params).unwrap_err();
         assert!(err.to_string().contains("errp_to_noise"), "{err}");
     }
 }

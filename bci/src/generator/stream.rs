@@ -8,6 +8,8 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Exp, StandardNormal};
 
+use errp_valid::Valid;
+
 use super::{Assessment, Components, EegBlock, GeneratorParams};
 use crate::erp::{AssessmentKind, ErpTemplates, waveform};
 use crate::error::Result;
@@ -83,18 +85,18 @@ pub struct EegGenerator {
 
 impl EegGenerator {
     /// A generator for `montage` with the shipped ERP templates.
-    pub fn new(params: GeneratorParams, montage: &Montage, seed: u64) -> Result<Self> {
+    pub fn new(params: &Valid<GeneratorParams>, montage: &Montage, seed: u64) -> Result<Self> {
         Self::with_templates(params, montage, ErpTemplates::default(), seed)
     }
 
     /// A generator with custom ERP templates.
     pub fn with_templates(
-        params: GeneratorParams,
+        params: &Valid<GeneratorParams>,
         montage: &Montage,
         templates: ErpTemplates,
         seed: u64,
     ) -> Result<Self> {
-        params.validate()?;
+        let params = params.get().clone();
         let mut rng_background = stream(seed, "eeg/background");
         let mut rng_artifacts = stream(seed, "eeg/artifacts");
         let rng_erp = stream(seed, "eeg/erp");

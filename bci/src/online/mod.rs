@@ -198,7 +198,7 @@ mod tests {
             duration_secs: 1e9,
             ..OnlineRecordingParams::default()
         }
-        .validate()
+        .check()
         .unwrap_err()
         .to_string();
         assert!(e.contains("duration_secs"), "{e}");

@@ -4,13 +4,13 @@
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
-use errp_valid::Valid;
+use errp_valid::{Check, Valid};
 
 use super::detector::{Detector, DetectorParams};
 use super::{SlidingWindow, WINDOW_STEP_SECS};
 use crate::continuous::ContinuousFeatures;
 use crate::erp::AssessmentKind;
-use crate::error::{Result, check};
+use crate::error::{BciError, Result, check};
 use crate::generator::{EegGenerator, GeneratorParams};
 use crate::montage::Montage;
 use crate::preprocess::Preprocessor;
@@ -42,9 +42,18 @@ impl Default for OnlineRecordingParams {
     }
 }
 
+/// Checked where it is made; [`record_online`] takes it checked.
+impl Check for OnlineRecordingParams {
+    type Error = BciError;
+
+    fn check(&self) -> Result<()> {
+        self.validate()
+    }
+}
+
 impl OnlineRecordingParams {
     /// Checks every field.
-    pub fn validate(&self) -> Result<()> {
+    fn validate(&self) -> Result<()> {
         check(
             self.duration_secs.is_finite() && (60.0..=3600.0).contains(&self.duration_secs),
             "duration_secs",
@@ -95,16 +104,15 @@ impl OnlineRecording {
 /// between two of them (the user sees the motion corrected). All draws come
 /// from `seed` (labelled streams distinct from the calibration's).
 pub fn record_online(
-    generator: &GeneratorParams,
+    generator: &Valid<GeneratorParams>,
     montage: &Montage,
     preprocessor: &Preprocessor,
     model: &SvmModel,
-    params: &OnlineRecordingParams,
+    params: &Valid<OnlineRecordingParams>,
     seed: u64,
 ) -> Result<OnlineRecording> {
-    params.validate()?;
     let gen_seed = crate::rng::derive_seed(seed, "online/eeg", 0);
-    let eeg = EegGenerator::new(generator.clone(), montage, gen_seed)?;
+    let eeg = EegGenerator::new(generator, montage, gen_seed)?;
     let features = ContinuousFeatures::paper(generator.sfreq_hz);
     let mut window = SlidingWindow::start(eeg, preprocessor, &features, montage)?;
     let mut gaps = stream(seed, "online/schedule");

@@ -4,12 +4,12 @@
 //! calibration is deterministic. Seeded; tolerances stated.
 
 use errp_bci::{
-    ContinuousSetup, ErrorModel, MeanAccuracy, SessionOptions, SvmDecoder, TargetingParams,
+    ContinuousSetup, ErrorModel, MeanAccuracy, SessionOptions, SvmDecoder, TargetingParams, Valid,
     calibrate_continuous, simulate_continuous_session, target_continuous_accuracy,
 };
 
-pub(crate) fn setup_at(ratio: f64) -> ContinuousSetup {
-    ContinuousSetup::with_ratio(ratio)
+pub(crate) fn setup_at(ratio: f64) -> Valid<ContinuousSetup> {
+    Valid::new(ContinuousSetup::with_ratio(ratio).unwrap()).unwrap()
 }
 
 pub(crate) fn rows(x: &errp_bci::Features) -> impl Iterator<Item = Vec<f64>> + '_ {
@@ -21,7 +21,7 @@ fn lands_within_2_points(requested: f64, seed: u64) {
     let found = target_continuous_accuracy(
         MeanAccuracy::new(requested).unwrap(),
         &decoder,
-        &ContinuousSetup::default(),
+        &Valid::default(),
         &TargetingParams::default(),
         seed,
         |_| {},
@@ -86,7 +86,7 @@ fn report_targeting() {
         let found = target_continuous_accuracy(
             MeanAccuracy::new(requested).unwrap(),
             &SvmDecoder::default(),
-            &ContinuousSetup::default(),
+            &Valid::default(),
             &TargetingParams::default(),
             seed,
             |s| println!("  ratio {:.4}: {:.4}", s.ratio, s.accuracy.mean()),

@@ -6,24 +6,25 @@
 use errp_bci::{
     CalibrationParams, CalibrationSetup, Classifier, Components, ErrorModel, Features,
     GeneratorParams, LdaDecoder, MeanAccuracy, SessionOptions, SessionParts, Shrinkage, SvmDecoder,
-    TargetingParams, calibrate, calibrate_session, cross_validate, rng::stream, simulate_session,
-    target_accuracy,
+    TargetingParams, Valid, calibrate, calibrate_session, cross_validate, rng::stream,
+    simulate_session, target_accuracy,
 };
 use rand::seq::SliceRandom;
 
-fn setup_at(ratio: f64) -> CalibrationSetup {
-    CalibrationSetup::with_ratio(ratio)
+fn setup_at(ratio: f64) -> Valid<CalibrationSetup> {
+    Valid::new(CalibrationSetup::with_ratio(ratio).unwrap()).unwrap()
 }
 
 /// The default setup with `n_actions` actions at ErrP-to-noise `ratio`.
-pub(crate) fn sized(n_actions: usize, ratio: f64) -> CalibrationSetup {
-    CalibrationSetup {
+pub(crate) fn sized(n_actions: usize, ratio: f64) -> Valid<CalibrationSetup> {
+    Valid::new(CalibrationSetup {
         calibration: CalibrationParams {
             n_actions,
             ..CalibrationParams::default()
         },
-        ..setup_at(ratio)
-    }
+        ..CalibrationSetup::with_ratio(ratio).unwrap()
+    })
+    .unwrap()
 }
 
 pub(crate) fn small_session(seed: u64) -> (Features, Vec<bool>) {
@@ -84,13 +85,7 @@ fn features_are_linear_in_the_errp_to_noise_ratio() {
     // Targeting relies on: features(r) = features(noise) + r * features(ERP at 1).
     let setup = sized(30, 1.0);
     let part = |c: Components, ratio: f64| {
-        let s = CalibrationSetup {
-            generator: GeneratorParams {
-                errp_to_noise: ratio,
-                ..setup.generator.clone()
-            },
-            ..setup.clone()
-        };
+        let s = Valid::new(setup.at_ratio(ratio).unwrap()).unwrap();
         simulate_session(
             &s,
             4,
@@ -145,7 +140,7 @@ fn session_parts_give_the_session_and_the_calibration_at_any_ratio() {
 
 fn lands_within_1_5_points(requested: f64, seed: u64) {
     let decoder = LdaDecoder::default();
-    let setup = CalibrationSetup::default();
+    let setup: Valid<CalibrationSetup> = Valid::default();
     let found = target_accuracy(
         MeanAccuracy::new(requested).unwrap(),
         &decoder,

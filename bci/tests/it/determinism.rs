@@ -6,7 +6,7 @@
 
 use errp_bci::{
     Assessment, AssessmentKind, ContinuousCalibrationParams, ContinuousSetup, EegGenerator,
-    ErrorModel, GeneratorParams, Montage, SvmDecoder, calibrate_continuous,
+    ErrorModel, GeneratorParams, Montage, SvmDecoder, Valid, calibrate_continuous,
 };
 
 use errp_bci::rng::fnv1a;
@@ -21,7 +21,12 @@ fn digest(value: &impl std::fmt::Debug) -> u64 {
 /// One second of the 40-channel EEG of seed 7 with an ErrP at 0.2 s.
 #[test]
 fn the_generator_gives_the_golden_samples() {
-    let mut g = EegGenerator::new(GeneratorParams::default(), &Montage::standard(), 7).unwrap();
+    let mut g = EegGenerator::new(
+        &Valid::<GeneratorParams>::default(),
+        &Montage::standard(),
+        7,
+    )
+    .unwrap();
     g.schedule(Assessment {
         onset_secs: 0.2,
         kind: AssessmentKind::Error,
@@ -46,13 +51,14 @@ fn the_discrete_session_has_the_golden_features() {
 /// decision on a fixed input.
 #[test]
 fn calibration_is_deterministic() {
-    let setup = ContinuousSetup {
+    let setup = Valid::new(ContinuousSetup {
         calibration: ContinuousCalibrationParams {
             per_class: 40,
             ..ContinuousCalibrationParams::default()
         },
-        ..continuous::setup_at(1.0)
-    };
+        ..continuous::setup_at(1.0).into_inner()
+    })
+    .unwrap();
     let a = calibrate_continuous(&SvmDecoder::default(), &setup, 5).unwrap();
     let b = calibrate_continuous(&SvmDecoder::default(), &setup, 5).unwrap();
     assert_eq!(a.accuracy, b.accuracy);

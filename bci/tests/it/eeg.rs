@@ -1,11 +1,11 @@
 //! Statistical properties of the synthetic EEG that a decoder would notice.
 
-use errp_bci::{Components, EegGenerator, FilterChain, GeneratorParams, Montage};
+use errp_bci::{Components, EegGenerator, FilterChain, GeneratorParams, Montage, Valid};
 use realfft::RealFftPlanner;
 
 fn background(seed: u64, secs: usize) -> (Montage, errp_bci::EegBlock) {
     let m = Montage::standard();
-    let mut g = EegGenerator::new(GeneratorParams::default(), &m, seed)
+    let mut g = EegGenerator::new(&Valid::<GeneratorParams>::default(), &m, seed)
         .unwrap()
         .with_components(Components {
             background: true,

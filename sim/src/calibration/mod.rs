@@ -10,7 +10,7 @@ pub use view::{calibration_recording, record_calibration};
 use errp_bci::{
     Calibrated, CalibrationParams, ChannelKind, GeneratorParams, LdaDecoder, LdaModel,
     MeanAccuracy, Protocol, SessionOptions, Setup, TargetingParams, TargetingResult, TargetingStep,
-    calibrate, target_accuracy,
+    Valid, calibrate, target_accuracy,
 };
 
 use crate::error::Result;
@@ -25,7 +25,7 @@ pub struct Request<P> {
     /// Seed of the synthetic user and session.
     pub seed: u64,
     /// EEG model, protocol, preprocessing, montage.
-    pub setup: Setup<P>,
+    pub setup: Valid<Setup<P>>,
     /// Search settings.
     pub search: TargetingParams,
 }
@@ -36,7 +36,7 @@ impl<P: Protocol> Request<P> {
         Self {
             accuracy,
             seed,
-            setup: Setup::default(),
+            setup: Valid::default(),
             search: TargetingParams::default(),
         }
     }
@@ -61,7 +61,7 @@ impl<P: Protocol + serde::Serialize> Request<P> {
             calibration,
             preprocess,
             montage,
-        } = setup;
+        } = setup.get();
         let channels: Vec<(&str, &str, [f64; 3])> = montage
             .channels()
             .iter()
@@ -91,7 +91,7 @@ pub struct Report<M> {
     /// The search for the ErrP-to-noise ratio.
     pub targeting: TargetingResult,
     /// The EEG model at the ratio found.
-    pub generator: GeneratorParams,
+    pub generator: Valid<GeneratorParams>,
     /// The calibration session at that ratio, its cross-validated accuracy
     /// and the decoder trained on all of it.
     pub calibrated: Calibrated<M>,
@@ -133,11 +133,11 @@ pub fn calibrate_at(
     targeting: TargetingResult,
     options: SessionOptions<'_>,
 ) -> Result<CalibrationReport> {
-    let setup = request.setup.at_ratio(targeting.ratio);
+    let setup = Valid::new(request.setup.at_ratio(targeting.ratio)?)?;
     let calibrated = calibrate(&LdaDecoder::default(), &setup, request.seed, options)?;
     Ok(CalibrationReport {
         targeting,
-        generator: setup.generator,
+        generator: setup.generator.clone(),
         calibrated,
     })
 }
@@ -245,8 +245,12 @@ mod tests {
         assert!(key.starts_with("targeting/v2;accuracy=f:"), "{key}");
         assert_eq!(key, base.clone().targeting_key());
         let mut other = base.clone();
-        other.setup.generator.alpha_hz =
-            f64::from_bits(other.setup.generator.alpha_hz.to_bits() + 1);
+        let generator = base
+            .setup
+            .generator
+            .with(|g| g.alpha_hz = f64::from_bits(g.alpha_hz.to_bits() + 1))
+            .unwrap();
+        other.setup = base.setup.with(|s| s.generator = generator).unwrap();
         assert_ne!(other.targeting_key(), key);
         let mut other = base.clone();
         other.seed = 2;

@@ -53,11 +53,11 @@ pub fn calibrate_continuous_at(
     request: &ContinuousRequest,
     targeting: TargetingResult,
 ) -> Result<ContinuousReport> {
-    let setup = request.setup.at_ratio(targeting.ratio);
+    let setup = Valid::new(request.setup.at_ratio(targeting.ratio)?)?;
     let calibrated = calibrate_continuous(&SvmDecoder::default(), &setup, request.seed)?;
     Ok(ContinuousReport {
         targeting,
-        generator: setup.generator,
+        generator: setup.generator.clone(),
         calibrated,
     })
 }
@@ -223,7 +223,7 @@ fn held_out_seed(seed: u64) -> u64 {
 #[derive(Debug, Clone)]
 pub struct ContinuousDecoder {
     /// The synthetic user's EEG model (at the calibrated ErrP-to-noise ratio).
-    pub generator: GeneratorParams,
+    pub generator: Valid<GeneratorParams>,
     /// The montage.
     pub montage: Montage,
     /// Preprocessing fitted during calibration.
@@ -258,7 +258,7 @@ impl ContinuousDecoder {
             &self.montage,
             &self.preprocessor,
             &self.model,
-            &OnlineRecordingParams::default(),
+            &Valid::<OnlineRecordingParams>::default(),
             held_out_seed(seed),
         )?)
     }
@@ -310,7 +310,7 @@ impl ContinuousDecoder {
     /// filters settled; episode time 0 is generator time
     /// [`WARM_UP_SECS`](errp_bci::WARM_UP_SECS).
     pub fn start_stream(&self, seed: u64) -> Result<SlidingWindow> {
-        let generator = EegGenerator::new(self.generator.clone(), &self.montage, seed)?;
+        let generator = EegGenerator::new(&self.generator, &self.montage, seed)?;
         Ok(SlidingWindow::start(
             generator,
             &self.preprocessor,

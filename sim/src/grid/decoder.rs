@@ -4,8 +4,8 @@
 
 use errp_bci::{
     Accuracy, Assessment, AssessmentKind, Components, EegBlock, EegGenerator, EpochWindow,
-    ErrorModel, GeneratorParams, LdaModel, Montage, PlattScaling, Preprocessor, rng::derive_seed,
-    rng::stream,
+    ErrorModel, GeneratorParams, LdaModel, Montage, PlattScaling, Preprocessor, Valid,
+    rng::derive_seed, rng::stream,
 };
 use rand::Rng;
 use serde::{Deserialize, Serialize};
@@ -111,10 +111,7 @@ impl EpochBankParts {
         per_class: usize,
         seed: u64,
     ) -> Result<Self> {
-        let generator = GeneratorParams {
-            errp_to_noise: 1.0,
-            ..source.generator.clone()
-        };
+        let generator = source.generator.with(|g| g.errp_to_noise = 1.0)?;
         let unit = EegSource {
             generator: &generator,
             ..source
@@ -243,7 +240,7 @@ fn stream_classes<T>(
 #[derive(Debug, Clone)]
 pub struct EegDecoder {
     /// The synthetic user's EEG model (at the calibrated ErrP-to-noise ratio).
-    pub generator: GeneratorParams,
+    pub generator: Valid<GeneratorParams>,
     /// The montage.
     pub montage: Montage,
     /// Preprocessing fitted on the calibration session's EOG recording.
@@ -306,7 +303,7 @@ pub(crate) fn decide(d: &EegDecoder, features: &[f64]) -> (f64, bool) {
 #[derive(Debug, Clone, Copy)]
 pub struct EegSource<'a> {
     /// The synthetic user's EEG model.
-    pub generator: &'a GeneratorParams,
+    pub generator: &'a Valid<GeneratorParams>,
     /// The montage.
     pub montage: &'a Montage,
     /// The preprocessing fitted at calibration.
@@ -326,7 +323,7 @@ impl OnlineEeg {
     pub(crate) fn start(d: EegSource<'_>, seed: u64, components: Components) -> Result<Self> {
         let fs = d.generator.sfreq_hz;
         let mut generator =
-            EegGenerator::new(d.generator.clone(), d.montage, seed)?.with_components(components);
+            EegGenerator::new(d.generator, d.montage, seed)?.with_components(components);
         let mut preprocessor = d.preprocessor.clone();
         preprocessor.reset();
         preprocessor.process(&generator.generate((errp_bci::WARM_UP_SECS * fs) as usize));

@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use errp_bci::{
     Accuracy, CalibrationSetup, Classifier, LdaDecoder, MeanAccuracy, SessionParts,
-    TargetingResult, TargetingStep, calibrate_session, rng::derive_seed, search_ratio,
+    TargetingResult, TargetingStep, Valid, calibrate_session, rng::derive_seed, search_ratio,
 };
 use errp_robot::{Grid, GridControlParams, QTable};
 
@@ -124,7 +124,7 @@ fn held_out_key(s: &GridScenario) -> String {
 /// intervals), from a seed of their own, so that no episode reads them.
 fn build_held_out(
     s: &GridScenario,
-    setup: &CalibrationSetup,
+    setup: &Valid<CalibrationSetup>,
     session: &SessionParts,
 ) -> Result<EpochBankParts> {
     stream_parts(
@@ -151,7 +151,7 @@ fn bank_key(s: &GridScenario) -> String {
 
 /// The calibration session of `setup` and `seed`, streamed as its noise and
 /// ERP parts in parallel.
-fn simulate_parts(setup: &CalibrationSetup, seed: u64) -> Result<SessionParts> {
+fn simulate_parts(setup: &Valid<CalibrationSetup>, seed: u64) -> Result<SessionParts> {
     let (noise, erp) = rayon::join(
         || SessionParts::simulate_part(setup, seed, false),
         || SessionParts::simulate_part(setup, seed, true),
@@ -163,7 +163,7 @@ fn simulate_parts(setup: &CalibrationSetup, seed: u64) -> Result<SessionParts> {
 /// with the user of `setup`.
 fn build_bank(
     s: &GridScenario,
-    setup: &CalibrationSetup,
+    setup: &Valid<CalibrationSetup>,
     session: &SessionParts,
 ) -> Result<EpochBankParts> {
     stream_parts(s, setup, session, s.bank_per_class, s.seed)
@@ -174,7 +174,7 @@ fn build_bank(
 /// `session`'s preprocessing.
 fn stream_parts(
     s: &GridScenario,
-    setup: &CalibrationSetup,
+    setup: &Valid<CalibrationSetup>,
     session: &SessionParts,
     per_class: usize,
     seed: u64,
@@ -193,7 +193,7 @@ impl GridShared {
     /// paper's protocol and the default EEG model, as every grid scenario
     /// is calibrated.
     pub fn build<'a>(scenarios: impl IntoIterator<Item = &'a GridScenario>) -> Result<Self> {
-        let setup = CalibrationSetup::default();
+        let setup: Valid<CalibrationSetup> = Valid::default();
         let mut shared = Self::default();
         for s in scenarios {
             if s.decoder != DecoderChoice::Eeg {
@@ -282,7 +282,7 @@ pub fn prepare_grid_decoder(
         request.seed,
     )?;
     let report = CalibrationReport {
-        generator: request.setup.at_ratio(targeting.ratio).generator,
+        generator: request.setup.at_ratio(targeting.ratio)?.generator,
         targeting,
         calibrated,
     };

@@ -255,7 +255,7 @@ fn detections_are_scored_over_the_span_where_the_decoder_responds() {
         "smoothing delays detections"
     );
     // ErrPs at known times, 5 s apart, in the user's own EEG.
-    let generator = EegGenerator::new(decoder.generator.clone(), &decoder.montage, 40).unwrap();
+    let generator = EegGenerator::new(&decoder.generator, &decoder.montage, 40).unwrap();
     let mut w = SlidingWindow::start(
         generator,
         &decoder.preprocessor,

@@ -91,14 +91,8 @@ fn banked_epochs_give_the_streamed_accuracy_and_reach_the_goals() {
 #[test]
 fn a_decoder_without_errps_converges_to_the_right_goal_only_by_chance() {
     // No ErrP at all (ratio 0): the real decoder is at chance.
-    use errp_bci::{CalibrationSetup, GeneratorParams, LdaDecoder, SessionOptions, calibrate};
-    let setup = CalibrationSetup {
-        generator: GeneratorParams {
-            errp_to_noise: 0.0,
-            ..GeneratorParams::default()
-        },
-        ..CalibrationSetup::default()
-    };
+    use errp_bci::{CalibrationSetup, LdaDecoder, SessionOptions, Valid, calibrate};
+    let setup = Valid::new(CalibrationSetup::with_ratio(0.0).unwrap()).unwrap();
     let c = calibrate(&LdaDecoder::default(), &setup, 5, SessionOptions::default()).unwrap();
     let eeg = EegDecoder {
         generator: setup.generator.clone(),

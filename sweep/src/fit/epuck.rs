@@ -264,7 +264,7 @@ pub fn run_epuck_fit(
                 chunk: 0,
                 repair: false,
             };
-            match run_sweep(&sweep, &opts, cancel, observer)? {
+            match run_sweep(&sweep.checked()?, &opts, cancel, observer)? {
                 SweepOutcome::Interrupted { .. } => return Ok(FitOutcome::Interrupted),
                 SweepOutcome::Complete { .. } => {}
             }

@@ -233,7 +233,13 @@ fn the_median_time_to_pisa_does_not_rise_with_accuracy() {
         chunk: 0,
         repair: false,
     };
-    run_sweep(&spec, &opts, &AtomicBool::new(false), &()).unwrap();
+    run_sweep(
+        &spec.checked().unwrap(),
+        &opts,
+        &AtomicBool::new(false),
+        &(),
+    )
+    .unwrap();
     let text = std::fs::read_to_string(out.join("episodes.csv")).unwrap();
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();

@@ -112,7 +112,12 @@ fn with_line(text: &str, line: usize, f: &dyn Fn(&str) -> String) -> String {
 fn run(spec: &SweepSpec, out: &Path, shard: Shard, repair: bool) -> errp_sim::Result<SweepOutcome> {
     let mut opts = options(out, shard, 7);
     opts.repair = repair;
-    run_sweep(spec, &opts, &AtomicBool::new(false), &())
+    run_sweep(
+        &spec.clone().checked()?,
+        &opts,
+        &AtomicBool::new(false),
+        &(),
+    )
 }
 
 #[test]

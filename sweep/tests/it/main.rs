@@ -91,7 +91,15 @@ pub(crate) fn complete(spec: &SweepSpec, out: &Path, shard: Shard, threads: usiz
         .build()
         .unwrap();
     let outcome = pool
-        .install(|| run_sweep(spec, &options(out, shard, 7), &AtomicBool::new(false), &()))
+        .install(|| {
+            let sweep = spec.clone().checked().unwrap();
+            run_sweep(
+                &sweep,
+                &options(out, shard, 7),
+                &AtomicBool::new(false),
+                &(),
+            )
+        })
         .unwrap();
     let SweepOutcome::Complete { report, .. } = outcome else {
         panic!("{outcome:?}")

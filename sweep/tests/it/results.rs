@@ -82,7 +82,8 @@ fn an_interrupted_or_crashed_sweep_resumes_to_the_same_files() {
         after: 30,
         cancel: &cancel,
     };
-    let outcome = run_sweep(&spec, &options(&resumed, Shard::ALL, 7), &cancel, &stop).unwrap();
+    let sweep = spec.clone().checked().unwrap();
+    let outcome = run_sweep(&sweep, &options(&resumed, Shard::ALL, 7), &cancel, &stop).unwrap();
     let SweepOutcome::Interrupted { done, total } = outcome else {
         panic!("{outcome:?}")
     };
@@ -105,7 +106,7 @@ fn an_interrupted_or_crashed_sweep_resumes_to_the_same_files() {
     let outcome = pool
         .install(|| {
             run_sweep(
-                &spec,
+                &sweep,
                 &options(&resumed, Shard::ALL, 50),
                 &AtomicBool::new(false),
                 &(),
@@ -122,7 +123,7 @@ fn an_interrupted_or_crashed_sweep_resumes_to_the_same_files() {
     // The same directory with other parameters is refused, untouched.
     let other = spec_with_seed(&spec, 6);
     let e = run_sweep(
-        &other,
+        &other.checked().unwrap(),
         &options(&resumed, Shard::ALL, 7),
         &AtomicBool::new(false),
         &(),
@@ -193,7 +194,8 @@ fn a_sweep_calibrates_like_errp_run() {
     let out = temp_dir("same-calibration");
     complete(&spec, &out, Shard::ALL, 2);
     let manifest = Manifest::read(&out).unwrap();
-    for (level, info) in spec.levels().unwrap().iter().zip(&manifest.decoders) {
+    let sweep = spec.checked().unwrap();
+    for (level, info) in sweep.levels().iter().zip(&manifest.decoders) {
         let errp_sim::AnyScenario::Grid(scenario) = &level.scenario else {
             panic!("a grid level");
         };
