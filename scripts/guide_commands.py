@@ -41,8 +41,8 @@ FIGURES_SCRIPT = ROOT / "scripts/readme_figures.sh"
 # Commands another step of .ci/run runs, by their first words.
 ELSEWHERE = {
     "cargo test --workspace": ".ci/run, step 'tests (the README's command)'",
-    "python3 -m venv .venv": ".ci/run, step 'the Python package' (a venv, pip install ./python)",
-    ".venv/bin/pip install ./python": ".ci/run, step 'the Python package' (pip install ./python)",
+    "python3 -m venv .venv": ".ci/run, step 'the Python package' (a venv, pip install "
+                             "\"./python[examples,test]\")",
     "scripts/slurm/submit.sh": ".ci/run, step 'Slurm' (scripts/slurm/test.sh submits with it)",
 }
 # Lines that only set the shell up: kept for the variables, not commands.

@@ -34,6 +34,12 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<env::GridEnvCore>()?;
     m.add_class::<env::EpuckEnvCore>()?;
     m.add("HAS_RERUN", cfg!(feature = "rerun"))?;
+    // The limits the package checks its whole-number arguments against
+    // (errp/_args.py), the program's own.
+    m.add("MAX_RUNS", errp_sim::epuck::MAX_RUNS)?;
+    m.add("MAX_EPISODES", errp_sweep::MAX_EPISODES)?;
+    m.add("MAX_THREADS", run::MAX_THREADS)?;
+    m.add("MAX_GENERATE_SAMPLES", session::MAX_GENERATE_SAMPLES)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -22,11 +22,18 @@ use pyo3::types::PyDict;
 
 use crate::convert::{Keys, load_any, load_any_text, py_err, value_error};
 
+/// Most worker threads of a sweep.
+pub(crate) const MAX_THREADS: usize = 1024;
+
 /// Keyword names in errors.
 const NAMES: InputNames = InputNames {
     scenario: "scenario=",
     task: "task=",
-    eeg: "eeg=",
+    eeg: "stream=",
+    accuracy: "accuracy=",
+    param: "params=",
+    episodes: "episodes=",
+    seed: "seed=",
 };
 
 /// The header of the frames `run` and the tasks' `run` return: the columns
@@ -369,8 +376,12 @@ pub(crate) fn sweep<'py>(
         ));
     }
     let threads = match threads {
-        Some(n) if !(1..=1024).contains(&n) => {
-            return Err(value_error("threads", n, "a whole number from 1 to 1024"));
+        Some(n) if !(1..=MAX_THREADS).contains(&n) => {
+            return Err(value_error(
+                "threads",
+                n,
+                &format!("a whole number from 1 to {MAX_THREADS}"),
+            ));
         }
         Some(n) => n,
         None => rayon::current_num_threads(),
@@ -380,19 +391,18 @@ pub(crate) fn sweep<'py>(
         task,
         scenario_path: path,
         scenario_toml: text,
-        accuracies: parse_accuracies(&accuracy)
-            .map_err(|e| PyValueError::new_err(format!("accuracy: {}", e)))?,
+        accuracies: parse_accuracies(&accuracy, &NAMES).map_err(py_err)?,
         axes: params
             .unwrap_or_default()
             .iter()
-            .map(|p| parse_axis(task, p))
+            .map(|p| parse_axis(task, p, &NAMES))
             .collect::<errp_sim::Result<_>>()
-            .map_err(|e| PyValueError::new_err(format!("params: {e}")))?,
+            .map_err(py_err)?,
         fixed: sweep_fixed(task, stream, NAMES).map_err(py_err)?,
         episodes,
         seed,
     };
-    let sweep = spec.checked().map_err(py_err)?;
+    let sweep = spec.checked(&NAMES).map_err(py_err)?;
     let opts = SweepOptions {
         out: out.clone(),
         cache: match cache {

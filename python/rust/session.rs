@@ -17,7 +17,7 @@ use crate::convert::{
 };
 
 /// The most samples one `generate` call returns: an hour at 256 Hz.
-const MAX_GENERATE_SAMPLES: usize = 3600 * 256;
+pub(crate) const MAX_GENERATE_SAMPLES: usize = 3600 * 256;
 
 /// Simulates the discrete calibration session of `errp calibrate
 /// --accuracy ACCURACY --seed SEED`: the ErrP-to-noise ratio targeted so

@@ -11,14 +11,23 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def errp_bin() -> Path:
-    """The `errp` program: $ERRP_BIN, or the repository's debug build."""
-    p = Path(os.environ.get("ERRP_BIN", ROOT / "target" / "debug" / "errp"))
-    if not p.exists():
-        pytest.fail(
-            f"the errp program is not at {p}: build it (cargo build) or set ERRP_BIN",
-            pytrace=False,
-        )
-    return p
+    """The `errp` program the package is compared with: $ERRP_BIN, else the
+    repository's debug or release build. A test that needs it is skipped,
+    with the command that builds it, when there is none (a set ERRP_BIN
+    that names no file is an error)."""
+    given = os.environ.get("ERRP_BIN")
+    if given:
+        if not Path(given).is_file():
+            pytest.fail(f"ERRP_BIN={given}: no such file", pytrace=False)
+        return Path(given)
+    for profile in ("debug", "release"):
+        p = ROOT / "target" / profile / "errp"
+        if p.is_file():
+            return p
+    pytest.skip(
+        "compares with the errp program, which is not built: run `cargo build` in "
+        f"{ROOT} (or set ERRP_BIN to an errp program)"
+    )
 
 
 def cli(*args: str) -> str:

@@ -41,7 +41,7 @@ def test_sweep_arguments_are_named(tmp_path):
         errp.sweep(out, task="grid", accuracy=0.7, episodes=0)
     with pytest.raises(ValueError, match="params"):
         errp.sweep(out, task="grid", accuracy=0.7, params={"no_such": [1]})
-    with pytest.raises(ValueError, match="eeg= applies to the grid"):
+    with pytest.raises(ValueError, match="stream= applies to the grid"):
         errp.sweep(out, task="epuck", accuracy=0.8, stream=True)
     with pytest.raises(ValueError, match="give scenario= FILE.toml, or task="):
         errp.sweep(out, accuracy=0.7)

@@ -137,3 +137,24 @@ def test_bad_arguments_name_the_field():
         errp.gym.GridEnv(render_mode="human")
     with pytest.raises(ValueError, match="'ansi' or 'rgb_array'"):
         errp.gym.EpuckEnv(render_mode="rgb")
+
+
+def test_the_environments_are_registered_without_importing_errp_gym(tmp_path):
+    # Gymnasium 1.x has no entry points: `import errp` registers both ids
+    # (by name only: errp.gym, which imports Gymnasium's spaces, is loaded
+    # by gym.make).
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, gymnasium as gym, errp\n"
+        "assert 'errp.gym' not in sys.modules\n"
+        "assert 'errp/Grid-v0' in gym.registry and 'errp/Epuck-v0' in gym.registry\n"
+        "env = gym.make('errp/Grid-v0')\n"
+        "print(type(env.unwrapped).__name__, env.spec.max_episode_steps,\n"
+        "      env.metadata['render_fps'])\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         cwd=tmp_path, timeout=600)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["GridEnv", "100", "2"]

@@ -11,7 +11,7 @@ use errp_sweep::fit::{
     EpuckFit, EpuckFitSpec, FitOutcome, GridFit, GridFitOutcome, GridFitSpec, Provenance,
     REACHED_LEVEL, run_epuck_fit, run_grid_fit,
 };
-use errp_sweep::{parse_accuracies, parse_values};
+use errp_sweep::{InputNames, parse_accuracies, parse_values};
 use toml::Value;
 
 use crate::cli::parse_seed;
@@ -124,7 +124,7 @@ pub fn fit(cmd: &FitCommand) -> Result<bool> {
 
 fn fit_epuck(args: &EpuckFitArgs) -> Result<bool> {
     let spec = EpuckFitSpec {
-        accuracies: parse_accuracies(&args.accuracy)?,
+        accuracies: parse_accuracies(&args.accuracy, &InputNames::CLI)?,
         calibrations: args.calibrations,
         runs: args.runs,
         seed: args.seed,

@@ -268,11 +268,7 @@ impl SweepObserver for Progress {
 
 /// Runs `errp sweep`. Returns false if interrupted (exit code 130).
 pub fn sweep(args: &SweepArgs) -> Result<bool> {
-    const NAMES: InputNames = InputNames {
-        scenario: "--scenario",
-        task: "--task",
-        eeg: "--eeg",
-    };
+    const NAMES: InputNames = InputNames::CLI;
     let want = args.task.map(|t| match t {
         TaskArg::Grid => SweepTask::Grid,
         TaskArg::Epuck => SweepTask::Epuck,
@@ -283,11 +279,11 @@ pub fn sweep(args: &SweepArgs) -> Result<bool> {
         task,
         scenario_path: path,
         scenario_toml: text,
-        accuracies: parse_accuracies(&args.accuracy)?,
+        accuracies: parse_accuracies(&args.accuracy, &NAMES)?,
         axes: args
             .params
             .iter()
-            .map(|p| parse_axis(task, p))
+            .map(|p| parse_axis(task, p, &NAMES))
             .collect::<errp_sim::Result<_>>()?,
         fixed,
         episodes: args.episodes as usize,
@@ -300,7 +296,7 @@ pub fn sweep(args: &SweepArgs) -> Result<bool> {
     let cache = args.workers.cache();
     // Every level is built and checked before anything is printed or
     // started; the sweep takes them checked.
-    let sweep = spec.checked()?;
+    let sweep = spec.checked(&NAMES)?;
     let spec = sweep.spec();
     // A cache that cannot be used is not an error, but the user is told.
     if let Some(why) = cache.problem() {

@@ -9,8 +9,8 @@ use std::sync::atomic::AtomicBool;
 
 use divan::Bencher;
 use errp_sweep::{
-    Shard, SweepOptions, SweepOutcome, SweepSpec, SweepTask, TargetCache, parse_accuracies,
-    run_sweep,
+    InputNames, Shard, SweepOptions, SweepOutcome, SweepSpec, SweepTask, TargetCache,
+    parse_accuracies, run_sweep,
 };
 
 fn main() {
@@ -23,7 +23,7 @@ fn spec(task: SweepTask, file: &str, toml: &str, accuracies: &str, episodes: usi
         task,
         scenario_path: format!("scenarios/{file}").into(),
         scenario_toml: toml.into(),
-        accuracies: parse_accuracies(accuracies).unwrap(),
+        accuracies: parse_accuracies(accuracies, &InputNames::CLI).unwrap(),
         axes: vec![],
         fixed: vec![],
         episodes,
@@ -77,7 +77,7 @@ fn sweep(spec: &SweepSpec, threads: usize, cache: &TargetCache, name: &str) {
         .unwrap();
     let outcome = pool
         .install(|| {
-            let sweep = spec.clone().checked().unwrap();
+            let sweep = spec.clone().checked(&InputNames::CLI).unwrap();
             run_sweep(&sweep, &opts, &AtomicBool::new(false), &())
         })
         .unwrap();
@@ -125,7 +125,7 @@ fn recheck_40000_rows(bencher: Bencher) {
         repair: false,
     };
     let cancel = AtomicBool::new(false);
-    let sweep = spec.checked().unwrap();
+    let sweep = spec.checked(&InputNames::CLI).unwrap();
     run_sweep(&sweep, &opts, &cancel, &()).unwrap();
     bencher.bench_local(|| {
         let outcome = run_sweep(&sweep, &opts, &cancel, &()).unwrap();

@@ -10,6 +10,7 @@ use errp_sim::{Result, SimError};
 use crate::figure::sweep_plot;
 use crate::manifest::{EPISODES, Manifest};
 use crate::plot::{self};
+use crate::spec::InputNames;
 use crate::summary::{SweepReport, summarise_dir};
 use crate::table::summary_csv;
 
@@ -23,7 +24,7 @@ pub fn finish_dir(dir: &Path, manifest: &Manifest) -> Result<SweepReport> {
     let scenario = match parse_scenario(&spec.scenario_toml, &spec.scenario_path) {
         Ok(s) => s,
         Err(_) => spec
-            .levels()?
+            .levels(&InputNames::CLI)?
             .into_iter()
             .next()
             .map(|l| l.scenario)

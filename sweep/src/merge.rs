@@ -16,7 +16,7 @@ use crate::lock::DirLock;
 use crate::manifest::{EPISODES, MANIFEST, Manifest};
 use crate::rows::{RowCheck, episodes_header};
 use crate::run::foreign_files;
-use crate::spec::{Level, SweepSpec, SweepTask};
+use crate::spec::{InputNames, Level, SweepSpec, SweepTask};
 use crate::summary::SweepReport;
 use crate::writer::read_row;
 
@@ -124,7 +124,7 @@ pub fn merge_sweeps(dirs: &[PathBuf], out: &Path) -> Result<SweepReport> {
             )));
         }
     }
-    let levels = spec.levels()?;
+    let levels = spec.levels(&InputNames::CLI)?;
     let created = create_dirs(out)?;
     // Go if the merge is interrupted before it is written.
     created.remove_if_interrupted();

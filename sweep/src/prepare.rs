@@ -61,20 +61,20 @@ mod tests {
     use errp_sim::epuck::EpuckTask;
 
     use super::*;
-    use crate::spec::{Level, SweepSpec, SweepTask, parse_accuracies, parse_axis};
+    use crate::spec::{InputNames, Level, SweepSpec, SweepTask, parse_accuracies, parse_axis};
 
     fn epuck_levels(param: &str) -> Vec<Level> {
         SweepSpec {
             task: SweepTask::Epuck,
             scenario_path: "mexico_to_pisa.toml".into(),
             scenario_toml: include_str!("../../scenarios/mexico_to_pisa.toml").into(),
-            accuracies: parse_accuracies("0.9").unwrap(),
-            axes: vec![parse_axis(SweepTask::Epuck, param).unwrap()],
+            accuracies: parse_accuracies("0.9", &InputNames::CLI).unwrap(),
+            axes: vec![parse_axis(SweepTask::Epuck, param, &InputNames::CLI).unwrap()],
             fixed: vec![],
             episodes: 1,
             seed: 1,
         }
-        .levels()
+        .levels(&InputNames::CLI)
         .unwrap()
     }
 

@@ -268,9 +268,10 @@ pub fn parse_values(text: &str, what: &str) -> Result<Vec<Value>> {
 }
 
 /// Parses the `--accuracy` levels: numbers in (0.5, 1), 1 allowed for the
-/// grid's oracle decoder.
-pub fn parse_accuracies(text: &str) -> Result<Vec<f64>> {
-    let values = parse_values(text, "--accuracy")?;
+/// grid's oracle decoder. Errors name the levels as `names` does.
+pub fn parse_accuracies(text: &str, names: &InputNames) -> Result<Vec<f64>> {
+    let flag = names.accuracy;
+    let values = parse_values(text, flag)?;
     let mut out = Vec::with_capacity(values.len());
     for v in values {
         let a = match v {
@@ -278,7 +279,7 @@ pub fn parse_accuracies(text: &str) -> Result<Vec<f64>> {
             Value::Integer(i) => i as f64,
             other => {
                 return Err(SimError::Sweep(format!(
-                    "--accuracy {text:?} is invalid: {} is not a number",
+                    "{flag} {text:?} is invalid: {} is not a number",
                     value_text(&other)
                 )));
             }
@@ -286,7 +287,7 @@ pub fn parse_accuracies(text: &str) -> Result<Vec<f64>> {
         // 1 is for the oracle; a grid EEG or e-puck scenario refuses it.
         if RequestedAccuracy::new(a).is_err() {
             return Err(SimError::Sweep(format!(
-                "--accuracy {text:?} is invalid: {a} is not a mean accuracy in (0.5, 1) \
+                "{flag} {text:?} is invalid: {a} is not a mean accuracy in (0.5, 1) \
                  (e.g. 0.55:0.95:0.05)"
             )));
         }
@@ -315,11 +316,13 @@ pub fn aliases(task: SweepTask) -> String {
     names.join(", ")
 }
 
-/// Parses one `--param NAME=VALUES` for `task`.
-pub fn parse_axis(task: SweepTask, text: &str) -> Result<Axis> {
+/// Parses one `--param NAME=VALUES` for `task`. Errors name it as `names`
+/// does.
+pub fn parse_axis(task: SweepTask, text: &str, names: &InputNames) -> Result<Axis> {
+    let flag = names.param;
     let (name, values) = text.split_once('=').ok_or_else(|| {
         SimError::Sweep(format!(
-            "--param {text:?} is invalid: expected NAME=VALUES, e.g. tau=0.1:0.5:0.1 or \
+            "{flag} {text:?} is invalid: expected NAME=VALUES, e.g. tau=0.1:0.5:0.1 or \
              strategy=greedy,info_gain"
         ))
     })?;
@@ -330,7 +333,7 @@ pub fn parse_axis(task: SweepTask, text: &str) -> Result<Axis> {
         alias(task, name)
             .ok_or_else(|| {
                 SimError::Sweep(format!(
-                    "--param {name}: not a {task} scenario parameter; use one of {} or a \
+                    "{flag} {name}: not a {task} scenario parameter; use one of {} or a \
                      dotted path into the scenario file (e.g. control.tau)",
                     aliases(task)
                 ))
@@ -342,7 +345,8 @@ pub fn parse_axis(task: SweepTask, text: &str) -> Result<Axis> {
         "seed" | "task" | "user.accuracy" | "user.subject"
     ) {
         return Err(SimError::Sweep(format!(
-            "--param {name}: sweep the accuracy with --accuracy and set the seed with --seed"
+            "{flag} {name}: sweep the accuracy with {} and set the seed with {}",
+            names.accuracy, names.seed
         )));
     }
     if key.split('.').count() > errp_sim::MAX_KEY_PARTS
@@ -351,7 +355,7 @@ pub fn parse_axis(task: SweepTask, text: &str) -> Result<Axis> {
             .all(|p| !p.is_empty() && p.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_'))
     {
         return Err(SimError::Sweep(format!(
-            "--param {}: not a scenario field: a field is a dotted key of 1 to {} parts of \
+            "{flag} {}: not a scenario field: a field is a dotted key of 1 to {} parts of \
              letters, digits and _ (e.g. control.tau)",
             errp_sim::truncate(name, 60),
             errp_sim::MAX_KEY_PARTS
@@ -362,7 +366,7 @@ pub fn parse_axis(task: SweepTask, text: &str) -> Result<Axis> {
     Ok(Axis {
         name: name.to_string(),
         key,
-        values: parse_values(values, &format!("--param {name}"))?,
+        values: parse_values(values, &format!("{flag} {name}"))?,
     })
 }
 
@@ -382,8 +386,8 @@ pub const BUILT_IN_GRID: &str = include_str!("../../scenarios/grid_fixed_goals.t
 /// The built-in e-puck scenario.
 pub const BUILT_IN_EPUCK: &str = include_str!("../../scenarios/mexico_to_pisa.toml");
 
-/// How a caller names the inputs of [`sweep_scenario`] and [`sweep_fixed`]
-/// in its errors: `--task` on the command line, `task` in Python.
+/// How a caller names a sweep's inputs in its errors: `--task` on the
+/// command line, `task=` in Python.
 #[derive(Debug, Clone, Copy)]
 pub struct InputNames {
     /// The scenario file.
@@ -392,6 +396,27 @@ pub struct InputNames {
     pub task: &'static str,
     /// The grid's EEG mode.
     pub eeg: &'static str,
+    /// The accuracy levels.
+    pub accuracy: &'static str,
+    /// A swept parameter.
+    pub param: &'static str,
+    /// The episodes per level.
+    pub episodes: &'static str,
+    /// The sweep's seed.
+    pub seed: &'static str,
+}
+
+impl InputNames {
+    /// The command line's flags.
+    pub const CLI: InputNames = InputNames {
+        scenario: "--scenario",
+        task: "--task",
+        eeg: "--eeg",
+        accuracy: "--accuracy",
+        param: "--param",
+        episodes: "--episodes",
+        seed: "--seed",
+    };
 }
 
 /// The scenario a sweep runs: the file at `path` (its task checked against
@@ -533,15 +558,16 @@ impl SweepSpec {
     /// Checks the sweep's size and that no level is given twice: the
     /// episodes per level, the number of levels, and axes that are distinct
     /// parameters.
-    pub fn check(&self) -> Result<()> {
+    pub fn check(&self, names: &InputNames) -> Result<()> {
+        let (accuracy, param) = (names.accuracy, names.param);
         if !(1..=MAX_EPISODES).contains(&self.episodes) {
             return Err(SimError::Sweep(format!(
-                "--episodes {} is invalid: expected 1 to {MAX_EPISODES} episodes per level",
-                self.episodes
+                "{} {} is invalid: expected 1 to {MAX_EPISODES} episodes per level",
+                names.episodes, self.episodes
             )));
         }
         if self.accuracies.is_empty() {
-            return Err(SimError::Sweep("--accuracy gives no level".into()));
+            return Err(SimError::Sweep(format!("{accuracy} gives no level")));
         }
         let levels = self
             .axes
@@ -554,10 +580,10 @@ impl SweepSpec {
                 .collect();
             let n = levels.map_or("more than 2^64".into(), |n| n.to_string());
             let what = if self.axes.is_empty() {
-                format!("--accuracy gives {n} levels,")
+                format!("{accuracy} gives {n} levels,")
             } else {
                 format!(
-                    "{n} levels ({} accuracies x {} --param values) are",
+                    "{n} levels ({} accuracies x {} {param} values) are",
                     sizes[0],
                     sizes[1..].join(" x ")
                 )
@@ -572,14 +598,14 @@ impl SweepSpec {
                 .find(|b| b.name == a.name || b.key == a.key)
             {
                 return Err(SimError::Sweep(format!(
-                    "--param {} and --param {} both set {}: give one --param per field, with \
+                    "{param} {} and {param} {} both set {}: give one {param} per field, with \
                      all its values (e.g. tau=0.3,0.5)",
                     b.name, a.name, a.key
                 )));
             }
             if let Some(twice) = repeated(&a.values) {
                 return Err(SimError::Sweep(format!(
-                    "--param {}: {twice} is given twice (each value once)",
+                    "{param} {}: {twice} is given twice (each value once)",
                     a.name
                 )));
             }
@@ -592,7 +618,7 @@ impl SweepSpec {
                 .collect::<Vec<_>>(),
         ) {
             return Err(SimError::Sweep(format!(
-                "--accuracy: {twice} is given twice (each level once)"
+                "{accuracy}: {twice} is given twice (each level once)"
             )));
         }
         Ok(())
@@ -600,16 +626,17 @@ impl SweepSpec {
 
     /// Builds and checks every level once: the sweep as
     /// [`run_sweep`](crate::run_sweep) and
-    /// [`prepare_sweep`](crate::prepare_sweep) take it.
-    pub fn checked(self) -> Result<CheckedSweep> {
-        let levels = self.levels()?;
+    /// [`prepare_sweep`](crate::prepare_sweep) take it. Errors name the
+    /// inputs as `names` does.
+    pub fn checked(self, names: &InputNames) -> Result<CheckedSweep> {
+        let levels = self.levels(names)?;
         Ok(CheckedSweep { spec: self, levels })
     }
 
     /// Builds and validates every level's scenario. An invalid swept value
     /// is reported with the level and the scenario's own field error.
-    pub(crate) fn levels(&self) -> Result<Vec<Level>> {
-        self.check()?;
+    pub(crate) fn levels(&self, names: &InputNames) -> Result<Vec<Level>> {
+        self.check(names)?;
         // The file's own errors quote its lines.
         let _: Table = parse_toml(&self.scenario_toml, &self.scenario_path)?;
         (0..self.n_levels())
@@ -685,36 +712,40 @@ mod tests {
             let e = parse_values(text, "--accuracy").unwrap_err().to_string();
             assert!(e.contains(needle), "{text}: {e}");
         }
-        let e = parse_accuracies("1.7").unwrap_err().to_string();
+        let e = parse_accuracies("1.7", &InputNames::CLI)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("1.7") && e.contains("(0.5, 1)"), "{e}");
-        assert!(parse_accuracies("0.5").is_err());
-        assert!(parse_accuracies("NaN").is_err());
+        assert!(parse_accuracies("0.5", &InputNames::CLI).is_err());
+        assert!(parse_accuracies("NaN", &InputNames::CLI).is_err());
     }
 
     #[test]
     fn params_resolve_short_names_and_refuse_the_accuracy() {
-        let a = parse_axis(SweepTask::Grid, "tau=0.1:0.3:0.1").unwrap();
+        let a = parse_axis(SweepTask::Grid, "tau=0.1:0.3:0.1", &InputNames::CLI).unwrap();
         assert_eq!(a.key, "control.tau");
         assert_eq!(a.values.len(), 3);
         assert_eq!(
-            parse_axis(SweepTask::Epuck, "t_e=0.7,0.8").unwrap().key,
+            parse_axis(SweepTask::Epuck, "t_e=0.7,0.8", &InputNames::CLI)
+                .unwrap()
+                .key,
             "control.t_e"
         );
         assert_eq!(
-            parse_axis(SweepTask::Grid, "timing.max_actions=50")
+            parse_axis(SweepTask::Grid, "timing.max_actions=50", &InputNames::CLI)
                 .unwrap()
                 .key,
             "timing.max_actions"
         );
-        let e = parse_axis(SweepTask::Grid, "t_e=0.8")
+        let e = parse_axis(SweepTask::Grid, "t_e=0.8", &InputNames::CLI)
             .unwrap_err()
             .to_string();
         assert!(
             e.contains("not a grid scenario parameter") && e.contains("tau"),
             "{e}"
         );
-        assert!(parse_axis(SweepTask::Grid, "user.accuracy=0.7").is_err());
-        assert!(parse_axis(SweepTask::Grid, "tau").is_err());
+        assert!(parse_axis(SweepTask::Grid, "user.accuracy=0.7", &InputNames::CLI).is_err());
+        assert!(parse_axis(SweepTask::Grid, "tau", &InputNames::CLI).is_err());
     }
 
     #[test]
@@ -738,12 +769,12 @@ mod tests {
             if let Err(e) = parse_values(&text, "--param x") {
                 proptest::prop_assert!(e.to_string().contains("--param x"));
             }
-            match parse_accuracies(&text) {
+            match parse_accuracies(&text, &InputNames::CLI) {
                 Ok(v) => proptest::prop_assert!(v.iter().all(|a| *a > 0.5 && *a <= 1.0) && v.len() <= 10_000),
                 Err(e) => proptest::prop_assert!(e.to_string().contains("--accuracy")),
             }
             for task in [SweepTask::Grid, SweepTask::Epuck] {
-                if let Err(e) = parse_axis(task, &text) {
+                if let Err(e) = parse_axis(task, &text, &InputNames::CLI) {
                     proptest::prop_assert!(e.to_string().contains("--param"), "{}", e);
                 }
             }
@@ -767,7 +798,7 @@ mod tests {
             episodes: 1,
             seed: 7,
         };
-        let levels = spec.levels().unwrap();
+        let levels = spec.levels(&InputNames::CLI).unwrap();
         let AnyScenario::Epuck(s) = &levels[0].scenario else {
             panic!("an e-puck scenario")
         };
@@ -782,7 +813,7 @@ mod tests {
             scenario_path: "x.toml".into(),
             scenario_toml: String::new(),
             accuracies: vec![0.6, 0.8],
-            axes: vec![parse_axis(SweepTask::Grid, "tau=0.1,0.3,0.5").unwrap()],
+            axes: vec![parse_axis(SweepTask::Grid, "tau=0.1,0.3,0.5", &InputNames::CLI).unwrap()],
             fixed: vec![],
             episodes: 10,
             seed: 1,

@@ -17,7 +17,9 @@ Three uses:
   preprocessed EEG; :func:`run` and :func:`sweep` give the testbed's own
   results as pandas DataFrames with the columns of ``episodes.csv``.
 - **Your own agent**: Gymnasium environments in :mod:`errp.gym`
-  (``errp/Grid-v0``), whose feedback is the decoded ErrP.
+  (``errp/Grid-v0``, the 5x5 grid; ``errp/Epuck-v0``, the e-puck driven by
+  motion primitives), whose feedback is the decoded ErrP;
+  ``gym.make("errp/Grid-v0")`` works once the package is installed.
 
 Units: EEG in microvolts (MNE objects in volts), time in seconds, sampling
 rate in Hz. Seeds are explicit everywhere; the same seed gives the same
@@ -27,16 +29,20 @@ numbers as the ``errp`` program.
 from __future__ import annotations
 
 import io
+import numbers
 import os
 import shutil
 import tempfile
 from dataclasses import dataclass, field
-from typing import Any, Callable, Dict, Mapping, Optional, Sequence, Union
+from typing import TYPE_CHECKING, Any, Callable, Dict, Mapping, Optional, Sequence, Union
 
 import numpy as np
 
-from . import _core
-from ._core import HAS_RERUN, EegGenerator, __version__
+if TYPE_CHECKING:  # pragma: no cover - for the annotations only
+    import pandas
+
+from . import _args, _core, _gym_plugin
+from ._core import HAS_RERUN, __version__
 
 __all__ = [
     "EegGenerator",
@@ -74,6 +80,78 @@ def episode_columns(task: str) -> list:
     from ``success`` to ``online_accuracy``, as ``episodes.csv`` names
     them."""
     return list(_core.episode_columns(task))
+
+
+class EegGenerator:
+    """Streaming synthetic EEG: 34 EEG + 6 EOG channels at 256 Hz, in uV,
+    the generator of the testbed's sessions and closed loops.
+
+    Parameters
+    ----------
+    seed : int
+        Seed of the background, the artifacts and the potentials' jitter
+        (0 to 2^63 - 1).
+    errp_to_noise : float
+        Peak of the error-minus-correct difference at FCz over the SD of
+        the background there (>= 0); a session's ``errp_to_noise`` gives
+        its user.
+    params : dict, optional
+        Other fields of the EEG model by name (``background_uv``,
+        ``blink_rate_hz``, ...), checked as a scenario's.
+    """
+
+    def __init__(
+        self, seed: int = 0, errp_to_noise: float = 1.0, params: Optional[Mapping[str, Any]] = None
+    ) -> None:
+        self._core = _core.EegGenerator(
+            _args.seed("seed", seed),
+            _args.real("errp_to_noise", errp_to_noise, lo=0.0,
+                       what="an ErrP-to-noise ratio >= 0"),
+            None if params is None else dict(params),
+        )
+
+    def schedule(self, onset_secs: float, kind: str) -> None:
+        """Schedules the potential of an assessment, ``kind`` "error" or
+        "correct", with its time zero at ``onset_secs`` on the generator's
+        clock (s; it may lie in the past of the stream by up to the
+        potential's length, or in the future)."""
+        self._core.schedule(_args.real("onset_secs", onset_secs, lo=0.0, what="a time >= 0 (s)"),
+                            kind)
+
+    def generate(self, n_samples: int) -> np.ndarray:
+        """The next ``n_samples`` samples, ``(n_channels, n_samples)``
+        float64 in uV, rows in :attr:`ch_names` order (at most an hour per
+        call)."""
+        return self._core.generate(
+            _args.whole("n_samples", n_samples, 0, _core.MAX_GENERATE_SAMPLES))
+
+    @property
+    def ch_names(self) -> list:
+        """Channel names: the EEG channels, then the EOG ones."""
+        return list(self._core.ch_names)
+
+    @property
+    def ch_types(self) -> list:
+        """MNE channel types ("eeg", "eog")."""
+        return list(self._core.ch_types)
+
+    @property
+    def sfreq(self) -> float:
+        """Sampling rate (Hz)."""
+        return self._core.sfreq
+
+    @property
+    def now_secs(self) -> float:
+        """The generator's clock: seconds generated so far."""
+        return self._core.now_secs
+
+    @property
+    def errp_to_noise(self) -> float:
+        """The ErrP-to-noise ratio."""
+        return self._core.errp_to_noise
+
+    def __repr__(self) -> str:
+        return f"EegGenerator(errp_to_noise={self.errp_to_noise}, now_secs={self.now_secs})"
 
 
 @dataclass(frozen=True)
@@ -138,7 +216,10 @@ class Session:
 
     def to_mne(self):
         """The raw recording as an ``mne.io.RawArray`` (in volts) with one
-        annotation per action ("error" or "correct"). Needs MNE-Python."""
+        annotation per action ("error" or "correct") and the standard 10-05
+        montage on the EEG channels (MNE's template head: ``colin27_1005``,
+        ``standard_1005`` before MNE 1.12), so that topographic plots work.
+        The EOG channels have no position. Needs MNE-Python."""
         try:
             import mne
         except ImportError as e:  # pragma: no cover - depends on the environment
@@ -148,6 +229,9 @@ class Session:
             ) from e
         info = mne.create_info(list(self.ch_names), self.sfreq, list(self.ch_types))
         raw = mne.io.RawArray(self.data * 1e-6, info, verbose="error")
+        templates = mne.channels.get_builtin_montages()
+        name = "colin27_1005" if "colin27_1005" in templates else "standard_1005"
+        raw.set_montage(mne.channels.make_standard_montage(name), verbose="error")
         raw.set_annotations(
             mne.Annotations(
                 onset=self.onsets,
@@ -184,7 +268,9 @@ def simulate_session(accuracy: float = 0.7438, seed: int = 1) -> Session:
         The recording, its events, the preprocessed epochs and the
         targeting; ``session.to_mne()`` gives an ``mne.io.RawArray``.
     """
-    d = _core.simulate_session(accuracy, seed)
+    d = _core.simulate_session(
+        _args.accuracy("accuracy", accuracy, oracle=False), _args.seed("seed", seed)
+    )
     d["labels"] = np.asarray(d["labels"])
     return Session(**d)
 
@@ -197,7 +283,7 @@ def run(
     accuracy: Optional[float] = None,
     overrides: Optional[Mapping[str, Any]] = None,
     save: Optional[PathLike] = None,
-):
+) -> "pandas.DataFrame":
     """Runs a scenario as ``errp run`` does and returns one row per episode.
 
     Parameters
@@ -226,9 +312,9 @@ def run(
     """
     d = _core.run(
         _path(scenario),
-        seed=seed,
-        runs=runs,
-        accuracy=accuracy,
+        seed=_args.seed("seed", seed, optional=True),
+        runs=_args.whole("runs", runs, 1, _core.MAX_RUNS, optional=True),
+        accuracy=_args.accuracy("accuracy", accuracy, optional=True),
         overrides=None if overrides is None else dict(overrides),
         save=_path(save),
     )
@@ -447,12 +533,20 @@ def sweep(
     threads : int, optional
         Worker threads (all cores by default); results do not depend on it.
     """
+    episodes = _args.whole("episodes", episodes, 1, _core.MAX_EPISODES)
+    seed = _args.seed("seed", seed)
+    threads = _args.whole("threads", threads, 1, _core.MAX_THREADS, optional=True)
     if isinstance(accuracy, str):
         acc = accuracy
-    elif isinstance(accuracy, (int, float)):
-        acc = repr(float(accuracy))
+    elif isinstance(accuracy, numbers.Real) and not isinstance(accuracy, bool):
+        acc = repr(_args.accuracy("accuracy", accuracy))
+    elif isinstance(accuracy, (list, tuple, np.ndarray)) and len(accuracy) > 0:
+        acc = ",".join(repr(_args.accuracy(f"accuracy[{i}]", a)) for i, a in enumerate(accuracy))
     else:
-        acc = ",".join(repr(float(a)) for a in accuracy)
+        raise TypeError(
+            "accuracy must be a range such as \"0.6:0.9:0.05\", a number or a non-empty "
+            f"list of numbers, not {type(accuracy).__name__} {accuracy!r}"
+        )
     axes = None
     if params is not None:
         axes = []
@@ -588,12 +682,12 @@ class GridTask(_Task):
             _path(scenario),
             decoder=decoder,
             batch_decoder=batch_decoder,
-            seed=seed,
-            accuracy=accuracy,
+            seed=_args.seed("seed", seed, optional=True),
+            accuracy=_args.accuracy("accuracy", accuracy, optional=True),
             overrides=None if overrides is None else dict(overrides),
         )
 
-    def run(self, *, save: Optional[PathLike] = None):
+    def run(self, *, save: Optional[PathLike] = None) -> "pandas.DataFrame":
         """Runs every episode of the scenario and returns one row per
         episode (the columns of :func:`run`). With ``save``, the episodes
         (at most 5000) are recorded into that ``.rrd`` as ``errp run
@@ -638,16 +732,19 @@ class EpuckTask(_Task):
         self._core = _core.EpuckTask(
             _path(scenario),
             decoder=decoder,
-            seed=seed,
-            accuracy=accuracy,
+            seed=_args.seed("seed", seed, optional=True),
+            accuracy=_args.accuracy("accuracy", accuracy, optional=True),
             overrides=None if overrides is None else dict(overrides),
         )
 
-    def run(self, runs: Optional[int] = None, *, save: Optional[PathLike] = None):
+    def run(
+        self, runs: Optional[int] = None, *, save: Optional[PathLike] = None
+    ) -> "pandas.DataFrame":
         """Runs ``runs`` runs (the scenario's by default) and returns one row
         per run (the columns of :func:`run`). With ``save``, the runs (at
         most 100) are recorded into that ``.rrd`` as ``errp run --save``
         records them, with the decoder in the loop (yours, if given)."""
+        runs = _args.whole("runs", runs, 1, _core.MAX_RUNS, optional=True)
         df = _frame(self._core.run(runs, save=_path(save)))
         df.attrs["task"] = "epuck"
         df.attrs["decoder"] = self.calibration
@@ -657,3 +754,8 @@ class EpuckTask(_Task):
     def t_e(self) -> float:
         """The detection threshold your decoder's p(error) is compared with."""
         return self._core.t_e
+
+
+# Gymnasium 1.x has no entry points: register errp/Grid-v0 and errp/Epuck-v0
+# here (a no-op without Gymnasium; errp.gym is imported only by gym.make).
+_gym_plugin.register()

@@ -8,6 +8,14 @@ import numpy.typing as npt
 
 HAS_RERUN: bool
 __version__: str
+#: Most e-puck runs in one call (``errp run --runs``).
+MAX_RUNS: int
+#: Most episodes per sweep level (``errp sweep --episodes``).
+MAX_EPISODES: int
+#: Most worker threads.
+MAX_THREADS: int
+#: Most samples per :meth:`EegGenerator.generate` call (an hour at 256 Hz).
+MAX_GENERATE_SAMPLES: int
 
 def simulate_session(accuracy: float = 0.7438, seed: int = 1) -> Dict[str, Any]:
     """The calibration session of ``errp calibrate``: ``data`` (n_channels,

@@ -1,6 +1,8 @@
 """Gymnasium environments for learning from ErrP feedback.
 
-Importing this module registers:
+``gym.make("errp/Grid-v0")`` needs no import of this module: installing
+the package registers the environments with Gymnasium (its entry point for
+Gymnasium 0.29, ``import errp`` for Gymnasium 1.x). They are:
 
 - ``errp/Epuck-v0``: the e-puck of sec. 5, driven by motion primitives
   (see :class:`EpuckEnv`); its feedback is the p(error) of the
@@ -28,7 +30,6 @@ decode the EEG themselves (the scenario's EEG must be streamed: the default
 here).
 
     import gymnasium as gym
-    import errp.gym  # registers the environments
 
     env = gym.make("errp/Grid-v0", goal=(3, 1))
     obs, info = env.reset(seed=0)
@@ -52,7 +53,7 @@ except ImportError as e:  # pragma: no cover - depends on the environment
         "errp.gym needs Gymnasium: pip install gymnasium (or pip install './python[gym]')"
     ) from e
 
-from . import _core
+from . import _args, _core, _gym_plugin
 
 __all__ = ["ACTIONS", "EPUCK_ACTIONS", "EpuckEnv", "GridEnv"]
 
@@ -111,7 +112,7 @@ class GridEnv(gym.Env):
             fields.update(overrides)
         self._core = _core.GridEnvCore(
             None if scenario is None else os.fspath(scenario),
-            accuracy=accuracy,
+            accuracy=_args.accuracy("accuracy", accuracy, optional=True),
             overrides=fields,
             save=None if save is None else os.fspath(save),
         )
@@ -312,7 +313,7 @@ class EpuckEnv(gym.Env):
             )
         self._core = _core.EpuckEnvCore(
             None if scenario is None else os.fspath(scenario),
-            accuracy=accuracy,
+            accuracy=_args.accuracy("accuracy", accuracy, optional=True),
             overrides=None if overrides is None else dict(overrides),
             save=None if save is None else os.fspath(save),
         )
@@ -598,19 +599,4 @@ def _cell(name: str, c) -> Optional[Tuple[int, int]]:
     return (x, y)
 
 
-def _register() -> None:
-    if "errp/Grid-v0" not in gym.registry:
-        gym.register(
-            id="errp/Grid-v0",
-            entry_point="errp.gym:GridEnv",
-            max_episode_steps=100,
-        )
-    if "errp/Epuck-v0" not in gym.registry:
-        gym.register(
-            id="errp/Epuck-v0",
-            entry_point="errp.gym:EpuckEnv",
-            max_episode_steps=1200,
-        )
-
-
-_register()
+_gym_plugin.register()

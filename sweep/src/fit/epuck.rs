@@ -264,7 +264,7 @@ pub fn run_epuck_fit(
                 chunk: 0,
                 repair: false,
             };
-            match run_sweep(&sweep.checked()?, &opts, cancel, observer)? {
+            match run_sweep(&sweep.checked(&NAMES)?, &opts, cancel, observer)? {
                 SweepOutcome::Interrupted { .. } => return Ok(FitOutcome::Interrupted),
                 SweepOutcome::Complete { .. } => {}
             }
@@ -279,11 +279,7 @@ pub fn run_epuck_fit(
     Ok(FitOutcome::Complete(Box::new(fit), files))
 }
 
-const NAMES: InputNames = InputNames {
-    scenario: "--scenario",
-    task: "--task",
-    eeg: "--eeg",
-};
+const NAMES: InputNames = InputNames::CLI;
 
 /// The largest grid, runs per point and bootstrap replicates.
 pub const MAX_FIT_POINTS: usize = 200;

@@ -211,11 +211,7 @@ fn median_time_to_goal(rows: &[(bool, f64)]) -> f64 {
 fn the_median_time_to_pisa_does_not_rise_with_accuracy() {
     use errp_sweep::{Shard, SweepOptions, SweepSpec, SweepTask, run_sweep, sweep_fixed};
     let out = temp_dir("monotonic");
-    let names = errp_sweep::InputNames {
-        scenario: "--scenario",
-        task: "--task",
-        eeg: "--eeg",
-    };
+    let names = errp_sweep::InputNames::CLI;
     let spec = SweepSpec {
         task: SweepTask::Epuck,
         scenario_path: "scenarios/mexico_to_pisa.toml".into(),
@@ -234,7 +230,7 @@ fn the_median_time_to_pisa_does_not_rise_with_accuracy() {
         repair: false,
     };
     run_sweep(
-        &spec.checked().unwrap(),
+        &spec.checked(&names).unwrap(),
         &opts,
         &AtomicBool::new(false),
         &(),

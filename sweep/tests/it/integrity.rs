@@ -113,7 +113,7 @@ fn run(spec: &SweepSpec, out: &Path, shard: Shard, repair: bool) -> errp_sim::Re
     let mut opts = options(out, shard, 7);
     opts.repair = repair;
     run_sweep(
-        &spec.clone().checked()?,
+        &spec.clone().checked(&errp_sweep::InputNames::CLI)?,
         &opts,
         &AtomicBool::new(false),
         &(),

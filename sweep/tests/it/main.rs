@@ -13,8 +13,8 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
 use errp_sweep::{
-    Shard, SweepOptions, SweepOutcome, SweepSpec, SweepTask, TargetCache, parse_accuracies,
-    parse_axis, run_sweep,
+    InputNames, Shard, SweepOptions, SweepOutcome, SweepSpec, SweepTask, TargetCache,
+    parse_accuracies, parse_axis, run_sweep,
 };
 
 /// A grid scenario with the EEG decoder on a small epoch bank.
@@ -63,10 +63,10 @@ pub(crate) fn spec(text: &str, accuracy: &str, params: &[&str], episodes: usize)
         task: SweepTask::Grid,
         scenario_path: "test.toml".into(),
         scenario_toml: text.into(),
-        accuracies: parse_accuracies(accuracy).unwrap(),
+        accuracies: parse_accuracies(accuracy, &InputNames::CLI).unwrap(),
         axes: params
             .iter()
-            .map(|p| parse_axis(SweepTask::Grid, p).unwrap())
+            .map(|p| parse_axis(SweepTask::Grid, p, &InputNames::CLI).unwrap())
             .collect(),
         fixed: vec![],
         episodes,
@@ -92,7 +92,7 @@ pub(crate) fn complete(spec: &SweepSpec, out: &Path, shard: Shard, threads: usiz
         .unwrap();
     let outcome = pool
         .install(|| {
-            let sweep = spec.clone().checked().unwrap();
+            let sweep = spec.clone().checked(&InputNames::CLI).unwrap();
             run_sweep(
                 &sweep,
                 &options(out, shard, 7),

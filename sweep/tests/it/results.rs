@@ -82,7 +82,7 @@ fn an_interrupted_or_crashed_sweep_resumes_to_the_same_files() {
         after: 30,
         cancel: &cancel,
     };
-    let sweep = spec.clone().checked().unwrap();
+    let sweep = spec.clone().checked(&errp_sweep::InputNames::CLI).unwrap();
     let outcome = run_sweep(&sweep, &options(&resumed, Shard::ALL, 7), &cancel, &stop).unwrap();
     let SweepOutcome::Interrupted { done, total } = outcome else {
         panic!("{outcome:?}")
@@ -123,7 +123,7 @@ fn an_interrupted_or_crashed_sweep_resumes_to_the_same_files() {
     // The same directory with other parameters is refused, untouched.
     let other = spec_with_seed(&spec, 6);
     let e = run_sweep(
-        &other.checked().unwrap(),
+        &other.checked(&errp_sweep::InputNames::CLI).unwrap(),
         &options(&resumed, Shard::ALL, 7),
         &AtomicBool::new(false),
         &(),
@@ -194,7 +194,7 @@ fn a_sweep_calibrates_like_errp_run() {
     let out = temp_dir("same-calibration");
     complete(&spec, &out, Shard::ALL, 2);
     let manifest = Manifest::read(&out).unwrap();
-    let sweep = spec.checked().unwrap();
+    let sweep = spec.checked(&errp_sweep::InputNames::CLI).unwrap();
     for (level, info) in sweep.levels().iter().zip(&manifest.decoders) {
         let errp_sim::AnyScenario::Grid(scenario) = &level.scenario else {
             panic!("a grid level");

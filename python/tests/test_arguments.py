@@ -1,0 +1,81 @@
+"""Every whole-number and real argument of the public functions, given a
+bad value, raises ValueError or TypeError naming the argument; none raises
+OverflowError or speaks in the command line's syntax (``--seed``). The bad
+values are drawn for each argument's kind: negative, too large for 64 bits,
+of the wrong type, not finite."""
+
+import math
+import re
+
+import numpy as np
+import pytest
+
+import errp
+
+WHOLE = [-1, -(2**70), 2**64, 2**200, 1.5, 2.0, "3", True, None, float("nan"), [1], np.float64(1.0)]
+REAL = [float("nan"), float("inf"), -float("inf"), "0.8", True, [0.8], object()]
+SWEEP_TEXT = ["2.0", "0.4:0.9:0.1", "abc", "0.9:0.6:0.1", ""]
+
+
+def calls():
+    """(label, argument name, bad value, call) for every case."""
+    cases = []
+
+    def add(label, name, values, f, optional=False):
+        for v in values:
+            if optional and v is None:
+                continue
+            cases.append((label, name, v, f))
+
+    add("simulate_session", "seed", WHOLE, lambda v: errp.simulate_session(seed=v))
+    add("simulate_session", "accuracy", REAL + [None], lambda v: errp.simulate_session(accuracy=v))
+    add("run", "seed", WHOLE, lambda v: errp.run(seed=v), optional=True)
+    add("run", "runs", WHOLE + [0, 10**6], lambda v: errp.run(runs=v), optional=True)
+    add("run", "accuracy", REAL, lambda v: errp.run(accuracy=v))
+    sweep = dict(task="grid", accuracy=0.7, episodes=2)
+    add("sweep", "episodes", WHOLE + [0, 10**7],
+        lambda v: errp.sweep(**{**sweep, "episodes": v}))
+    add("sweep", "seed", WHOLE, lambda v: errp.sweep(**{**sweep, "seed": v}))
+    add("sweep", "threads", WHOLE + [0, 5000],
+        lambda v: errp.sweep(**{**sweep, "threads": v}), optional=True)
+    # A sweep's accuracy may be text: a range or a list ("0.6:0.9:0.05").
+    numbers = [v for v in REAL if not isinstance(v, (str, list))]
+    add("sweep", "accuracy", numbers + SWEEP_TEXT + [[], [0.7, "x"], [0.7, 2.0]],
+        lambda v: errp.sweep(**{**sweep, "accuracy": v}))
+    add("GridTask", "seed", WHOLE, lambda v: errp.GridTask(seed=v), optional=True)
+    add("GridTask", "accuracy", REAL, lambda v: errp.GridTask(accuracy=v))
+    add("EpuckTask", "seed", WHOLE, lambda v: errp.EpuckTask(seed=v), optional=True)
+    add("EpuckTask", "accuracy", REAL, lambda v: errp.EpuckTask(accuracy=v))
+    add("EegGenerator", "seed", WHOLE, lambda v: errp.EegGenerator(seed=v))
+    add("EegGenerator", "errp_to_noise", REAL + [-1.0, None],
+        lambda v: errp.EegGenerator(errp_to_noise=v))
+    gen = errp.EegGenerator(seed=1)
+    add("EegGenerator.generate", "n_samples", WHOLE + [10**9], gen.generate)
+    add("EegGenerator.schedule", "onset_secs", REAL + [-1.0, None],
+        lambda v: gen.schedule(v, "error"))
+    return cases
+
+
+CASES = calls()
+
+
+@pytest.mark.parametrize(
+    "label,name,value,call", CASES, ids=[f"{c[0]}-{c[1]}-{c[2]!r}"[:60] for c in CASES]
+)
+def test_a_bad_argument_is_named(label, name, value, call):
+    with pytest.raises((ValueError, TypeError)) as info:
+        call(value)
+    assert not isinstance(info.value, OverflowError)
+    message = str(info.value)
+    assert re.search(rf"\b{re.escape(name)}\b", message), f"{label}: {message}"
+    assert not re.search(r"(^|\s)--[a-z]", message), f"{label} speaks CLI: {message}"
+
+
+def test_the_bad_values_cover_every_kind():
+    # Negative, beyond 64 bits, fractional, text, bool and non-finite all
+    # appear for the whole-number arguments; a wrong implementation that
+    # let any through to the core would raise OverflowError above.
+    kinds = {type(v).__name__ for v in WHOLE}
+    assert {"int", "float", "str", "bool"} <= kinds
+    assert any(isinstance(v, int) and v >= 2**64 for v in WHOLE)
+    assert any(isinstance(v, float) and math.isnan(v) for v in REAL)
