@@ -40,6 +40,9 @@ pub enum BciError {
     /// Writing an export file failed.
     #[error("I/O error: {0}")]
     Io(#[from] std::io::Error),
+    /// Stopped on request (the `stop` module) before the work was done.
+    #[error("stopped on request (interrupted)")]
+    Interrupted,
 }
 
 /// Shorthand for results in this crate.

@@ -44,6 +44,7 @@ mod preprocess;
 mod psd;
 pub mod rng;
 mod smo;
+pub mod stop;
 mod subjects;
 mod svm;
 

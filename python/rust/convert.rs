@@ -10,7 +10,7 @@ use errp_sim::grid::GridScenario;
 use errp_sim::{AnyScenario, SimError};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray2};
-use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyValueError};
+use pyo3::exceptions::{PyFileNotFoundError, PyKeyboardInterrupt, PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyString};
 
@@ -23,6 +23,7 @@ pub(crate) fn py_err(e: SimError) -> PyErr {
         SimError::Input { .. } | SimError::Output { .. } | SimError::Record { .. } => {
             PyOSError::new_err(text)
         }
+        SimError::Bci(errp_bci::BciError::Interrupted) => PyKeyboardInterrupt::new_err(text),
         _ => PyValueError::new_err(text),
     }
 }

@@ -21,6 +21,7 @@ use pyo3::types::PyDict;
 use crate::convert::{
     Keys, block_to_numpy, load_any_text, load_epuck, load_grid, py_err, value_error,
 };
+use crate::interrupt::long;
 use crate::run::check_save;
 
 /// The most episodes a grid environment records (as `errp run --save`).
@@ -181,7 +182,7 @@ impl GridEnvCore {
         let decoder = match cached(&GRID_DECODERS, &key) {
             Some(d) => d,
             None => {
-                let (d, _) = py.detach(|| prepare_decoder(&s, |_| {})).map_err(py_err)?;
+                let (d, _) = long(py, || prepare_decoder(&s, |_| {}))?.map_err(py_err)?;
                 keep(&GRID_DECODERS, key, Arc::new(d))
             }
         };
@@ -402,9 +403,8 @@ impl EpuckEnvCore {
         let decoder = match cached(&EPUCK_DECODERS, &key) {
             Some(d) => d,
             None => {
-                let (d, _) = py
-                    .detach(|| prepare_continuous_decoder(&s, |_| {}))
-                    .map_err(py_err)?;
+                let (d, _) =
+                    long(py, || prepare_continuous_decoder(&s, |_| {}))?.map_err(py_err)?;
                 keep(&EPUCK_DECODERS, key, Arc::new(d))
             }
         };

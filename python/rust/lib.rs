@@ -13,6 +13,7 @@ mod convert;
 mod env;
 #[cfg(feature = "rerun")]
 mod inspect;
+mod interrupt;
 mod run;
 mod session;
 mod tasks;

@@ -2,7 +2,7 @@
 //! them, and Monte Carlo sweeps as `errp sweep` writes them.
 
 use std::path::PathBuf;
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use errp_bci::rng::derive_seed;
 use errp_sim::AnyScenario;
@@ -21,6 +21,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::{Keys, load_any, load_any_text, py_err, value_error};
+use crate::interrupt::{long, long_or};
 
 /// Most worker threads of a sweep.
 pub(crate) const MAX_THREADS: usize = 1024;
@@ -153,9 +154,7 @@ pub(crate) fn run<'py>(
     let out = PyDict::new(py);
     match any {
         AnyScenario::Grid(s) => {
-            let (csv, info) = py
-                .detach(|| run_grid(&s, save.as_ref(), text))
-                .map_err(py_err)?;
+            let (csv, info) = long(py, || run_grid(&s, save.as_ref(), text))?.map_err(py_err)?;
             out.set_item("task", "grid")?;
             out.set_item("csv", csv)?;
             out.set_item("decoder", info)?;
@@ -168,9 +167,7 @@ pub(crate) fn run<'py>(
                     "at most 100 with save= (each run adds about 2.5 MB to the recording)",
                 ));
             }
-            let (csv, info) = py
-                .detach(|| run_epuck(&s, save.as_ref(), text))
-                .map_err(py_err)?;
+            let (csv, info) = long(py, || run_epuck(&s, save.as_ref(), text))?.map_err(py_err)?;
             out.set_item("task", "epuck")?;
             out.set_item("csv", csv)?;
             out.set_item("decoder", info)?;
@@ -418,9 +415,14 @@ pub(crate) fn sweep<'py>(
         .num_threads(threads)
         .build()
         .map_err(|e| PyValueError::new_err(format!("threads: cannot start them: {e}")))?;
-    let outcome = py
-        .detach(|| pool.install(|| errp_sweep::run_sweep(&sweep, &opts, &cancel, &())))
-        .map_err(py_err)?;
+    // Ctrl-C also sets the sweep's own flag: the rows written so far are
+    // kept, and the same call later resumes.
+    let outcome = long_or(
+        py,
+        || cancel.store(true, Ordering::SeqCst),
+        || pool.install(|| errp_sweep::run_sweep(&sweep, &opts, &cancel, &())),
+    )?
+    .map_err(py_err)?;
     match outcome {
         SweepOutcome::Interrupted { .. } => {
             Err(PyKeyboardInterrupt::new_err("the sweep was interrupted"))

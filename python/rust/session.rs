@@ -15,6 +15,7 @@ use pyo3::types::PyDict;
 use crate::convert::{
     block_to_numpy, blocks_to_array3, channel_names, py_err, toml_value, value_error,
 };
+use crate::interrupt::long;
 
 /// The most samples one `generate` call returns: an hour at 256 Hz.
 pub(crate) const MAX_GENERATE_SAMPLES: usize = 3600 * 256;
@@ -32,24 +33,23 @@ pub(crate) fn simulate_session<'py>(
     seed: u64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let accuracy = MeanAccuracy::new(accuracy).map_err(|e| py_err(e.into()))?;
-    let (report, raw, events) = py
-        .detach(|| {
-            let request = CalibrationRequest::new(accuracy, seed);
-            let mut blocks: Vec<EegBlock> = Vec::new();
-            let mut events: Vec<Assessment> = Vec::new();
-            let mut sink = |block: &EegBlock, now: &[Assessment]| -> errp_bci::Result<()> {
-                blocks.push(block.clone());
-                events.extend_from_slice(now);
-                Ok(())
-            };
-            let options = SessionOptions {
-                raw_sink: Some(&mut sink),
-                ..SessionOptions::default()
-            };
-            let report = run_calibration(&request, |_| {}, options)?;
-            Ok::<_, errp_sim::SimError>((report, EegBlock::concat(&blocks), events))
-        })
-        .map_err(py_err)?;
+    let (report, raw, events) = long(py, || {
+        let request = CalibrationRequest::new(accuracy, seed);
+        let mut blocks: Vec<EegBlock> = Vec::new();
+        let mut events: Vec<Assessment> = Vec::new();
+        let mut sink = |block: &EegBlock, now: &[Assessment]| -> errp_bci::Result<()> {
+            blocks.push(block.clone());
+            events.extend_from_slice(now);
+            Ok(())
+        };
+        let options = SessionOptions {
+            raw_sink: Some(&mut sink),
+            ..SessionOptions::default()
+        };
+        let report = run_calibration(&request, |_| {}, options)?;
+        Ok::<_, errp_sim::SimError>((report, EegBlock::concat(&blocks), events))
+    })?
+    .map_err(py_err)?;
 
     let montage = Montage::standard();
     let fs = report.generator.sfreq_hz;

@@ -26,6 +26,7 @@ use crate::convert::{
     Keys, PyDecoder, blocks_to_array3, channel_names, check_callable, load_any_text, load_epuck,
     load_grid, py_err, value_error,
 };
+use crate::interrupt::long;
 use crate::run::{
     DecoderSummary, check_save, epuck_summary, grid_summary, header, line, summary_dict,
 };
@@ -100,7 +101,7 @@ impl GridTask {
                 "decoder and batch_decoder: give one of them, not both",
             ));
         }
-        let (builtin, calibration) = py.detach(|| prepare_decoder(&s, |_| {})).map_err(py_err)?;
+        let (builtin, calibration) = long(py, || prepare_decoder(&s, |_| {}))?.map_err(py_err)?;
         let info = grid_summary(&s, calibration.as_ref());
         if (decoder.is_some() || batch_decoder.is_some()) && eeg_of(&builtin).is_none() {
             return Err(PyValueError::new_err(
@@ -154,26 +155,30 @@ impl GridTask {
             (Some(f), _) => {
                 let mut dec = PyDecoder::new(f.clone_ref(py));
                 let eeg = eeg_of(builtin).expect("checked: an EEG decoder");
-                let result = py.detach(|| {
+                let result = long(py, || {
                     let mut call = |b: &EegBlock| dec.call(b);
                     let decoding = GridDecoding::Epochs {
                         source: eeg.source(),
                         decode: &mut call,
                     };
                     run_grid_scenario_with(s, decoding, record, &mut push)
-                });
+                })?;
                 self.calls.fetch_add(dec.calls, Ordering::Relaxed);
                 result.map_err(|e| dec.error(e))?
             }
             (None, Some((error, correct))) => {
                 let decoding = GridDecoding::Scores { error, correct };
-                py.detach(|| run_grid_scenario_with(s, decoding, record, &mut push))
-                    .map_err(py_err)?
+                long(py, || {
+                    run_grid_scenario_with(s, decoding, record, &mut push)
+                })?
+                .map_err(py_err)?
             }
             (None, None) => {
                 let decoding = GridDecoding::Builtin(builtin);
-                py.detach(|| run_grid_scenario_with(s, decoding, record, &mut push))
-                    .map_err(py_err)?
+                long(py, || {
+                    run_grid_scenario_with(s, decoding, record, &mut push)
+                })?
+                .map_err(py_err)?
             }
         };
         #[cfg(feature = "rerun")]
@@ -246,9 +251,10 @@ impl GridTask {
     fn score_bank(&mut self, py: Python<'_>, f: Py<PyAny>) -> PyResult<()> {
         let eeg = eeg_of(&self.builtin).expect("checked: an EEG decoder");
         let s = &self.scenario;
-        let blocks = py
-            .detach(|| EpochBlocks::build(eeg.source(), &s.params, s.bank_per_class, s.seed))
-            .map_err(py_err)?;
+        let blocks = long(py, || {
+            EpochBlocks::build(eeg.source(), &s.params, s.bank_per_class, s.seed)
+        })?
+        .map_err(py_err)?;
         let all: Vec<&EegBlock> = blocks.error.iter().chain(&blocks.correct).collect();
         let x = blocks_to_array3(&all).into_pyarray(py);
         let out = f.bind(py).call1((x,))?;
@@ -319,9 +325,10 @@ impl EpuckTask {
         let text = load_any_text(scenario.clone(), true, keys, overrides)?;
         let s = load_epuck(scenario, keys, overrides, "errp.EpuckTask")?;
         check_callable(py, "decoder", decoder.as_ref())?;
-        let (builtin, report) = py
-            .detach(|| errp_sim::epuck::prepare_continuous_decoder(&s, |_| {}))
-            .map_err(py_err)?;
+        let (builtin, report) = long(py, || {
+            errp_sim::epuck::prepare_continuous_decoder(&s, |_| {})
+        })?
+        .map_err(py_err)?;
         let info = epuck_summary(&s, &builtin, &report);
         Ok(Self {
             scenario: s,
@@ -369,12 +376,13 @@ impl EpuckTask {
             let call = task_call("EpuckTask", self.decoder.is_some());
             let p = crate::run::provenance("epuck", &s.name, self.text.clone(), s.seed, &call);
             let results = match &self.decoder {
-                None => py
-                    .detach(|| errp_sim::epuck::record_epuck_runs_with(&file, s, d, &p, runs, None))
-                    .map_err(py_err)?,
+                None => long(py, || {
+                    errp_sim::epuck::record_epuck_runs_with(&file, s, d, &p, runs, None)
+                })?
+                .map_err(py_err)?,
                 Some(f) => {
                     let mut dec = PyDecoder::new(f.clone_ref(py));
-                    let result = py.detach(|| {
+                    let result = long(py, || {
                         let mut call = |b: &EegBlock| dec.call(b);
                         errp_sim::epuck::record_epuck_runs_with(
                             &file,
@@ -384,7 +392,7 @@ impl EpuckTask {
                             runs,
                             Some(&mut call),
                         )
-                    });
+                    })?;
                     self.calls.fetch_add(dec.calls, Ordering::Relaxed);
                     result.map_err(|e| dec.error(e))?
                 }
@@ -395,12 +403,13 @@ impl EpuckTask {
         #[cfg(not(feature = "rerun"))]
         let _ = &self.text;
         let results = match &self.decoder {
-            None => py.detach(|| run_epuck_batch(s, d, runs)).map_err(py_err)?,
+            None => long(py, || run_epuck_batch(s, d, runs))?.map_err(py_err)?,
             Some(f) => {
                 let mut dec = PyDecoder::new(f.clone_ref(py));
-                let result = py.detach(|| {
+                let result = long(py, || {
                     (0..runs)
                         .map(|k| {
+                            errp_bci::stop::check()?;
                             let mut call = |b: &EegBlock| dec.call(b);
                             run_epuck_episode_with(
                                 s,
@@ -411,7 +420,7 @@ impl EpuckTask {
                             )
                         })
                         .collect::<errp_sim::Result<Vec<_>>>()
-                });
+                })?;
                 self.calls.fetch_add(dec.calls, Ordering::Relaxed);
                 result.map_err(|e| dec.error(e))?
             }

@@ -235,6 +235,7 @@ pub fn simulate_session_with(
     let mut done = 0;
     let mut next_event = 0;
     while done < total {
+        crate::stop::check()?;
         let n = block_len.min(total - done);
         let raw = generator.generate(n);
         if let Some(sink) = options.raw_sink.as_mut() {

@@ -359,6 +359,7 @@ pub fn search_ratio(
     let requested = requested.get();
     let mut steps: Vec<TargetingStep> = Vec::new();
     let mut evaluate = |ratio: f64, steps: &mut Vec<TargetingStep>| -> Result<f64> {
+        crate::stop::check()?;
         let accuracy = evaluate(ratio)?;
         let step = TargetingStep { ratio, accuracy };
         progress(&step);

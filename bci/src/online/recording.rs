@@ -127,7 +127,11 @@ pub fn record_online(
     }
     let n = (params.duration_secs / WINDOW_STEP_SECS).round() as usize;
     let mut p_error = Vec::with_capacity(n);
-    for _ in 0..n {
+    for k in 0..n {
+        // A second of EEG (16 windows) between checks.
+        if k % 16 == 0 {
+            crate::stop::check()?;
+        }
         window.advance();
         p_error.push(window.p_error(model));
     }

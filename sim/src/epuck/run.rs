@@ -156,7 +156,10 @@ pub fn run_epuck_batch(
 ) -> Result<Vec<EpuckEpisodeResult>> {
     (0..runs)
         .into_par_iter()
-        .map(|k| run_epuck_once(scenario, decoder, k, &mut ()))
+        .map(|k| {
+            errp_bci::stop::check()?;
+            run_epuck_once(scenario, decoder, k, &mut ())
+        })
         .collect()
 }
 

@@ -583,6 +583,7 @@ pub fn record_epuck_runs_with(
     let mut recorder = EpuckRecorder::new(file, &scenario.arena, layout, t_e)?;
     let mut out = Vec::with_capacity(runs);
     for k in 0..runs {
+        errp_bci::stop::check()?;
         let seed = crate::epuck::epuck_run_seed(scenario.seed, k);
         recorder.next_run(
             &format!("run {}: the user wants {goal} ({decoder_text})", k + 1),

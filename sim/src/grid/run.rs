@@ -394,6 +394,7 @@ pub fn run_grid_scenario_with(
     )?;
     let mut out = Vec::with_capacity(scenario.episodes.len());
     for (k, &(start, goal)) in scenario.episodes.iter().enumerate() {
+        errp_bci::stop::check()?;
         let seed = derive_seed(scenario.seed, "grid/episode", k as u64);
         let r = run_grid_episode_with(
             start,
