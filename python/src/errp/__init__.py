@@ -105,8 +105,7 @@ class EegGenerator:
     ) -> None:
         self._core = _core.EegGenerator(
             _args.seed("seed", seed),
-            _args.real("errp_to_noise", errp_to_noise, lo=0.0,
-                       what="an ErrP-to-noise ratio >= 0"),
+            _args.real("errp_to_noise", errp_to_noise, what="an ErrP-to-noise ratio >= 0"),
             None if params is None else dict(params),
         )
 
@@ -115,8 +114,7 @@ class EegGenerator:
         "correct", with its time zero at ``onset_secs`` on the generator's
         clock (s; it may lie in the past of the stream by up to the
         potential's length, or in the future)."""
-        self._core.schedule(_args.real("onset_secs", onset_secs, lo=0.0, what="a time >= 0 (s)"),
-                            kind)
+        self._core.schedule(_args.real("onset_secs", onset_secs, what="a time >= 0 (s)"), kind)
 
     def generate(self, n_samples: int) -> np.ndarray:
         """The next ``n_samples`` samples, ``(n_channels, n_samples)``

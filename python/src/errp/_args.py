@@ -40,16 +40,11 @@ def seed(name: str, value, *, optional: bool = False) -> Optional[int]:
 
 
 def real(
-    name: str,
-    value,
-    *,
-    optional: bool = False,
-    lo: float = -math.inf,
-    hi: float = math.inf,
-    what: str = "a finite number",
+    name: str, value, *, optional: bool = False, what: str = "a finite number"
 ) -> Optional[float]:
-    """``value`` as a finite ``float`` in ``[lo, hi]`` (``None`` passes if
-    ``optional``); ``bool`` and strings are refused."""
+    """``value`` as a finite ``float`` (``None`` passes if ``optional``);
+    ``bool`` and strings are refused. Its range is the core's to check
+    (``what`` only words the messages)."""
     if value is None:
         if optional:
             return None
@@ -57,7 +52,7 @@ def real(
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise TypeError(f"{name} must be {what}, not {type(value).__name__} {value!r}")
     v = float(value)
-    if not (math.isfinite(v) and lo <= v <= hi):
+    if not math.isfinite(v):
         raise ValueError(f"{name} = {v!r} is invalid: expected {what}")
     return v
 
