@@ -58,10 +58,10 @@ pub use calibration::targeting::{
     target_continuous_accuracy,
 };
 pub use calibration::{
-    Accuracy, Calibrated, CalibrationParams, CalibrationSession, CalibrationSetup, GrandAverage,
-    Protocol, RawSink, SessionOptions, Setup, TargetingParams, calibrate, calibrate_session,
-    cross_validate, cv_seed, eog_session, out_of_fold_decisions, schedule, simulate_session,
-    simulate_session_with,
+    Accuracy, Calibrated, CalibratedModel, CalibrationParams, CalibrationSession, CalibrationSetup,
+    GrandAverage, Protocol, RawSink, SessionOptions, Setup, TargetingParams, calibrate,
+    calibrate_features, calibrate_session, cross_validate, cv_seed, eog_session,
+    out_of_fold_decisions, schedule, simulate_session, simulate_session_with,
 };
 pub use classify::{Classifier, ErrorModel, Features, sigmoid, stratified_folds};
 pub use continuous::ContinuousFeatures;
@@ -85,4 +85,4 @@ pub use platt::PlattScaling;
 pub use preprocess::{PreprocessParams, Preprocessing, Preprocessor};
 pub use psd::ThetaPsd;
 pub use subjects::{GoalSet, Subject, subject, subjects};
-pub use svm::{SvmDecoder, SvmModel};
+pub use svm::{SvmDecoder, SvmModel, SvmParts};

@@ -118,6 +118,101 @@ impl SvmModel {
     pub fn iterations(&self) -> usize {
         self.iterations
     }
+
+    /// Mean of each feature over the training set (the z-scoring).
+    pub fn feature_means(&self) -> &[f64] {
+        &self.mean
+    }
+
+    /// 1 / SD of each feature over the training set (the z-scoring).
+    pub fn feature_inv_sds(&self) -> &[f64] {
+        &self.inv_sd
+    }
+
+    /// The support vectors, z-scored, `(n_support, n_features)` row-major.
+    pub fn support_vectors(&self) -> &[f32] {
+        &self.support
+    }
+
+    /// A model from its parts (those the accessors give), e.g. a model kept
+    /// outside the program. Every part is checked: one mean and one inverse
+    /// SD per feature, `n_support x n_features` support values, one
+    /// coefficient per support vector, everything finite, `gamma > 0`.
+    pub fn from_parts(parts: SvmParts) -> Result<Self> {
+        let SvmParts {
+            mean,
+            inv_sd,
+            gamma,
+            support,
+            coef,
+            bias,
+            platt,
+        } = parts;
+        let d = mean.len();
+        check(d > 0, "mean", d, "at least one feature")?;
+        check(
+            inv_sd.len() == d,
+            "inv_sd",
+            inv_sd.len(),
+            &format!("one value per feature ({d})"),
+        )?;
+        check(
+            support.len() == coef.len() * d,
+            "support",
+            support.len(),
+            &format!("n_support x n_features = {} x {d}", coef.len()),
+        )?;
+        let finite = mean
+            .iter()
+            .chain(&inv_sd)
+            .chain(&coef)
+            .all(|v| v.is_finite())
+            && support.iter().all(|v| v.is_finite())
+            && bias.is_finite()
+            && platt.a.is_finite()
+            && platt.b.is_finite();
+        check(finite, "model", "not finite", "finite numbers throughout")?;
+        check(
+            gamma.is_finite() && gamma > 0.0,
+            "gamma",
+            gamma,
+            "a finite width > 0",
+        )?;
+        let support_sq_norms = support
+            .chunks_exact(d)
+            .map(|sv| sv.iter().map(|&v| f64::from(v) * f64::from(v)).sum())
+            .collect();
+        Ok(Self {
+            mean,
+            inv_sd,
+            gamma,
+            support,
+            support_sq_norms,
+            coef,
+            bias,
+            platt,
+            iterations: 0,
+        })
+    }
+}
+
+/// The parts of an [`SvmModel`], for [`SvmModel::from_parts`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct SvmParts {
+    /// Mean of each feature.
+    pub mean: Vec<f64>,
+    /// 1 / SD of each feature.
+    pub inv_sd: Vec<f64>,
+    /// Kernel width on the z-scored features.
+    pub gamma: f64,
+    /// Support vectors, z-scored, `(n_support, n_features)` row-major.
+    pub support: Vec<f32>,
+    /// `alpha_i y_i` of each support vector.
+    pub coef: Vec<f64>,
+    /// The constant of the decision function.
+    pub bias: f64,
+    /// The Platt scaling of the decisions.
+    pub platt: PlattScaling,
 }
 
 impl ErrorModel for SvmModel {
@@ -328,6 +423,46 @@ mod tests {
                 m.decision(r)
             );
         }
+    }
+
+    #[test]
+    fn a_model_rebuilt_from_its_parts_decides_alike_and_bad_parts_are_named() {
+        let (x, labels) = blobs(30, 5, 1.5, 11);
+        let m = SvmDecoder::default().fit(&x, &labels, 4).unwrap();
+        let parts = SvmParts {
+            mean: m.feature_means().to_vec(),
+            inv_sd: m.feature_inv_sds().to_vec(),
+            gamma: m.gamma(),
+            support: m.support_vectors().to_vec(),
+            coef: m.dual_coefficients().to_vec(),
+            bias: m.bias(),
+            platt: m.platt(),
+        };
+        let back = SvmModel::from_parts(parts.clone()).unwrap();
+        for r in rows(&x) {
+            assert_eq!(back.decision(&r), m.decision(&r));
+            assert_eq!(back.p_error(&r), m.p_error(&r));
+        }
+        let bad = |p: SvmParts, name: &str| {
+            let e = SvmModel::from_parts(p).unwrap_err().to_string();
+            assert!(e.contains(name), "{e}");
+        };
+        let mut p = parts.clone();
+        p.support.pop();
+        bad(p, "support");
+        let mut p = parts.clone();
+        p.inv_sd.push(1.0);
+        bad(p, "inv_sd");
+        let mut p = parts.clone();
+        p.coef[0] = f64::NAN;
+        bad(p, "model");
+        bad(
+            SvmParts {
+                gamma: 0.0,
+                ..parts
+            },
+            "gamma",
+        );
     }
 
     #[test]

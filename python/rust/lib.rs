@@ -10,6 +10,7 @@
 //! by a decoder of the caller's own propagates unchanged.
 
 mod convert;
+mod decoders;
 mod env;
 #[cfg(feature = "rerun")]
 mod inspect;
@@ -29,6 +30,11 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run::episode_columns, m)?)?;
     #[cfg(feature = "rerun")]
     m.add_function(wrap_pyfunction!(inspect::read_recording, m)?)?;
+    m.add_function(wrap_pyfunction!(decoders::temporal_features, m)?)?;
+    m.add_function(wrap_pyfunction!(decoders::continuous_features, m)?)?;
+    m.add_function(wrap_pyfunction!(decoders::lda_fit, m)?)?;
+    m.add_function(wrap_pyfunction!(decoders::svm_fit, m)?)?;
+    m.add_function(wrap_pyfunction!(decoders::svm_decision, m)?)?;
     m.add_class::<session::EegGenerator>()?;
     m.add_class::<tasks::GridTask>()?;
     m.add_class::<tasks::EpuckTask>()?;
@@ -41,6 +47,9 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MAX_EPISODES", errp_sweep::MAX_EPISODES)?;
     m.add("MAX_THREADS", run::MAX_THREADS)?;
     m.add("MAX_GENERATE_SAMPLES", session::MAX_GENERATE_SAMPLES)?;
+    m.add("MAX_LDA_TRIALS", decoders::MAX_LDA_TRIALS)?;
+    m.add("MAX_LDA_FEATURES", decoders::MAX_LDA_FEATURES)?;
+    m.add("MAX_SVM_TRIALS", decoders::MAX_SVM_TRIALS)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -21,7 +21,18 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::{Keys, load_any, load_any_text, py_err, value_error};
-use crate::interrupt::{long, long_or};
+use crate::interrupt::{CALIBRATING, EPISODES, Meter, RUNS, long_or, long_shown};
+
+/// A sweep's progress: its decoders calibrated, then its episodes.
+impl errp_sweep::SweepObserver for Meter {
+    fn decoder_ready(&self, _info: &errp_sweep::DecoderInfo, done: usize, total: usize) {
+        self.set(CALIBRATING, done, total);
+    }
+
+    fn episodes_done(&self, done: usize, total: usize) {
+        self.set(EPISODES, done, total);
+    }
+}
 
 /// Most worker threads of a sweep.
 pub(crate) const MAX_THREADS: usize = 1024;
@@ -111,7 +122,8 @@ fn check_ours(path: &std::path::Path) -> PyResult<()> {
 /// results) and returns its episodes as CSV text, one row per episode, and
 /// what was calibrated.
 #[pyfunction]
-#[pyo3(signature = (scenario=None, *, seed=None, runs=None, accuracy=None, overrides=None, save=None))]
+#[pyo3(signature = (scenario=None, *, seed=None, runs=None, accuracy=None, overrides=None, save=None, progress=None))]
+#[allow(clippy::too_many_arguments)] // Python's keywords, one each
 pub(crate) fn run<'py>(
     py: Python<'py>,
     scenario: Option<PathBuf>,
@@ -120,6 +132,7 @@ pub(crate) fn run<'py>(
     accuracy: Option<f64>,
     overrides: Option<&Bound<'py, PyDict>>,
     save: Option<PathBuf>,
+    progress: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     check_save(save.as_ref())?;
     let keys = Keys {
@@ -154,7 +167,11 @@ pub(crate) fn run<'py>(
     let out = PyDict::new(py);
     match any {
         AnyScenario::Grid(s) => {
-            let (csv, info) = long(py, || run_grid(&s, save.as_ref(), text))?.map_err(py_err)?;
+            let meter = Meter::default();
+            let (csv, info) = long_shown(py, &meter, progress, || {
+                run_grid(&s, save.as_ref(), text, &meter)
+            })?
+            .map_err(py_err)?;
             out.set_item("task", "grid")?;
             out.set_item("csv", csv)?;
             out.set_item("decoder", info)?;
@@ -167,7 +184,11 @@ pub(crate) fn run<'py>(
                     "at most 100 with save= (each run adds about 2.5 MB to the recording)",
                 ));
             }
-            let (csv, info) = long(py, || run_epuck(&s, save.as_ref(), text))?.map_err(py_err)?;
+            let meter = Meter::default();
+            let (csv, info) = long_shown(py, &meter, progress, || {
+                run_epuck(&s, save.as_ref(), text, &meter)
+            })?
+            .map_err(py_err)?;
             out.set_item("task", "epuck")?;
             out.set_item("csv", csv)?;
             out.set_item("decoder", info)?;
@@ -252,6 +273,7 @@ fn run_grid(
     s: &GridScenario,
     save: Option<&PathBuf>,
     text: String,
+    meter: &Meter,
 ) -> errp_sim::Result<(String, DecoderSummary)> {
     #[cfg(feature = "rerun")]
     let rrd = match save {
@@ -260,8 +282,11 @@ fn run_grid(
     };
     #[cfg(not(feature = "rerun"))]
     let _ = (save, &text);
-    let (decoder, calibration) = prepare_decoder(s, |_| {})?;
-    let episodes = run_grid_scenario(s, &decoder, save.is_some(), |_, _| {})?;
+    let (decoder, calibration) = prepare_decoder(s, |_| meter.step(CALIBRATING, 0))?;
+    let n = s.episodes.len();
+    let episodes = run_grid_scenario(s, &decoder, save.is_some(), |k, _| {
+        meter.set(EPISODES, k + 1, n);
+    })?;
     let mut lines = vec![header(&GridTask::INFO)];
     for (k, r) in episodes.iter().enumerate() {
         let seed = derive_seed(s.seed, "grid/episode", k as u64);
@@ -285,6 +310,7 @@ fn run_epuck(
     s: &EpuckScenario,
     save: Option<&PathBuf>,
     text: String,
+    meter: &Meter,
 ) -> errp_sim::Result<(String, DecoderSummary)> {
     #[cfg(feature = "rerun")]
     let rrd = match save {
@@ -293,17 +319,30 @@ fn run_epuck(
     };
     #[cfg(not(feature = "rerun"))]
     let _ = (save, &text);
-    let (decoder, report) = errp_sim::epuck::prepare_continuous_decoder(s, |_| {})?;
+    let (decoder, report) = errp_sim::epuck::prepare_continuous_decoder_with(
+        s,
+        |_| meter.step(CALIBRATING, 0),
+        |_| meter.step(CALIBRATING, 0),
+    )?;
+    let one_more = || meter.step(RUNS, s.runs);
     #[cfg(feature = "rerun")]
     let results = match &rrd {
         Some(file) => {
             let p = provenance("epuck", &s.name, text, s.seed, "errp.run");
-            errp_sim::epuck::record_epuck_runs(file, s, &decoder, &p)?
+            errp_sim::epuck::record_epuck_runs_with(
+                file,
+                s,
+                &decoder,
+                &p,
+                s.runs,
+                None,
+                &mut |_| one_more(),
+            )?
         }
-        None => errp_sim::epuck::run_epuck_batch(s, &decoder, s.runs)?,
+        None => errp_sim::epuck::run_epuck_batch_counted(s, &decoder, s.runs, &one_more)?,
     };
     #[cfg(not(feature = "rerun"))]
-    let results = errp_sim::epuck::run_epuck_batch(s, &decoder, s.runs)?;
+    let results = errp_sim::epuck::run_epuck_batch_counted(s, &decoder, s.runs, &one_more)?;
     let mut lines = vec![header(&EpuckTask::INFO)];
     for (k, r) in results.iter().enumerate() {
         let seed = epuck_run_seed(s.seed, k);
@@ -337,10 +376,12 @@ pub(crate) struct SweepKeywords {
 /// the paths of its files. A rerun of the same sweep into the same
 /// directory resumes it.
 #[pyfunction]
+#[pyo3(signature = (out, keywords, progress=None))]
 pub(crate) fn sweep<'py>(
     py: Python<'py>,
     out: PathBuf,
     keywords: SweepKeywords,
+    progress: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let SweepKeywords {
         accuracy,
@@ -417,10 +458,12 @@ pub(crate) fn sweep<'py>(
         .map_err(|e| PyValueError::new_err(format!("threads: cannot start them: {e}")))?;
     // Ctrl-C also sets the sweep's own flag: the rows written so far are
     // kept, and the same call later resumes.
+    let meter = Meter::default();
     let outcome = long_or(
         py,
         || cancel.store(true, Ordering::SeqCst),
-        || pool.install(|| errp_sweep::run_sweep(&sweep, &opts, &cancel, &())),
+        progress.map(|p| (&meter, p)),
+        || pool.install(|| errp_sweep::run_sweep(&sweep, &opts, &cancel, &meter)),
     )?
     .map_err(py_err)?;
     match outcome {

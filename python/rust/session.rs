@@ -3,7 +3,7 @@
 
 use errp_bci::{
     Assessment, AssessmentKind, EegBlock, EpochWindow, GeneratorParams, MeanAccuracy, Montage,
-    SessionOptions,
+    SessionOptions, cv_seed, stratified_folds,
 };
 use errp_sim::calibration::{CalibrationRequest, run_calibration};
 use numpy::ndarray::Array1;
@@ -15,7 +15,7 @@ use pyo3::types::PyDict;
 use crate::convert::{
     block_to_numpy, blocks_to_array3, channel_names, py_err, toml_value, value_error,
 };
-use crate::interrupt::long;
+use crate::interrupt::{CALIBRATING, Meter, long_shown};
 
 /// The most samples one `generate` call returns: an hour at 256 Hz.
 pub(crate) const MAX_GENERATE_SAMPLES: usize = 3600 * 256;
@@ -26,15 +26,17 @@ pub(crate) const MAX_GENERATE_SAMPLES: usize = 3600 * 256;
 /// actions (20 % erroneous) at that ratio. Returns the raw recording (all 40
 /// channels, uV), its events, the preprocessed epochs and the targeting.
 #[pyfunction]
-#[pyo3(signature = (accuracy=0.7438, seed=1))]
+#[pyo3(signature = (accuracy=0.7438, seed=1, progress=None))]
 pub(crate) fn simulate_session<'py>(
     py: Python<'py>,
     accuracy: f64,
     seed: u64,
+    progress: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let accuracy = MeanAccuracy::new(accuracy).map_err(|e| py_err(e.into()))?;
-    let (report, raw, events) = long(py, || {
-        let request = CalibrationRequest::new(accuracy, seed);
+    let request = CalibrationRequest::new(accuracy, seed);
+    let meter = Meter::default();
+    let (report, raw, events) = long_shown(py, &meter, progress, || {
         let mut blocks: Vec<EegBlock> = Vec::new();
         let mut events: Vec<Assessment> = Vec::new();
         let mut sink = |block: &EegBlock, now: &[Assessment]| -> errp_bci::Result<()> {
@@ -46,7 +48,7 @@ pub(crate) fn simulate_session<'py>(
             raw_sink: Some(&mut sink),
             ..SessionOptions::default()
         };
-        let report = run_calibration(&request, |_| {}, options)?;
+        let report = run_calibration(&request, |_| meter.step(CALIBRATING, 0), options)?;
         Ok::<_, errp_sim::SimError>((report, EegBlock::concat(&blocks), events))
     })?
     .map_err(py_err)?;
@@ -125,6 +127,13 @@ pub(crate) fn simulate_session<'py>(
     d.set_item("cv_error", a.error)?;
     d.set_item("cv_mean", a.mean())?;
     d.set_item("seed", seed)?;
+    // The folds the session's accuracy was cross-validated on.
+    let labels = &session.labels;
+    let folds = stratified_folds(labels, request.setup.calibration.folds, cv_seed(seed));
+    d.set_item(
+        "cv_folds",
+        Array1::from_iter(folds.into_iter().map(|k| k as i64)).into_pyarray(py),
+    )?;
     Ok(d)
 }
 

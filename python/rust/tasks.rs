@@ -10,7 +10,7 @@ use errp_bci::EegBlock;
 use errp_bci::rng::derive_seed;
 use errp_sim::epuck::{
     ContinuousDecoder, EpuckScenario, EpuckTask as EpuckInfo, epuck_row, epuck_run_seed,
-    run_epuck_batch, run_epuck_episode_with,
+    run_epuck_batch_counted, run_epuck_episode_with,
 };
 use errp_sim::grid::{
     AssessmentDecoder, EegDecoder, EpochBlocks, GridDecoding, GridScenario, GridTask as GridInfo,
@@ -26,7 +26,7 @@ use crate::convert::{
     Keys, PyDecoder, blocks_to_array3, channel_names, check_callable, load_any_text, load_epuck,
     load_grid, py_err, value_error,
 };
-use crate::interrupt::long;
+use crate::interrupt::{CALIBRATING, EPISODES, Meter, RUNS, long, long_shown};
 use crate::run::{
     DecoderSummary, check_save, epuck_summary, grid_summary, header, line, summary_dict,
 };
@@ -77,7 +77,8 @@ impl GridTask {
     /// action's epoch) or `batch_decoder` (called once with a bank of
     /// epochs), a decoder of the caller's own replaces it in the loop.
     #[new]
-    #[pyo3(signature = (scenario=None, *, decoder=None, batch_decoder=None, seed=None, accuracy=None, overrides=None))]
+    #[pyo3(signature = (scenario=None, *, decoder=None, batch_decoder=None, seed=None, accuracy=None, overrides=None, progress=None))]
+    #[allow(clippy::too_many_arguments)] // Python's keywords, one each
     fn new(
         py: Python<'_>,
         scenario: Option<PathBuf>,
@@ -86,6 +87,7 @@ impl GridTask {
         seed: Option<u64>,
         accuracy: Option<f64>,
         overrides: Option<&Bound<'_, PyDict>>,
+        progress: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let keys = Keys {
             accuracy,
@@ -101,7 +103,11 @@ impl GridTask {
                 "decoder and batch_decoder: give one of them, not both",
             ));
         }
-        let (builtin, calibration) = long(py, || prepare_decoder(&s, |_| {}))?.map_err(py_err)?;
+        let meter = Meter::default();
+        let (builtin, calibration) = long_shown(py, &meter, progress, || {
+            prepare_decoder(&s, |_| meter.step(CALIBRATING, 0))
+        })?
+        .map_err(py_err)?;
         let info = grid_summary(&s, calibration.as_ref());
         if (decoder.is_some() || batch_decoder.is_some()) && eeg_of(&builtin).is_none() {
             return Err(PyValueError::new_err(
@@ -127,8 +133,13 @@ impl GridTask {
     /// Runs every episode of the scenario (episode k from the seed `errp
     /// run` gives it) and returns the rows as CSV text; with `save`, records
     /// them into that `.rrd` as `errp run --save` does.
-    #[pyo3(signature = (save=None))]
-    fn run(&self, py: Python<'_>, save: Option<PathBuf>) -> PyResult<String> {
+    #[pyo3(signature = (save=None, progress=None))]
+    fn run(
+        &self,
+        py: Python<'_>,
+        save: Option<PathBuf>,
+        progress: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<String> {
         check_save(save.as_ref())?;
         let s = &self.scenario;
         if save.is_some() && s.episodes.len() > MAX_SAVED_GRID_EPISODES {
@@ -147,15 +158,18 @@ impl GridTask {
         let record = save.is_some();
         let builtin = &self.builtin;
         let mut lines = vec![header(&GridInfo::INFO)];
+        let meter = Meter::default();
+        let n = s.episodes.len();
         let mut push = |k: usize, r: &errp_sim::grid::GridEpisodeResult| {
             let seed = derive_seed(s.seed, "grid/episode", k as u64);
             lines.push(line(s.accuracy, k, seed, grid_row(r)));
+            meter.set(EPISODES, k + 1, n);
         };
         let episodes = match (&self.decoder, &self.scores) {
             (Some(f), _) => {
                 let mut dec = PyDecoder::new(f.clone_ref(py));
                 let eeg = eeg_of(builtin).expect("checked: an EEG decoder");
-                let result = long(py, || {
+                let result = long_shown(py, &meter, progress, || {
                     let mut call = |b: &EegBlock| dec.call(b);
                     let decoding = GridDecoding::Epochs {
                         source: eeg.source(),
@@ -168,14 +182,14 @@ impl GridTask {
             }
             (None, Some((error, correct))) => {
                 let decoding = GridDecoding::Scores { error, correct };
-                long(py, || {
+                long_shown(py, &meter, progress, || {
                     run_grid_scenario_with(s, decoding, record, &mut push)
                 })?
                 .map_err(py_err)?
             }
             (None, None) => {
                 let decoding = GridDecoding::Builtin(builtin);
-                long(py, || {
+                long_shown(py, &meter, progress, || {
                     run_grid_scenario_with(s, decoding, record, &mut push)
                 })?
                 .map_err(py_err)?
@@ -273,7 +287,8 @@ impl GridTask {
                 &format!("{} p(error) values, one per epoch", all.len()),
             ));
         }
-        let p = p.as_slice()?.to_vec();
+        // Any 1-D array, a strided view (a column of predict_proba) too.
+        let p = p.as_array().to_vec();
         for (i, &v) in p.iter().enumerate() {
             if !(v.is_finite() && (0.0..=1.0).contains(&v)) {
                 return Err(value_error(
@@ -308,7 +323,7 @@ impl EpuckTask {
     /// Calibrates the scenario's continuous decoder; with `decoder`, a
     /// decoder of the caller's own replaces it in the loop.
     #[new]
-    #[pyo3(signature = (scenario=None, *, decoder=None, seed=None, accuracy=None, overrides=None))]
+    #[pyo3(signature = (scenario=None, *, decoder=None, seed=None, accuracy=None, overrides=None, progress=None))]
     fn new(
         py: Python<'_>,
         scenario: Option<PathBuf>,
@@ -316,6 +331,7 @@ impl EpuckTask {
         seed: Option<u64>,
         accuracy: Option<f64>,
         overrides: Option<&Bound<'_, PyDict>>,
+        progress: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let keys = Keys {
             accuracy,
@@ -325,8 +341,13 @@ impl EpuckTask {
         let text = load_any_text(scenario.clone(), true, keys, overrides)?;
         let s = load_epuck(scenario, keys, overrides, "errp.EpuckTask")?;
         check_callable(py, "decoder", decoder.as_ref())?;
-        let (builtin, report) = long(py, || {
-            errp_sim::epuck::prepare_continuous_decoder(&s, |_| {})
+        let meter = Meter::default();
+        let (builtin, report) = long_shown(py, &meter, progress, || {
+            errp_sim::epuck::prepare_continuous_decoder_with(
+                &s,
+                |_| meter.step(CALIBRATING, 0),
+                |_| meter.step(CALIBRATING, 0),
+            )
         })?
         .map_err(py_err)?;
         let info = epuck_summary(&s, &builtin, &report);
@@ -346,8 +367,14 @@ impl EpuckTask {
     /// runs them one after another. With `save` (at most 100 runs), the
     /// runs are recorded into that `.rrd` as `errp run --save` records
     /// them, one after another.
-    #[pyo3(signature = (runs=None, *, save=None))]
-    fn run(&self, py: Python<'_>, runs: Option<usize>, save: Option<PathBuf>) -> PyResult<String> {
+    #[pyo3(signature = (runs=None, *, save=None, progress=None))]
+    fn run(
+        &self,
+        py: Python<'_>,
+        runs: Option<usize>,
+        save: Option<PathBuf>,
+        progress: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<String> {
         check_save(save.as_ref())?;
         let max = errp_sim::epuck::MAX_RUNS as usize;
         let runs = runs.unwrap_or(self.scenario.runs);
@@ -370,19 +397,29 @@ impl EpuckTask {
         }
         let s = &self.scenario;
         let d = &self.builtin;
+        let meter = Meter::default();
+        let one_more = || meter.step(RUNS, runs);
         #[cfg(feature = "rerun")]
         if let Some(path) = &save {
             let file = errp_sim::epuck::epuck_recording(path).map_err(py_err)?;
             let call = task_call("EpuckTask", self.decoder.is_some());
             let p = crate::run::provenance("epuck", &s.name, self.text.clone(), s.seed, &call);
             let results = match &self.decoder {
-                None => long(py, || {
-                    errp_sim::epuck::record_epuck_runs_with(&file, s, d, &p, runs, None)
+                None => long_shown(py, &meter, progress, || {
+                    errp_sim::epuck::record_epuck_runs_with(
+                        &file,
+                        s,
+                        d,
+                        &p,
+                        runs,
+                        None,
+                        &mut |_| one_more(),
+                    )
                 })?
                 .map_err(py_err)?,
                 Some(f) => {
                     let mut dec = PyDecoder::new(f.clone_ref(py));
-                    let result = long(py, || {
+                    let result = long_shown(py, &meter, progress, || {
                         let mut call = |b: &EegBlock| dec.call(b);
                         errp_sim::epuck::record_epuck_runs_with(
                             &file,
@@ -391,6 +428,7 @@ impl EpuckTask {
                             &p,
                             runs,
                             Some(&mut call),
+                            &mut |_| one_more(),
                         )
                     })?;
                     self.calls.fetch_add(dec.calls, Ordering::Relaxed);
@@ -403,21 +441,26 @@ impl EpuckTask {
         #[cfg(not(feature = "rerun"))]
         let _ = &self.text;
         let results = match &self.decoder {
-            None => long(py, || run_epuck_batch(s, d, runs))?.map_err(py_err)?,
+            None => long_shown(py, &meter, progress, || {
+                run_epuck_batch_counted(s, d, runs, &one_more)
+            })?
+            .map_err(py_err)?,
             Some(f) => {
                 let mut dec = PyDecoder::new(f.clone_ref(py));
-                let result = long(py, || {
+                let result = long_shown(py, &meter, progress, || {
                     (0..runs)
                         .map(|k| {
                             errp_bci::stop::check()?;
                             let mut call = |b: &EegBlock| dec.call(b);
-                            run_epuck_episode_with(
+                            let r = run_epuck_episode_with(
                                 s,
                                 d,
                                 epuck_run_seed(s.seed, k),
                                 &mut (),
                                 Some(&mut call),
-                            )
+                            );
+                            one_more();
+                            r
                         })
                         .collect::<errp_sim::Result<Vec<_>>>()
                 })?;

@@ -53,6 +53,31 @@ def calls():
     add("EegGenerator.generate", "n_samples", WHOLE + [10**9], gen.generate)
     add("EegGenerator.schedule", "onset_secs", REAL + [-1.0, None],
         lambda v: gen.schedule(v, "error"))
+    # errp.decoders: scikit-learn's habit, parameters checked at fit.
+    try:
+        from errp import decoders as d
+    except ImportError:  # pragma: no cover - scikit-learn missing
+        return cases
+    rng = np.random.default_rng(0)
+    y = np.arange(40) % 2
+    x = rng.normal(size=(40, 4)) + y[:, None]
+    epochs = rng.normal(size=(4, 2, 210))
+    fit = lambda make: (lambda v: make(v).fit(x, y))  # noqa: E731
+    add("ShrinkageLDA", "pca_variance", REAL + [0.0, 1.5, -0.1, None],
+        fit(lambda v: d.ShrinkageLDA(pca_variance=v)))
+    add("ShrinkageLDA", "shrinkage", REAL + [-0.5, 1.5, None],
+        fit(lambda v: d.ShrinkageLDA(shrinkage=v)))
+    add("ShrinkageLDA", "cv", WHOLE + [1, 10**4],
+        fit(lambda v: d.ShrinkageLDA(probability="platt", cv=v)))
+    add("ShrinkageLDA", "random_state", WHOLE, fit(lambda v: d.ShrinkageLDA(random_state=v)),
+        optional=True)
+    add("RbfSVC", "C", REAL + [0.0, -1.0, None], fit(lambda v: d.RbfSVC(C=v)))
+    add("RbfSVC", "gamma", REAL + [0.0, -1.0, None], fit(lambda v: d.RbfSVC(gamma=v)))
+    add("RbfSVC", "tol", REAL + [0.0, -1.0, None], fit(lambda v: d.RbfSVC(tol=v)))
+    add("RbfSVC", "random_state", WHOLE, fit(lambda v: d.RbfSVC(random_state=v)), optional=True)
+    for cls in (d.TemporalFeatures, d.ContinuousFeatures):
+        add(cls.__name__, "sfreq", REAL + [0.0, 250.0, 2.0**70, None],
+            lambda v, cls=cls: cls(sfreq=v).fit_transform(epochs))
     return cases
 
 

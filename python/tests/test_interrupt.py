@@ -13,6 +13,7 @@ import pytest
 
 CALLS = {
     "run": "errp.run(runs=20000, seed=1)",
+    "run-progress": "errp.run(runs=20000, seed=1, progress=True)",
     "run-save": "errp.run(runs=100, seed=1, save='run.rrd')",
     "sweep": "errp.sweep('sweep', task='grid', accuracy='0.6:0.9:0.05', episodes=200000, seed=1)",
     "GridTask.run": "errp.GridTask(overrides={'repeats': 10000, 'eeg': 'stream'}).run()",

@@ -54,24 +54,51 @@ pub fn calibrate_session<C: Classifier>(
     folds: usize,
     seed: u64,
 ) -> Result<Calibrated<C::Model>> {
-    let decisions = out_of_fold_decisions(
-        classifier,
-        &session.features,
-        &session.labels,
-        folds,
-        cv_seed(seed),
-    )?;
-    let predicted: Vec<bool> = decisions.iter().map(|&d| d >= 0.0).collect();
-    let accuracy = Accuracy::score(&session.labels, &predicted);
-    let platt = PlattScaling::fit(&decisions, &session.labels)?
-        .balanced(accuracy.n_error, accuracy.n_correct);
-    let model = classifier.fit(
-        &session.features,
-        &session.labels,
-        derive_seed(seed, "calibration/fit", 0),
-    )?;
+    let CalibratedModel {
+        accuracy,
+        model,
+        platt,
+    } = calibrate_features(classifier, &session.features, &session.labels, folds, seed)?;
     Ok(Calibrated {
         session,
+        accuracy,
+        model,
+        platt,
+    })
+}
+
+/// A decoder trained as a calibration trains it, with its scores.
+#[derive(Debug, Clone)]
+pub struct CalibratedModel<M> {
+    /// k-fold cross-validated accuracy.
+    pub accuracy: Accuracy,
+    /// The decoder trained on every trial.
+    pub model: M,
+    /// Platt scaling fitted on the out-of-fold decisions, the training
+    /// set's class prior removed.
+    pub platt: PlattScaling,
+}
+
+/// What [`calibrate_session`] does with a session's features and labels,
+/// on any features: the out-of-fold decisions of a stratified
+/// `folds`-fold cross-validation (folds drawn from [`cv_seed`]`(seed)`)
+/// give the accuracy and the Platt scaling (class prior removed); the model
+/// is then trained on every trial. The same features and seed give the
+/// loop's very decoder.
+pub fn calibrate_features<C: Classifier>(
+    classifier: &C,
+    features: &Features,
+    labels: &[bool],
+    folds: usize,
+    seed: u64,
+) -> Result<CalibratedModel<C::Model>> {
+    let decisions = out_of_fold_decisions(classifier, features, labels, folds, cv_seed(seed))?;
+    let predicted: Vec<bool> = decisions.iter().map(|&d| d >= 0.0).collect();
+    let accuracy = Accuracy::score(labels, &predicted);
+    let platt =
+        PlattScaling::fit(&decisions, labels)?.balanced(accuracy.n_error, accuracy.n_correct);
+    let model = classifier.fit(features, labels, derive_seed(seed, "calibration/fit", 0))?;
+    Ok(CalibratedModel {
         accuracy,
         model,
         platt,

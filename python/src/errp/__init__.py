@@ -41,7 +41,7 @@ import numpy as np
 if TYPE_CHECKING:  # pragma: no cover - for the annotations only
     import pandas
 
-from . import _args, _core, _gym_plugin
+from . import _args, _core, _gym_plugin, _progress
 from ._core import HAS_RERUN, __version__
 
 __all__ = [
@@ -184,6 +184,10 @@ class Session:
     cv_correct, cv_error, cv_mean : float
         The testbed's decoder's cross-validated accuracy on this session
         (correct class, error class, their mean).
+    cv_folds : ndarray of int, shape (n_actions,)
+        The fold (0 to 9) each action was scored in by that
+        cross-validation: ``sklearn.model_selection.PredefinedSplit(
+        session.cv_folds)`` repeats it (see :mod:`errp.decoders`).
     seed : int
     """
 
@@ -200,6 +204,7 @@ class Session:
     cv_correct: float
     cv_error: float
     cv_mean: float
+    cv_folds: np.ndarray
     seed: int
 
     @property
@@ -245,7 +250,9 @@ class Session:
         return self.to_mne()
 
 
-def simulate_session(accuracy: float = 0.7438, seed: int = 1) -> Session:
+def simulate_session(
+    accuracy: float = 0.7438, seed: int = 1, *, progress: Optional[bool] = None
+) -> Session:
     """Simulates the discrete calibration session of ``errp calibrate
     --accuracy ACCURACY --seed SEED``: the ErrP-to-noise ratio is targeted
     so that the paper's decoder reaches ``accuracy`` (mean of the two
@@ -259,6 +266,9 @@ def simulate_session(accuracy: float = 0.7438, seed: int = 1) -> Session:
         0.7438 fixed goals, 0.7767 free goals).
     seed : int
         Seed of the synthetic user and the session (>= 0).
+    progress : bool, optional
+        Show progress on stderr (a tqdm bar if tqdm is installed, else a
+        line per tenth): by default when stderr is a terminal.
 
     Returns
     -------
@@ -266,9 +276,10 @@ def simulate_session(accuracy: float = 0.7438, seed: int = 1) -> Session:
         The recording, its events, the preprocessed epochs and the
         targeting; ``session.to_mne()`` gives an ``mne.io.RawArray``.
     """
-    d = _core.simulate_session(
-        _args.accuracy("accuracy", accuracy, oracle=False), _args.seed("seed", seed)
-    )
+    accuracy = _args.accuracy("accuracy", accuracy, oracle=False)
+    seed = _args.seed("seed", seed)
+    with _progress.shown(progress, "simulate_session") as report:
+        d = _core.simulate_session(accuracy, seed, progress=report)
     d["labels"] = np.asarray(d["labels"])
     return Session(**d)
 
@@ -281,6 +292,7 @@ def run(
     accuracy: Optional[float] = None,
     overrides: Optional[Mapping[str, Any]] = None,
     save: Optional[PathLike] = None,
+    progress: Optional[bool] = None,
 ) -> "pandas.DataFrame":
     """Runs a scenario as ``errp run`` does and returns one row per episode.
 
@@ -300,6 +312,9 @@ def run(
         are checked as the file's own.
     save : path, optional
         Records the run to this ``.rrd`` file, as ``errp run --save``.
+    progress : bool, optional
+        Show progress on stderr (a tqdm bar if tqdm is installed, else a
+        line per tenth): by default when stderr is a terminal.
 
     Returns
     -------
@@ -308,14 +323,15 @@ def run(
         ``episode``, ``seed``, ``success``, the task's columns and the
         online accuracy); ``df.attrs["decoder"]`` holds the calibration.
     """
-    d = _core.run(
-        _path(scenario),
+    keywords = dict(
         seed=_args.seed("seed", seed, optional=True),
         runs=_args.whole("runs", runs, 1, _core.MAX_RUNS, optional=True),
         accuracy=_args.accuracy("accuracy", accuracy, optional=True),
         overrides=None if overrides is None else dict(overrides),
         save=_path(save),
     )
+    with _progress.shown(progress, "errp.run") as report:
+        d = _core.run(_path(scenario), progress=report, **keywords)
     df = _frame(d["csv"])
     df.attrs["task"] = d["task"]
     df.attrs["decoder"] = dict(d["decoder"])
@@ -501,6 +517,7 @@ def sweep(
     stream: Optional[bool] = None,
     cache: Optional[PathLike] = None,
     threads: Optional[int] = None,
+    progress: Optional[bool] = None,
 ) -> SweepResult:
     """Runs a Monte Carlo sweep as ``errp sweep`` does.
 
@@ -530,6 +547,9 @@ def sweep(
         A directory for the accuracy targeting, shared across sweeps.
     threads : int, optional
         Worker threads (all cores by default); results do not depend on it.
+    progress : bool, optional
+        Show progress on stderr (the decoders calibrated, then the
+        episodes: tqdm bars if tqdm is installed, else a line per tenth): by default when stderr is a terminal.
     """
     episodes = _args.whole("episodes", episodes, 1, _core.MAX_EPISODES)
     seed = _args.seed("seed", seed)
@@ -559,20 +579,22 @@ def sweep(
     else:
         target = os.fspath(out)
     try:
-        d = _core.sweep(
-            target,
-            dict(
-                accuracy=acc,
-                task=task,
-                scenario=_path(scenario),
-                episodes=episodes,
-                seed=seed,
-                params=axes,
-                stream=stream,
-                cache=_path(cache),
-                threads=threads,
-            ),
-        )
+        with _progress.shown(progress, "errp.sweep") as report:
+            d = _core.sweep(
+                target,
+                dict(
+                    accuracy=acc,
+                    task=task,
+                    scenario=_path(scenario),
+                    episodes=episodes,
+                    seed=seed,
+                    params=axes,
+                    stream=stream,
+                    cache=_path(cache),
+                    threads=threads,
+                ),
+                progress=report,
+            )
         import pandas as pd
 
         result = SweepResult(
@@ -662,8 +684,8 @@ class GridTask(_Task):
         A grid scenario file; by default the built-in fixed-goals one
         (``scenarios/grid_fixed_goals.toml``, 74.38 %).
     decoder, batch_decoder : callable, optional
-    seed, accuracy, overrides :
-        As for :func:`run`.
+    seed, accuracy, overrides, progress :
+        As for :func:`run` (``progress`` shows the calibration's search).
     """
 
     def __init__(
@@ -675,23 +697,29 @@ class GridTask(_Task):
         seed: Optional[int] = None,
         accuracy: Optional[float] = None,
         overrides: Optional[Mapping[str, Any]] = None,
+        progress: Optional[bool] = None,
     ) -> None:
-        self._core = _core.GridTask(
-            _path(scenario),
+        keywords = dict(
             decoder=decoder,
             batch_decoder=batch_decoder,
             seed=_args.seed("seed", seed, optional=True),
             accuracy=_args.accuracy("accuracy", accuracy, optional=True),
             overrides=None if overrides is None else dict(overrides),
         )
+        with _progress.shown(progress, "errp.GridTask") as report:
+            self._core = _core.GridTask(_path(scenario), progress=report, **keywords)
 
-    def run(self, *, save: Optional[PathLike] = None) -> "pandas.DataFrame":
+    def run(
+        self, *, save: Optional[PathLike] = None, progress: Optional[bool] = None
+    ) -> "pandas.DataFrame":
         """Runs every episode of the scenario and returns one row per
         episode (the columns of :func:`run`). With ``save``, the episodes
         (at most 5000) are recorded into that ``.rrd`` as ``errp run
         --save`` records them, with the decoder in the loop (yours, if
-        given)."""
-        df = _frame(self._core.run(_path(save)))
+        given). ``progress`` as for :func:`run`."""
+        with _progress.shown(progress, "GridTask.run") as report:
+            csv = self._core.run(_path(save), progress=report)
+        df = _frame(csv)
         df.attrs["task"] = "grid"
         df.attrs["decoder"] = self.calibration
         return df
@@ -714,8 +742,8 @@ class EpuckTask(_Task):
     scenario : path, optional
         An e-puck scenario; by default the built-in Mexico-to-Pisa run.
     decoder : callable, optional
-    seed, accuracy, overrides :
-        As for :func:`run`.
+    seed, accuracy, overrides, progress :
+        As for :func:`run` (``progress`` shows the calibration's search).
     """
 
     def __init__(
@@ -726,24 +754,33 @@ class EpuckTask(_Task):
         seed: Optional[int] = None,
         accuracy: Optional[float] = None,
         overrides: Optional[Mapping[str, Any]] = None,
+        progress: Optional[bool] = None,
     ) -> None:
-        self._core = _core.EpuckTask(
-            _path(scenario),
+        keywords = dict(
             decoder=decoder,
             seed=_args.seed("seed", seed, optional=True),
             accuracy=_args.accuracy("accuracy", accuracy, optional=True),
             overrides=None if overrides is None else dict(overrides),
         )
+        with _progress.shown(progress, "errp.EpuckTask") as report:
+            self._core = _core.EpuckTask(_path(scenario), progress=report, **keywords)
 
     def run(
-        self, runs: Optional[int] = None, *, save: Optional[PathLike] = None
+        self,
+        runs: Optional[int] = None,
+        *,
+        save: Optional[PathLike] = None,
+        progress: Optional[bool] = None,
     ) -> "pandas.DataFrame":
         """Runs ``runs`` runs (the scenario's by default) and returns one row
         per run (the columns of :func:`run`). With ``save``, the runs (at
         most 100) are recorded into that ``.rrd`` as ``errp run --save``
-        records them, with the decoder in the loop (yours, if given)."""
+        records them, with the decoder in the loop (yours, if given).
+        ``progress`` as for :func:`run`."""
         runs = _args.whole("runs", runs, 1, _core.MAX_RUNS, optional=True)
-        df = _frame(self._core.run(runs, save=_path(save)))
+        with _progress.shown(progress, "EpuckTask.run") as report:
+            csv = self._core.run(runs, save=_path(save), progress=report)
+        df = _frame(csv)
         df.attrs["task"] = "epuck"
         df.attrs["decoder"] = self.calibration
         return df

@@ -16,13 +16,57 @@ MAX_EPISODES: int
 MAX_THREADS: int
 #: Most samples per :meth:`EegGenerator.generate` call (an hour at 256 Hz).
 MAX_GENERATE_SAMPLES: int
+#: What long calls report their progress to: ``progress(stage, done,
+#: total)``, ``total`` 0 when not known beforehand.
+Progress = Callable[[str, int, int], None]
+#: Most trials and features :func:`lda_fit` takes; most trials of :func:`svm_fit`.
+MAX_LDA_TRIALS: int
+MAX_LDA_FEATURES: int
+MAX_SVM_TRIALS: int
 
-def simulate_session(accuracy: float = 0.7438, seed: int = 1) -> Dict[str, Any]:
+def simulate_session(
+    accuracy: float = 0.7438, seed: int = 1, progress: Optional[Progress] = None
+) -> Dict[str, Any]:
     """The calibration session of ``errp calibrate``: ``data`` (n_channels,
     n_samples) uV, ``ch_names``, ``ch_types``, ``sfreq``, ``onsets`` (s),
     ``labels``, ``epochs`` (n_actions, n_eeg, n_samples) float32,
     ``epoch_ch_names``, ``errp_to_noise``, ``accuracy``, ``cv_correct``,
-    ``cv_error``, ``cv_mean``, ``seed``."""
+    ``cv_error``, ``cv_mean``, ``seed``, ``cv_folds`` (n_actions,)."""
+
+def temporal_features(x: npt.NDArray[np.float64], sfreq: float) -> npt.NDArray[np.float64]:
+    """The discrete decoder's features of C-ordered epochs (n, channels,
+    samples): (n, 39 x channels)."""
+
+def continuous_features(x: npt.NDArray[np.float64], sfreq: float) -> npt.NDArray[np.float64]:
+    """The continuous decoder's features of C-ordered windows: (n, 64 x
+    channels)."""
+
+def lda_fit(
+    x: npt.NDArray[np.float64],
+    y: npt.NDArray[np.bool_],
+    pca_variance: float,
+    shrinkage: Optional[float],
+    platt_folds: Optional[int],
+    seed: int,
+) -> Dict[str, Any]:
+    """``coef``, ``intercept``, ``n_components``, ``shrinkage``, ``platt_a``,
+    ``platt_b``."""
+
+def svm_fit(
+    x: npt.NDArray[np.float64],
+    y: npt.NDArray[np.bool_],
+    c: float,
+    gamma: Optional[float],
+    tolerance: float,
+    seed: int,
+) -> Dict[str, Any]:
+    """``mean``, ``inv_sd``, ``gamma``, ``support`` (float32), ``dual_coef``,
+    ``intercept``, ``platt_a``, ``platt_b``, ``n_iter``."""
+
+def svm_decision(
+    model: Dict[str, Any], x: npt.NDArray[np.float64]
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """The decision and Platt-scaled p(error) of each row."""
 
 def run(
     scenario: Optional[str] = None,
@@ -32,10 +76,13 @@ def run(
     accuracy: Optional[float] = None,
     overrides: Optional[Dict[str, Any]] = None,
     save: Optional[str] = None,
+    progress: Optional[Progress] = None,
 ) -> Dict[str, Any]:
     """``task``, ``csv`` (one row per episode) and ``decoder``."""
 
-def sweep(out: str, keywords: Dict[str, Any]) -> Dict[str, Any]:
+def sweep(
+    out: str, keywords: Dict[str, Any], progress: Optional[Progress] = None
+) -> Dict[str, Any]:
     """Paths of the sweep's files, ``ran``, ``total`` and ``task``.
 
     ``keywords`` holds every keyword of :func:`errp.sweep` (``accuracy``,
@@ -76,8 +123,9 @@ class GridTask:
         seed: Optional[int] = None,
         accuracy: Optional[float] = None,
         overrides: Optional[Dict[str, Any]] = None,
+        progress: Optional[Progress] = None,
     ) -> None: ...
-    def run(self, save: Optional[str] = None) -> str: ...
+    def run(self, save: Optional[str] = None, progress: Optional[Progress] = None) -> str: ...
     @property
     def calibration(self) -> Dict[str, float]: ...
     @property
@@ -102,8 +150,15 @@ class EpuckTask:
         seed: Optional[int] = None,
         accuracy: Optional[float] = None,
         overrides: Optional[Dict[str, Any]] = None,
+        progress: Optional[Progress] = None,
     ) -> None: ...
-    def run(self, runs: Optional[int] = None, *, save: Optional[str] = None) -> str: ...
+    def run(
+        self,
+        runs: Optional[int] = None,
+        *,
+        save: Optional[str] = None,
+        progress: Optional[Progress] = None,
+    ) -> str: ...
     @property
     def calibration(self) -> Dict[str, float]: ...
     @property

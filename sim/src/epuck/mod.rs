@@ -38,7 +38,7 @@ pub use report::{EpuckRunHeader, EpuckRunRow, EpuckSummaryReport};
 pub use run::{
     EpuckSummary, PreparedEpuck, epuck_run_seed, finish_continuous_decoder,
     prepare_continuous_decoder, prepare_continuous_decoder_with, prepare_epuck_decoder,
-    run_epuck_batch, run_epuck_once, summarise,
+    run_epuck_batch, run_epuck_batch_counted, run_epuck_once, summarise,
 };
 pub use scenario::{
     EpuckScenario, MAX_OBSTACLES, MAX_REACTION_LATENCY_MS, MAX_REELICIT_SECS, MAX_RUN_SECS,

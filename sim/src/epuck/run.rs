@@ -154,11 +154,25 @@ pub fn run_epuck_batch(
     decoder: &ContinuousDecoder,
     runs: usize,
 ) -> Result<Vec<EpuckEpisodeResult>> {
+    run_epuck_batch_counted(scenario, decoder, runs, &|| {})
+}
+
+/// [`run_epuck_batch`], calling `on_run` after each run ends (on the
+/// thread that ran it, in no set order), e.g. to count them for a progress
+/// bar.
+pub fn run_epuck_batch_counted(
+    scenario: &EpuckScenario,
+    decoder: &ContinuousDecoder,
+    runs: usize,
+    on_run: &(dyn Fn() + Sync),
+) -> Result<Vec<EpuckEpisodeResult>> {
     (0..runs)
         .into_par_iter()
         .map(|k| {
             errp_bci::stop::check()?;
-            run_epuck_once(scenario, decoder, k, &mut ())
+            let r = run_epuck_once(scenario, decoder, k, &mut ());
+            on_run();
+            r
         })
         .collect()
 }

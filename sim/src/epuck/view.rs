@@ -561,12 +561,21 @@ pub fn record_epuck_runs(
     decoder: &ContinuousDecoder,
     provenance: &Provenance,
 ) -> Result<Vec<EpuckEpisodeResult>> {
-    record_epuck_runs_with(file, scenario, decoder, provenance, scenario.runs, None)
+    record_epuck_runs_with(
+        file,
+        scenario,
+        decoder,
+        provenance,
+        scenario.runs,
+        None,
+        &mut |_| {},
+    )
 }
 
 /// [`record_epuck_runs`] of `runs` runs, with `window_decoder` (a decoder
 /// of the caller's own, as in [`crate::epuck::run_epuck_episode_with`]) in
-/// place of the calibrated SVM when given.
+/// place of the calibrated SVM when given; `on_run(k)` is called after run
+/// `k` (from 0) is recorded.
 pub fn record_epuck_runs_with(
     file: &RrdFile,
     scenario: &EpuckScenario,
@@ -574,6 +583,7 @@ pub fn record_epuck_runs_with(
     provenance: &Provenance,
     runs: usize,
     mut window_decoder: Option<WindowDecoder<'_>>,
+    on_run: &mut dyn FnMut(usize),
 ) -> Result<Vec<EpuckEpisodeResult>> {
     provenance.write(file, runs)?;
     let layout = &scenario.layout;
@@ -599,6 +609,7 @@ pub fn record_epuck_runs_with(
                 Some(&mut **decode),
             )?,
         });
+        on_run(k);
     }
     recorder.finish()?;
     Ok(out)
