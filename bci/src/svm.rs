@@ -139,60 +139,59 @@ impl SvmModel {
     /// SD per feature, `n_support x n_features` support values, one
     /// coefficient per support vector, everything finite, `gamma > 0`.
     pub fn from_parts(parts: SvmParts) -> Result<Self> {
-        let SvmParts {
-            mean,
-            inv_sd,
-            gamma,
-            support,
-            coef,
-            bias,
-            platt,
-        } = parts;
-        let d = mean.len();
+        let p = &parts;
+        let d = p.mean.len();
         check(d > 0, "mean", d, "at least one feature")?;
         check(
-            inv_sd.len() == d,
+            p.inv_sd.len() == d,
             "inv_sd",
-            inv_sd.len(),
+            p.inv_sd.len(),
             &format!("one value per feature ({d})"),
         )?;
         check(
-            support.len() == coef.len() * d,
+            p.support.len() == p.coef.len() * d,
             "support",
-            support.len(),
-            &format!("n_support x n_features = {} x {d}", coef.len()),
+            p.support.len(),
+            &format!("n_support x n_features = {} x {d}", p.coef.len()),
         )?;
-        let finite = mean
+        let finite = p
+            .mean
             .iter()
-            .chain(&inv_sd)
-            .chain(&coef)
+            .chain(&p.inv_sd)
+            .chain(&p.coef)
             .all(|v| v.is_finite())
-            && support.iter().all(|v| v.is_finite())
-            && bias.is_finite()
-            && platt.a.is_finite()
-            && platt.b.is_finite();
+            && p.support.iter().all(|v| v.is_finite())
+            && [p.bias, p.platt.a, p.platt.b].iter().all(|v| v.is_finite());
         check(finite, "model", "not finite", "finite numbers throughout")?;
         check(
-            gamma.is_finite() && gamma > 0.0,
+            p.gamma.is_finite() && p.gamma > 0.0,
             "gamma",
-            gamma,
+            p.gamma,
             "a finite width > 0",
         )?;
-        let support_sq_norms = support
+        Ok(Self::assemble(parts, 0))
+    }
+
+    /// The model of consistent parts, with the squared norms of its support
+    /// vectors.
+    fn assemble(parts: SvmParts, iterations: usize) -> Self {
+        let d = parts.mean.len();
+        let support_sq_norms = parts
+            .support
             .chunks_exact(d)
             .map(|sv| sv.iter().map(|&v| f64::from(v) * f64::from(v)).sum())
             .collect();
-        Ok(Self {
-            mean,
-            inv_sd,
-            gamma,
-            support,
+        Self {
+            mean: parts.mean,
+            inv_sd: parts.inv_sd,
+            gamma: parts.gamma,
+            support: parts.support,
             support_sq_norms,
-            coef,
-            bias,
-            platt,
-            iterations: 0,
-        })
+            coef: parts.coef,
+            bias: parts.bias,
+            platt: parts.platt,
+            iterations,
+        }
     }
 }
 
@@ -302,25 +301,23 @@ impl Classifier for SvmDecoder {
 
         let sol = solve_dual(&kernel, &y, self.c, self.tolerance)?;
         let mut support = Vec::new();
-        let mut support_sq_norms = Vec::new();
         let mut coef = Vec::new();
         for i in (0..n).filter(|&i| sol.alpha[i] > 0.0) {
-            let row: Vec<f32> = z.row(i).iter().map(|&v| v as f32).collect();
-            support_sq_norms.push(row.iter().map(|&v| f64::from(v) * f64::from(v)).sum());
-            support.extend(row);
+            support.extend(z.row(i).iter().map(|&v| v as f32));
             coef.push(sol.alpha[i] * y[i]);
         }
-        Ok(SvmModel {
-            mean,
-            inv_sd,
-            gamma,
-            support,
-            support_sq_norms,
-            coef,
-            bias: -sol.rho,
-            platt,
-            iterations: sol.iterations,
-        })
+        Ok(SvmModel::assemble(
+            SvmParts {
+                mean,
+                inv_sd,
+                gamma,
+                support,
+                coef,
+                bias: -sol.rho,
+                platt,
+            },
+            sol.iterations,
+        ))
     }
 }
 
