@@ -49,8 +49,8 @@ mod subjects;
 mod svm;
 
 pub use calibration::continuous::{
-    ContinuousCalibrationParams, ContinuousSetup, calibrate_continuous, continuous_schedule,
-    simulate_continuous_session,
+    ContinuousCalibrationParams, ContinuousSetup, calibrate_continuous, calibrate_continuous_with,
+    continuous_schedule, simulate_continuous_session,
 };
 pub use calibration::targeting::{
     MeanAccuracy, RequestedAccuracy, SessionParts, TargetingResult, TargetingStep,

@@ -2,10 +2,12 @@
 //! and a streaming generator.
 
 use errp_bci::{
-    Assessment, AssessmentKind, EegBlock, EpochWindow, GeneratorParams, MeanAccuracy, Montage,
-    SessionOptions, cv_seed, stratified_folds,
+    Accuracy, Assessment, AssessmentKind, CalibrationSession, ContinuousFeatures, EegBlock,
+    EpochWindow, GeneratorParams, MeanAccuracy, Montage, SessionOptions, SvmDecoder, TargetingStep,
+    Valid, calibrate_continuous_with, continuous_schedule, cv_seed, stratified_folds,
 };
 use errp_sim::calibration::{CalibrationRequest, run_calibration};
+use errp_sim::epuck::{ContinuousRequest, target_continuous};
 use numpy::ndarray::Array1;
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::exceptions::PyValueError;
@@ -25,116 +27,228 @@ pub(crate) const MAX_GENERATE_SAMPLES: usize = 3600 * 256;
 /// that the paper's decoder reaches `accuracy` by cross-validation, then 400
 /// actions (20 % erroneous) at that ratio. Returns the raw recording (all 40
 /// channels, uV), its events, the preprocessed epochs and the targeting.
+///
+/// With `continuous`, the continuous decoder's calibration session instead
+/// (sec. 5.1), as the e-puck task calibrates it: the ratio targeted for the
+/// RBF SVM on the 512 features of an 800 ms window, then 70 erroneous and
+/// 70 correct assessments; the epochs are the example windows, from the
+/// user's button presses (`window_starts`).
 #[pyfunction]
-#[pyo3(signature = (accuracy=0.7438, seed=1, progress=None))]
+#[pyo3(signature = (accuracy=0.7438, seed=1, continuous=false, progress=None))]
 pub(crate) fn simulate_session<'py>(
     py: Python<'py>,
     accuracy: f64,
     seed: u64,
+    continuous: bool,
     progress: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let accuracy = MeanAccuracy::new(accuracy).map_err(|e| py_err(e.into()))?;
-    let request = CalibrationRequest::new(accuracy, seed);
     let meter = Meter::default();
-    let (report, raw, events) = long_shown(py, &meter, progress, || {
-        let mut blocks: Vec<EegBlock> = Vec::new();
-        let mut events: Vec<Assessment> = Vec::new();
-        let mut sink = |block: &EegBlock, now: &[Assessment]| -> errp_bci::Result<()> {
-            blocks.push(block.clone());
-            events.extend_from_slice(now);
-            Ok(())
+    let (sim, raw, events) = long_shown(py, &meter, progress, || {
+        let step = |_: &TargetingStep| meter.step(CALIBRATING, 0);
+        let mut rec = RawRecorder::default();
+        let sim = {
+            let mut sink = rec.sink();
+            let options = SessionOptions {
+                raw_sink: Some(&mut sink),
+                ..SessionOptions::default()
+            };
+            if continuous {
+                continuous_calibration(accuracy, seed, step, options)?
+            } else {
+                discrete_calibration(accuracy, seed, step, options)?
+            }
         };
-        let options = SessionOptions {
-            raw_sink: Some(&mut sink),
-            ..SessionOptions::default()
-        };
-        let report = run_calibration(&request, |_| meter.step(CALIBRATING, 0), options)?;
-        Ok::<_, errp_sim::SimError>((report, EegBlock::concat(&blocks), events))
+        let (raw, events) = rec.finish();
+        Ok::<_, errp_sim::SimError>((sim, raw, events))
     })?
     .map_err(py_err)?;
-
-    let montage = Montage::standard();
-    let fs = report.generator.sfreq_hz;
-    // The epochs a decoder of the user's own reads in the closed loop: the
-    // session through the preprocessing fitted on its EOG recording (notch,
-    // band-pass, CAR, EOG regression), cut from each onset over the span of
-    // the paper's feature window.
-    let session = &report.calibrated.session;
-    let mut preprocessor = session.preprocessor.clone();
-    let (clean, span) = py.detach(|| {
-        preprocessor.reset();
-        (preprocessor.process(&raw), EpochWindow::paper(fs).span())
-    });
-    let mut epochs = Vec::with_capacity(events.len());
-    for a in &events {
-        let start = (a.onset_secs * fs).round() as usize;
-        if start + span > clean.n_samples {
-            continue;
-        }
-        let mut e = EegBlock::zeros(clean.n_channels, span);
-        for ch in 0..clean.n_channels {
-            e.channel_mut(ch)
-                .copy_from_slice(&clean.channel(ch)[start..start + span]);
-        }
-        epochs.push(e);
+    // Discrete: each action's epoch from its onset.
+    let starts = match &sim.window_starts {
+        Some(w) => w.clone(),
+        None => events.iter().map(|a| a.onset_secs).collect(),
+    };
+    let out = Recorded {
+        raw: &raw,
+        events: &events,
+        starts: &starts,
+        sim: &sim,
+    };
+    let d = out.dict(py, accuracy, seed)?;
+    if let Some(w) = &sim.window_starts {
+        d.set_item("window_starts", Array1::from(w.clone()).into_pyarray(py))?;
     }
-    let refs: Vec<&EegBlock> = epochs.iter().collect();
-    let d = PyDict::new(py);
-    d.set_item("data", block_to_numpy(py, &raw))?;
-    d.set_item(
-        "ch_names",
-        montage
-            .channels()
-            .iter()
-            .map(|c| c.name.clone())
-            .collect::<Vec<_>>(),
-    )?;
-    d.set_item(
-        "ch_types",
-        montage
-            .channels()
-            .iter()
-            .map(|c| match c.kind {
-                errp_bci::ChannelKind::Eeg => "eeg",
-                errp_bci::ChannelKind::Eog => "eog",
-            })
-            .collect::<Vec<_>>(),
-    )?;
-    d.set_item("sfreq", fs)?;
-    d.set_item(
-        "onsets",
-        Array1::from_iter(events.iter().map(|a| a.onset_secs)).into_pyarray(py),
-    )?;
-    d.set_item(
-        "labels",
-        events
-            .iter()
-            .map(|a| match a.kind {
-                AssessmentKind::Error => "error",
-                AssessmentKind::Correct => "correct",
-            })
-            .collect::<Vec<_>>(),
-    )?;
-    d.set_item("epochs", blocks_to_array3(&refs).into_pyarray(py))?;
-    d.set_item(
-        "epoch_ch_names",
-        channel_names(&montage, session.preprocessor.outputs()),
-    )?;
-    let a = report.calibrated.accuracy;
-    d.set_item("errp_to_noise", report.generator.errp_to_noise)?;
-    d.set_item("accuracy", accuracy.get())?;
-    d.set_item("cv_correct", a.correct)?;
-    d.set_item("cv_error", a.error)?;
-    d.set_item("cv_mean", a.mean())?;
-    d.set_item("seed", seed)?;
-    // The folds the session's accuracy was cross-validated on.
-    let labels = &session.labels;
-    let folds = stratified_folds(labels, request.setup.calibration.folds, cv_seed(seed));
-    d.set_item(
-        "cv_folds",
-        Array1::from_iter(folds.into_iter().map(|k| k as i64)).into_pyarray(py),
-    )?;
     Ok(d)
+}
+
+/// A calibration session and what its cross-validation found.
+struct Simulated {
+    generator: Valid<GeneratorParams>,
+    accuracy: Accuracy,
+    session: CalibrationSession,
+    /// The examples' window starts (s), for the continuous protocol.
+    window_starts: Option<Vec<f64>>,
+    /// Samples per epoch: the span of the decoder's features.
+    span: usize,
+    folds: usize,
+}
+
+fn discrete_calibration(
+    accuracy: MeanAccuracy,
+    seed: u64,
+    step: impl FnMut(&TargetingStep),
+    options: SessionOptions<'_>,
+) -> errp_sim::Result<Simulated> {
+    let request = CalibrationRequest::new(accuracy, seed);
+    let report = run_calibration(&request, step, options)?;
+    Ok(Simulated {
+        span: EpochWindow::paper(report.generator.sfreq_hz).span(),
+        generator: report.generator,
+        accuracy: report.calibrated.accuracy,
+        session: report.calibrated.session,
+        window_starts: None,
+        folds: request.setup.calibration.folds,
+    })
+}
+
+fn continuous_calibration(
+    accuracy: MeanAccuracy,
+    seed: u64,
+    step: impl FnMut(&TargetingStep),
+    options: SessionOptions<'_>,
+) -> errp_sim::Result<Simulated> {
+    let request = ContinuousRequest::new(accuracy, seed);
+    let targeting = target_continuous(&request, step)?;
+    let setup = Valid::new(request.setup.at_ratio(targeting.ratio)?)?;
+    let c = calibrate_continuous_with(&SvmDecoder::default(), &setup, seed, options)?;
+    let (_, starts) = continuous_schedule(&request.setup.calibration, seed);
+    Ok(Simulated {
+        generator: setup.generator.clone(),
+        accuracy: c.accuracy,
+        session: c.session,
+        window_starts: Some(starts),
+        span: ContinuousFeatures::paper(setup.generator.sfreq_hz).span(),
+        folds: request.setup.calibration.folds,
+    })
+}
+
+/// The raw blocks of a session and the assessments whose onsets fall in
+/// them, as the session's raw sink gives them.
+#[derive(Default)]
+struct RawRecorder {
+    blocks: Vec<EegBlock>,
+    events: Vec<Assessment>,
+}
+
+impl RawRecorder {
+    fn sink(&mut self) -> impl FnMut(&EegBlock, &[Assessment]) -> errp_bci::Result<()> + '_ {
+        |block, now| {
+            self.blocks.push(block.clone());
+            self.events.extend_from_slice(now);
+            Ok(())
+        }
+    }
+
+    fn finish(self) -> (EegBlock, Vec<Assessment>) {
+        (EegBlock::concat(&self.blocks), self.events)
+    }
+}
+
+/// A simulated session as Python receives it.
+struct Recorded<'a> {
+    raw: &'a EegBlock,
+    events: &'a [Assessment],
+    /// The start of each epoch (s).
+    starts: &'a [f64],
+    sim: &'a Simulated,
+}
+
+impl Recorded<'_> {
+    fn dict<'py>(
+        &self,
+        py: Python<'py>,
+        accuracy: MeanAccuracy,
+        seed: u64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let (generator, cv, session) = (&self.sim.generator, &self.sim.accuracy, &self.sim.session);
+        let montage = Montage::standard();
+        let fs = generator.sfreq_hz;
+        // The epochs a decoder of the user's own reads in the closed loop:
+        // the session through the preprocessing fitted on its EOG recording
+        // (notch, band-pass, CAR, EOG regression), `span` samples from each
+        // start.
+        let mut preprocessor = session.preprocessor.clone();
+        let span = self.sim.span;
+        let clean = py.detach(|| {
+            preprocessor.reset();
+            preprocessor.process(self.raw)
+        });
+        let mut epochs = Vec::with_capacity(self.starts.len());
+        for &t in self.starts {
+            let start = (t * fs).round() as usize;
+            if start + span > clean.n_samples {
+                continue;
+            }
+            let mut e = EegBlock::zeros(clean.n_channels, span);
+            for ch in 0..clean.n_channels {
+                e.channel_mut(ch)
+                    .copy_from_slice(&clean.channel(ch)[start..start + span]);
+            }
+            epochs.push(e);
+        }
+        let refs: Vec<&EegBlock> = epochs.iter().collect();
+        let kind = |c: &errp_bci::Channel| match c.kind {
+            errp_bci::ChannelKind::Eeg => "eeg",
+            errp_bci::ChannelKind::Eog => "eog",
+        };
+        let d = PyDict::new(py);
+        d.set_item("data", block_to_numpy(py, self.raw))?;
+        d.set_item(
+            "ch_names",
+            montage
+                .channels()
+                .iter()
+                .map(|c| c.name.clone())
+                .collect::<Vec<_>>(),
+        )?;
+        d.set_item(
+            "ch_types",
+            montage.channels().iter().map(kind).collect::<Vec<_>>(),
+        )?;
+        d.set_item("sfreq", fs)?;
+        d.set_item(
+            "onsets",
+            Array1::from_iter(self.events.iter().map(|a| a.onset_secs)).into_pyarray(py),
+        )?;
+        d.set_item(
+            "labels",
+            self.events
+                .iter()
+                .map(|a| match a.kind {
+                    AssessmentKind::Error => "error",
+                    AssessmentKind::Correct => "correct",
+                })
+                .collect::<Vec<_>>(),
+        )?;
+        d.set_item("epochs", blocks_to_array3(&refs).into_pyarray(py))?;
+        d.set_item(
+            "epoch_ch_names",
+            channel_names(&montage, session.preprocessor.outputs()),
+        )?;
+        d.set_item("errp_to_noise", generator.errp_to_noise)?;
+        d.set_item("accuracy", accuracy.get())?;
+        d.set_item("cv_correct", cv.correct)?;
+        d.set_item("cv_error", cv.error)?;
+        d.set_item("cv_mean", cv.mean())?;
+        d.set_item("seed", seed)?;
+        // The folds the session's accuracy was cross-validated on.
+        let folds = stratified_folds(&session.labels, self.sim.folds, cv_seed(seed));
+        d.set_item(
+            "cv_folds",
+            Array1::from_iter(folds.into_iter().map(|k| k as i64)).into_pyarray(py),
+        )?;
+        Ok(d)
+    }
 }
 
 /// A streaming synthetic EEG generator (34 EEG + 6 EOG channels, 256 Hz, in

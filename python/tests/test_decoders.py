@@ -70,6 +70,23 @@ def test_cross_validation_on_the_sessions_folds_gives_its_accuracy(session):
     assert errors.max() - errors.min() <= 1
 
 
+def test_the_continuous_decoder_gives_the_continuous_sessions_accuracy():
+    """The same for the continuous protocol: the SVM on the 512 features of
+    the button-locked windows, on the session's folds."""
+    import errp
+
+    s = errp.simulate_session(accuracy=0.8, seed=3, protocol="continuous")
+    assert s.epochs.shape == (140, 8, 205) and s.y.sum() == 70
+    assert s.protocol == "continuous" and len(s.window_starts) == 140
+    lag = s.window_starts - s.onsets
+    assert abs(lag.mean()) < 0.015 and 0.035 < lag.std() < 0.065
+    y_hat = cross_val_predict(continuous_decoder(), s.epochs, s.y, cv=PredefinedSplit(s.cv_folds))
+    assert abs(balanced_accuracy_score(s.y, y_hat) - s.cv_mean) < 0.005
+    assert abs(s.cv_mean - 0.8) < 0.03
+    with pytest.raises(ValueError, match="protocol"):
+        errp.simulate_session(protocol="async")
+
+
 def test_temporal_features_are_the_papers_samples(session):
     x = session.epochs
     f = TemporalFeatures().fit_transform(x)

@@ -181,7 +181,18 @@ pub fn calibrate_continuous(
     setup: &Valid<ContinuousSetup>,
     seed: u64,
 ) -> Result<Calibrated<SvmModel>> {
-    let session = simulate_continuous_session(setup, seed, SessionOptions::default())?;
+    calibrate_continuous_with(classifier, setup, seed, SessionOptions::default())
+}
+
+/// [`calibrate_continuous`], with what else to produce while the session is
+/// simulated (e.g. the raw EEG, to a sink).
+pub fn calibrate_continuous_with(
+    classifier: &SvmDecoder,
+    setup: &Valid<ContinuousSetup>,
+    seed: u64,
+    options: SessionOptions<'_>,
+) -> Result<Calibrated<SvmModel>> {
+    let session = simulate_continuous_session(setup, seed, options)?;
     let decisions = out_of_fold_decisions(
         classifier,
         &session.features,

@@ -25,13 +25,19 @@ MAX_LDA_FEATURES: int
 MAX_SVM_TRIALS: int
 
 def simulate_session(
-    accuracy: float = 0.7438, seed: int = 1, progress: Optional[Progress] = None
+    accuracy: float = 0.7438,
+    seed: int = 1,
+    continuous: bool = False,
+    progress: Optional[Progress] = None,
 ) -> Dict[str, Any]:
     """The calibration session of ``errp calibrate``: ``data`` (n_channels,
     n_samples) uV, ``ch_names``, ``ch_types``, ``sfreq``, ``onsets`` (s),
     ``labels``, ``epochs`` (n_actions, n_eeg, n_samples) float32,
     ``epoch_ch_names``, ``errp_to_noise``, ``accuracy``, ``cv_correct``,
-    ``cv_error``, ``cv_mean``, ``seed``, ``cv_folds`` (n_actions,)."""
+    ``cv_error``, ``cv_mean``, ``seed``, ``cv_folds`` (n_actions,). With
+    ``continuous``, the continuous decoder's session (sec. 5.1): 800 ms
+    windows from the button presses as ``epochs``, and ``window_starts``
+    (s)."""
 
 def temporal_features(x: npt.NDArray[np.float64], sfreq: float) -> npt.NDArray[np.float64]:
     """The discrete decoder's features of C-ordered epochs (n, channels,
