@@ -1,5 +1,6 @@
 """progress=: what long calls report, and how it is shown."""
 
+import re
 import subprocess
 import sys
 
@@ -87,7 +88,9 @@ def test_without_tqdm_a_line_per_tenth_goes_to_stderr():
     )
     assert out.returncode == 0, out.stderr
     lines = out.stderr.splitlines()
-    assert any(line.startswith("errp.run: calibrating, step 1 [") for line in lines), lines
+    # The core is polled every 50 ms, so which steps of the search show
+    # depends on the machine's speed; that some do, with their count, does not.
+    assert any(re.match(r"errp\.run: calibrating, step \d+ \[", line) for line in lines), lines
     runs = [line for line in lines if line.startswith("errp.run: runs ")]
     assert 2 <= len(runs) <= 11 and runs[-1].startswith("errp.run: runs 20/20 ["), lines
     assert out.stdout == ""
