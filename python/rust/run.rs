@@ -3,6 +3,7 @@
 
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Mutex, PoisonError};
 
 use errp_bci::rng::derive_seed;
 use errp_sim::AnyScenario;
@@ -23,14 +24,39 @@ use pyo3::types::PyDict;
 use crate::convert::{Keys, load_any, load_any_text, py_err, value_error};
 use crate::interrupt::{CALIBRATING, EPISODES, Meter, RUNS, long_or, long_shown};
 
-/// A sweep's progress: its decoders calibrated, then its episodes.
-impl errp_sweep::SweepObserver for Meter {
+/// What a sweep reports from Python: its progress (its decoders
+/// calibrated, then its episodes) on the meter, and its warnings kept for
+/// the caller, who raises them as Python warnings.
+#[derive(Debug, Default)]
+struct SweepWatch {
+    meter: Meter,
+    warnings: Mutex<Vec<String>>,
+}
+
+impl SweepWatch {
+    fn keep(&self, text: &str) {
+        self.warnings
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .push(text.to_owned());
+    }
+}
+
+impl errp_sweep::SweepObserver for SweepWatch {
     fn decoder_ready(&self, _info: &errp_sweep::DecoderInfo, done: usize, total: usize) {
-        self.set(CALIBRATING, done, total);
+        self.meter.set(CALIBRATING, done, total);
     }
 
     fn episodes_done(&self, done: usize, total: usize) {
-        self.set(EPISODES, done, total);
+        self.meter.set(EPISODES, done, total);
+    }
+
+    fn note(&self, text: &str) {
+        self.keep(text);
+    }
+
+    fn warning(&self, text: &str) {
+        self.keep(text);
     }
 }
 
@@ -458,12 +484,18 @@ pub(crate) fn sweep<'py>(
         .map_err(|e| PyValueError::new_err(format!("threads: cannot start them: {e}")))?;
     // Ctrl-C also sets the sweep's own flag: the rows written so far are
     // kept, and the same call later resumes.
-    let meter = Meter::default();
+    let watch = SweepWatch::default();
+    if let Some(why) = opts.cache.unwritable() {
+        watch.keep(&format!(
+            "cache: the targeting cache cannot be written ({why}), so every decoder's accuracy \
+             targeting is searched again on every sweep (give another cache= directory)"
+        ));
+    }
     let outcome = long_or(
         py,
         || cancel.store(true, Ordering::SeqCst),
-        progress.map(|p| (&meter, p)),
-        || pool.install(|| errp_sweep::run_sweep(&sweep, &opts, &cancel, &meter)),
+        progress.map(|p| (&watch.meter, p)),
+        || pool.install(|| errp_sweep::run_sweep(&sweep, &opts, &cancel, &watch)),
     )?
     .map_err(py_err)?;
     match outcome {
@@ -479,6 +511,13 @@ pub(crate) fn sweep<'py>(
             d.set_item("ran", ran)?;
             d.set_item("total", total)?;
             d.set_item("task", task.to_string())?;
+            d.set_item(
+                "warnings",
+                watch
+                    .warnings
+                    .into_inner()
+                    .unwrap_or_else(PoisonError::into_inner),
+            )?;
             Ok(d)
         }
     }

@@ -85,15 +85,23 @@ impl TargetCache {
                  {unused} (give --cache DIR, or --no-cache to turn it off)"
             ));
         }
-        let dir = self.dir.as_ref()?;
-        let probe = errp_sim::create_dir(dir)
-            .and_then(|()| errp_sim::PendingFile::create(dir.join("write-test")).map(drop));
-        probe.err().map(|e| {
+        self.unwritable().map(|e| {
             format!(
                 "the targeting cache cannot be written ({e}), {unused} (give another --cache \
                  DIR, or --no-cache)"
             )
         })
+    }
+
+    /// Why the cache directory cannot be written, if it cannot: it is
+    /// created if missing and tried now, with a temporary file. `None` also
+    /// when there is no directory.
+    pub fn unwritable(&self) -> Option<String> {
+        let dir = self.dir.as_ref()?;
+        errp_sim::create_dir(dir)
+            .and_then(|()| errp_sim::PendingFile::create(dir.join("write-test")).map(drop))
+            .err()
+            .map(|e| e.to_string())
     }
 
     /// What was found wrong in the cache since the last call (each an

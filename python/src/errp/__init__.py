@@ -33,6 +33,7 @@ import numbers
 import os
 import shutil
 import tempfile
+import warnings
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Callable, Dict, Mapping, Optional, Sequence, Union
 
@@ -51,6 +52,7 @@ __all__ = [
     "HAS_RERUN",
     "Session",
     "SweepResult",
+    "SweepWarning",
     "episode_columns",
     "Recording",
     "read_recording",
@@ -535,6 +537,13 @@ class SweepResult:
     files: Dict[str, str] = field(default_factory=dict)
 
 
+class SweepWarning(UserWarning):
+    """Something a sweep found wrong and worked around: a targeting cache
+    that cannot be written, or a cached targeting whose figures did not
+    come back when checked (searched again and replaced). The sweep's
+    results are right either way; it may only have been slower."""
+
+
 def sweep(
     out: Optional[PathLike] = None,
     *,
@@ -574,7 +583,9 @@ def sweep(
         Grid: stream the EEG of every action instead of drawing epochs from
         a bank (the sweep's default).
     cache : path, optional
-        A directory for the accuracy targeting, shared across sweeps.
+        A directory for the accuracy targeting, shared across sweeps. Each
+        cached entry is checked before use; one that does not verify, or a
+        directory that cannot be written, gives a :class:`SweepWarning`.
     threads : int, optional
         Worker threads (all cores by default); results do not depend on it.
     progress : bool, optional
@@ -625,6 +636,8 @@ def sweep(
                 ),
                 progress=report,
             )
+        for text in d["warnings"]:
+            warnings.warn(text, SweepWarning, stacklevel=2)
         import pandas as pd
 
         result = SweepResult(

@@ -89,7 +89,8 @@ def run(
 def sweep(
     out: str, keywords: Dict[str, Any], progress: Optional[Progress] = None
 ) -> Dict[str, Any]:
-    """Paths of the sweep's files, ``ran``, ``total`` and ``task``.
+    """Paths of the sweep's files, ``ran``, ``total``, ``task`` and
+    ``warnings`` (what the sweep found wrong and worked around).
 
     ``keywords`` holds every keyword of :func:`errp.sweep` (``accuracy``,
     ``task``, ``scenario``, ``episodes``, ``seed``, ``params``, ``stream``,
