@@ -54,3 +54,15 @@ def test_a_cache_that_cannot_be_written_warns_and_the_sweep_goes_on(tmp_path):
     assert message.startswith("cache: the targeting cache cannot be written"), message
     assert str(blocker) in message and "give another cache= directory" in message, message
     assert blocker.read_text() == "mine" and len(res.episodes) == 3
+
+
+def test_an_entry_that_cannot_be_stored_warns_naming_it(tmp_path):
+    cache = tmp_path / "cache"
+    first = grid(tmp_path, cache, "a")
+    [entry] = cache.glob("*.json")
+    entry.unlink()
+    entry.mkdir()  # where the entry goes, something that is not ours to replace
+    with pytest.warns(errp.SweepWarning, match=rf"{re.escape(entry.name)} could not be stored"):
+        again = grid(tmp_path, cache, "b")
+    assert entry.is_dir() and [p.name for p in cache.iterdir()] == [entry.name]
+    pd.testing.assert_frame_equal(again.episodes, first.episodes)

@@ -9,6 +9,7 @@
 //! rewritten.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
 use errp_bci::TargetingResult;
@@ -26,6 +27,9 @@ pub struct TargetCache {
     unset: bool,
     /// Entries found wrong since the last [`TargetCache::take_warnings`].
     warnings: Arc<Mutex<Vec<String>>>,
+    /// [`TargetCache::unwritable`] found the directory unwritable, and the
+    /// user was told once: each entry's store failing is not told again.
+    told_unwritable: Arc<AtomicBool>,
 }
 
 impl PartialEq for TargetCache {
@@ -95,13 +99,18 @@ impl TargetCache {
 
     /// Why the cache directory cannot be written, if it cannot: it is
     /// created if missing and tried now, with a temporary file. `None` also
-    /// when there is no directory.
+    /// when there is no directory. The caller tells the user; the entries
+    /// that then cannot be stored are not warned of one by one.
     pub fn unwritable(&self) -> Option<String> {
         let dir = self.dir.as_ref()?;
-        errp_sim::create_dir(dir)
+        let why = errp_sim::create_dir(dir)
             .and_then(|()| errp_sim::PendingFile::create(dir.join("write-test")).map(drop))
             .err()
-            .map(|e| e.to_string())
+            .map(|e| e.to_string());
+        if why.is_some() {
+            self.told_unwritable.store(true, Ordering::Relaxed);
+        }
+        why
     }
 
     /// What was found wrong in the cache since the last call (each an
@@ -137,8 +146,8 @@ impl TargetingCache for TargetCache {
     /// `verify` evaluate the entry's ratio again: an entry whose figures do
     /// not come back is a miss, with a warning naming it (see
     /// [`TargetCache::take_warnings`]). A miss searches and stores the
-    /// result atomically, and a store that fails only costs the next run a
-    /// search.
+    /// result atomically, and a store that fails (with a warning) only
+    /// costs the next run a search.
     fn get_or_search(
         &self,
         kind: &str,
@@ -173,11 +182,19 @@ impl TargetingCache for TargetCache {
             ));
         }
         let result = search()?;
-        // A cache that cannot be written is not an error: the sweep goes on.
-        // (serde_json's `float_roundtrip` makes a stored ratio read back bit
-        // for bit, so a hit gives what this miss gives.)
+        // A cache that cannot be written is not an error: the sweep goes on,
+        // with a warning. (serde_json's `float_roundtrip` makes a stored
+        // ratio read back bit for bit, so a hit gives what this miss gives.)
         let entry = Entry { request, result };
-        let _ = Self::store(&path, &entry);
+        if let Err(e) = Self::store(&path, &entry)
+            && !self.told_unwritable.load(Ordering::Relaxed)
+        {
+            self.warn(format!(
+                "the targeting {} could not be stored in the cache ({e}); the results are \
+                 the same, and the next sweep searches it again",
+                path.display()
+            ));
+        }
         Ok((entry.result, false))
     }
 }
@@ -297,6 +314,36 @@ mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
+    /// An entry that cannot be stored is a warning naming it, and the
+    /// search's result is given all the same.
+    #[test]
+    fn an_entry_that_cannot_be_stored_is_a_warning() {
+        let dir = scratch("store");
+        let cache = TargetCache::new(&dir);
+        let _ = cache
+            .get_or_search("k", "a", &mut || Ok(result(0.25)), &mut ok)
+            .unwrap();
+        assert!(cache.take_warnings().is_empty());
+        // A directory where the entry goes: read as a miss, not replaced.
+        let name = entries(&dir).into_iter().next().unwrap();
+        std::fs::remove_file(dir.join(&name)).unwrap();
+        std::fs::create_dir(dir.join(&name)).unwrap();
+        let (r, hit) = cache
+            .get_or_search("k", "a", &mut || Ok(result(0.25)), &mut ok)
+            .unwrap();
+        assert!(!hit && r == result(0.25));
+        let warnings = cache.take_warnings();
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
+        assert!(
+            warnings[0].contains(&name) && warnings[0].contains("could not be stored"),
+            "{}",
+            warnings[0]
+        );
+        assert!(dir.join(&name).is_dir());
+        assert_eq!(entries(&dir), [name], "no temporary left behind");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
     /// Writers of one entry at once (threads here; hosts and processes on
     /// a shared file system alike) each write their own temporary: the
     /// entry is whole and nothing else is left.
@@ -334,13 +381,32 @@ mod tests {
     #[test]
     fn a_cache_that_cannot_be_kept_says_why() {
         assert!(TargetCache::disabled().problem().is_none());
-        let ok = scratch("ok");
-        assert!(TargetCache::new(&ok).problem().is_none());
-        assert!(entries(&ok).is_empty(), "the write test leaves nothing");
-        let e = TargetCache::new("/proc/errp-no-cache").problem().unwrap();
+        let writable = scratch("ok");
+        assert!(TargetCache::new(&writable).problem().is_none());
+        assert!(
+            entries(&writable).is_empty(),
+            "the write test leaves nothing"
+        );
+        let unwritable = TargetCache::new("/proc/errp-no-cache");
+        let e = unwritable.problem().unwrap();
         assert!(
             e.contains("/proc/errp-no-cache") && e.contains("--no-cache"),
             "{e}"
+        );
+        // Told once: its entries' stores failing are not warned of again,
+        // while a store failing unannounced is.
+        let search = |cache: &TargetCache| {
+            let (r, hit) = cache
+                .get_or_search("k", "a", &mut || Ok(result(0.5)), &mut ok)
+                .unwrap();
+            assert!(!hit && r == result(0.5));
+            cache.take_warnings()
+        };
+        assert_eq!(search(&unwritable), Vec::<String>::new());
+        let unannounced = search(&TargetCache::new("/proc/errp-no-cache"));
+        assert!(
+            unannounced.len() == 1 && unannounced[0].contains("could not be stored"),
+            "{unannounced:?}"
         );
         let unset = TargetCache {
             dir: None,
@@ -348,7 +414,7 @@ mod tests {
             ..TargetCache::default()
         };
         assert!(unset.problem().unwrap().contains("$HOME"));
-        std::fs::remove_dir_all(&ok).unwrap();
+        std::fs::remove_dir_all(&writable).unwrap();
     }
 
     /// An entry whose ratio was edited (x3, 0, 1e308), or whose figures do

@@ -539,9 +539,10 @@ class SweepResult:
 
 class SweepWarning(UserWarning):
     """Something a sweep found wrong and worked around: a targeting cache
-    that cannot be written, or a cached targeting whose figures did not
-    come back when checked (searched again and replaced). The sweep's
-    results are right either way; it may only have been slower."""
+    that cannot be written (or an entry of it that could not be stored), or
+    a cached targeting whose figures did not come back when checked
+    (searched again and replaced). The sweep's results are right either
+    way; it, or the next one, may only be slower."""
 
 
 def sweep(
