@@ -21,7 +21,7 @@ use pyo3::types::PyDict;
 use crate::convert::{
     Keys, block_to_numpy, load_any_text, load_epuck, load_grid, py_err, value_error,
 };
-use crate::interrupt::long;
+use crate::interrupt::{CALIBRATING, Meter, long_shown};
 use crate::run::check_save;
 
 /// The most episodes a grid environment records (as `errp run --save`).
@@ -134,17 +134,19 @@ fn cell(name: &str, c: Option<(i64, i64)>) -> PyResult<Option<Cell>> {
 #[pymethods]
 impl GridEnvCore {
     /// Loads the scenario (the built-in fixed-goals one by default) and
-    /// calibrates its decoder.
+    /// calibrates its decoder (unless one of the same key is kept), its
+    /// targeting steps reported to `progress`.
     /// With `save`, every episode (up to 5000) is recorded into that `.rrd`
     /// when it ends, and the file is moved into place by `close()`.
     #[new]
-    #[pyo3(signature = (scenario=None, *, accuracy=None, overrides=None, save=None))]
+    #[pyo3(signature = (scenario=None, *, accuracy=None, overrides=None, save=None, progress=None))]
     fn new(
         py: Python<'_>,
         scenario: Option<PathBuf>,
         accuracy: Option<f64>,
         overrides: Option<&Bound<'_, PyDict>>,
         save: Option<PathBuf>,
+        progress: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         check_save(save.as_ref())?;
         let text = match &save {
@@ -182,7 +184,11 @@ impl GridEnvCore {
         let decoder = match cached(&GRID_DECODERS, &key) {
             Some(d) => d,
             None => {
-                let (d, _) = long(py, || prepare_decoder(&s, |_| {}))?.map_err(py_err)?;
+                let meter = Meter::default();
+                let (d, _) = long_shown(py, &meter, progress, || {
+                    prepare_decoder(&s, |_| meter.step(CALIBRATING, 0))
+                })?
+                .map_err(py_err)?;
                 keep(&GRID_DECODERS, key, Arc::new(d))
             }
         };
@@ -376,17 +382,19 @@ pub(crate) struct EpuckEnvCore {
 #[pymethods]
 impl EpuckEnvCore {
     /// Loads the scenario (the built-in Mexico-to-Pisa one by default) and
-    /// calibrates its continuous decoder.
+    /// calibrates its continuous decoder (unless one of the same key is
+    /// kept), its targeting steps reported to `progress`.
     /// With `save`, every episode (up to 100) is recorded into that `.rrd`
     /// as it runs, and the file is moved into place by `close()`.
     #[new]
-    #[pyo3(signature = (scenario=None, *, accuracy=None, overrides=None, save=None))]
+    #[pyo3(signature = (scenario=None, *, accuracy=None, overrides=None, save=None, progress=None))]
     fn new(
         py: Python<'_>,
         scenario: Option<PathBuf>,
         accuracy: Option<f64>,
         overrides: Option<&Bound<'_, PyDict>>,
         save: Option<PathBuf>,
+        progress: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         check_save(save.as_ref())?;
         let text = match &save {
@@ -403,8 +411,11 @@ impl EpuckEnvCore {
         let decoder = match cached(&EPUCK_DECODERS, &key) {
             Some(d) => d,
             None => {
-                let (d, _) =
-                    long(py, || prepare_continuous_decoder(&s, |_| {}))?.map_err(py_err)?;
+                let meter = Meter::default();
+                let (d, _) = long_shown(py, &meter, progress, || {
+                    prepare_continuous_decoder(&s, |_| meter.step(CALIBRATING, 0))
+                })?
+                .map_err(py_err)?;
                 keep(&EPUCK_DECODERS, key, Arc::new(d))
             }
         };

@@ -60,6 +60,27 @@ def test_a_grid_task_and_a_sweep_report_their_episodes(tmp_path):
     check_counts(calls.seen)
 
 
+@pytest.mark.parametrize("core, accuracy", [("GridEnvCore", 0.7123), ("EpuckEnvCore", 0.8765)])
+def test_an_environment_reports_its_calibration_once_per_decoder(core, accuracy):
+    # An accuracy no other test asks for: the process keeps decoders by key.
+    make = getattr(_core, core)
+    calls = Calls()
+    make(None, accuracy=accuracy, progress=calls).close()
+    assert calls.stages() == ["calibrating"], calls.seen
+    check_counts(calls.seen)
+    again = Calls()
+    make(None, accuracy=accuracy, progress=again).close()
+    assert again.seen == [], "a kept decoder is not calibrated again"
+
+
+def test_the_gymnasium_environments_take_progress():
+    from errp.gym import EpuckEnv, GridEnv
+
+    for env in (GridEnv, EpuckEnv):
+        with pytest.raises(TypeError, match="progress must be True, False or None"):
+            env(progress="yes")
+
+
 def test_an_exception_in_the_progress_callable_stops_the_work():
     def fail(stage, done, total):
         raise RuntimeError("stop here")

@@ -191,6 +191,7 @@ class GridEnvCore:
         accuracy: Optional[float] = None,
         overrides: Optional[Dict[str, Any]] = None,
         save: Optional[str] = None,
+        progress: Optional[Progress] = None,
     ) -> None: ...
     def close(self) -> Optional[str]: ...
     @property
@@ -219,6 +220,7 @@ class EpuckEnvCore:
         accuracy: Optional[float] = None,
         overrides: Optional[Dict[str, Any]] = None,
         save: Optional[str] = None,
+        progress: Optional[Progress] = None,
     ) -> None: ...
     def close(self) -> Optional[str]: ...
     @property

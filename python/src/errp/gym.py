@@ -53,7 +53,7 @@ except ImportError as e:  # pragma: no cover - depends on the environment
         "errp.gym needs Gymnasium: pip install gymnasium (or pip install './python[gym]')"
     ) from e
 
-from . import _args, _core, _gym_plugin
+from . import _args, _core, _gym_plugin, _progress
 
 __all__ = ["ACTIONS", "EPUCK_ACTIONS", "EpuckEnv", "GridEnv"]
 
@@ -90,6 +90,11 @@ class GridEnv(gym.Env):
         :meth:`close`: the actions, p(error) and the user's judgements, as
         ``errp run --save`` records the grid (no belief: the agent's is its
         own).
+    progress : bool, optional
+        Show the decoder's calibration on stderr (a tqdm bar if tqdm is
+        installed, else a line per tenth): by default when stderr is a
+        terminal. A decoder of the same scenario and accuracy is calibrated
+        once per process, so later environments show nothing.
     """
 
     metadata = {"render_modes": ["ansi", "rgb_array"], "render_fps": 2}
@@ -105,17 +110,21 @@ class GridEnv(gym.Env):
         observe_epoch: bool = False,
         render_mode: Optional[str] = None,
         save: Optional[str] = None,
+        progress: Optional[bool] = None,
     ) -> None:
         _check_render_mode(render_mode, self.metadata["render_modes"])
         fields = {"eeg": "stream"}
         if overrides:
             fields.update(overrides)
-        self._core = _core.GridEnvCore(
-            None if scenario is None else os.fspath(scenario),
-            accuracy=_args.accuracy("accuracy", accuracy, optional=True),
-            overrides=fields,
-            save=None if save is None else os.fspath(save),
-        )
+        accuracy = _args.accuracy("accuracy", accuracy, optional=True)
+        with _progress.shown(progress, "errp/Grid-v0") as report:
+            self._core = _core.GridEnvCore(
+                None if scenario is None else os.fspath(scenario),
+                accuracy=accuracy,
+                overrides=fields,
+                save=None if save is None else os.fspath(save),
+                progress=report,
+            )
         self.save = save
         self._full_warned = False
         # The recording is written by close(), or when the environment is
@@ -289,6 +298,11 @@ class EpuckEnv(gym.Env):
         ``errp run --save`` records the e-puck, written by :meth:`close`;
         an episode cut short (a time limit, a reset) is a run without a
         commitment.
+    progress : bool, optional
+        Show the continuous decoder's calibration on stderr (a tqdm bar if
+        tqdm is installed, else a line per tenth): by default when stderr is
+        a terminal. A decoder of the same scenario and accuracy is
+        calibrated once per process, so later environments show nothing.
     """
 
     metadata = {"render_modes": ["ansi", "rgb_array"], "render_fps": 4}
@@ -304,6 +318,7 @@ class EpuckEnv(gym.Env):
         observe_window: bool = False,
         render_mode: Optional[str] = None,
         save: Optional[str] = None,
+        progress: Optional[bool] = None,
     ) -> None:
         _check_render_mode(render_mode, self.metadata["render_modes"])
         if not (isinstance(windows_per_action, int) and 1 <= windows_per_action <= 64):
@@ -311,12 +326,15 @@ class EpuckEnv(gym.Env):
                 f"windows_per_action = {windows_per_action!r} is invalid: expected a "
                 "whole number from 1 to 64 (windows of 62.5 ms)"
             )
-        self._core = _core.EpuckEnvCore(
-            None if scenario is None else os.fspath(scenario),
-            accuracy=_args.accuracy("accuracy", accuracy, optional=True),
-            overrides=None if overrides is None else dict(overrides),
-            save=None if save is None else os.fspath(save),
-        )
+        accuracy = _args.accuracy("accuracy", accuracy, optional=True)
+        with _progress.shown(progress, "errp/Epuck-v0") as report:
+            self._core = _core.EpuckEnvCore(
+                None if scenario is None else os.fspath(scenario),
+                accuracy=accuracy,
+                overrides=None if overrides is None else dict(overrides),
+                save=None if save is None else os.fspath(save),
+                progress=report,
+            )
         self.save = save
         self._full_warned = False
         # The recording is written by close(), or when the environment is
