@@ -485,11 +485,8 @@ pub(crate) fn sweep<'py>(
     // Ctrl-C also sets the sweep's own flag: the rows written so far are
     // kept, and the same call later resumes.
     let watch = SweepWatch::default();
-    if let Some(why) = opts.cache.unwritable() {
-        watch.keep(&format!(
-            "cache: the targeting cache cannot be written ({why}), so every decoder's accuracy \
-             targeting is searched again on every sweep (give another cache= directory)"
-        ));
+    if let Some(why) = opts.cache.unwritable("give another cache= directory") {
+        watch.keep(&format!("cache: {why}"));
     }
     let outcome = long_or(
         py,

@@ -39,6 +39,9 @@ impl PartialEq for TargetCache {
     }
 }
 
+/// What a cache that keeps nothing costs, for the user.
+const UNUSED: &str = "so every decoder's accuracy targeting is searched again on every run";
+
 #[derive(Serialize, Deserialize)]
 struct Entry {
     request: String,
@@ -82,35 +85,30 @@ impl TargetCache {
     /// tried now, with a temporary file). A sweep runs without it, each
     /// targeting searched afresh.
     pub fn problem(&self) -> Option<String> {
-        let unused = "so every decoder's accuracy targeting is searched again on every run";
         if self.unset {
             return Some(format!(
                 "no targeting cache: $ERRP_CACHE_DIR, $XDG_CACHE_HOME and $HOME are all unset, \
-                 {unused} (give --cache DIR, or --no-cache to turn it off)"
+                 {UNUSED} (give --cache DIR, or --no-cache to turn it off)"
             ));
         }
-        self.unwritable().map(|e| {
-            format!(
-                "the targeting cache cannot be written ({e}), {unused} (give another --cache \
-                 DIR, or --no-cache)"
-            )
-        })
+        self.unwritable("give another --cache DIR, or --no-cache")
     }
 
-    /// Why the cache directory cannot be written, if it cannot: it is
-    /// created if missing and tried now, with a temporary file. `None` also
-    /// when there is no directory. The caller tells the user; the entries
-    /// that then cannot be stored are not warned of one by one.
-    pub fn unwritable(&self) -> Option<String> {
+    /// Why the cache directory cannot be written, if it cannot, for the
+    /// user, ending with `advice` (what to give instead, in the words of
+    /// the front end): it is created if missing and tried now, with a
+    /// temporary file. `None` also when there is no directory. The caller
+    /// tells the user; the entries that then cannot be stored are not
+    /// warned of one by one.
+    pub fn unwritable(&self, advice: &str) -> Option<String> {
         let dir = self.dir.as_ref()?;
-        let why = errp_sim::create_dir(dir)
+        let e = errp_sim::create_dir(dir)
             .and_then(|()| errp_sim::PendingFile::create(dir.join("write-test")).map(drop))
-            .err()
-            .map(|e| e.to_string());
-        if why.is_some() {
-            self.told_unwritable.store(true, Ordering::Relaxed);
-        }
-        why
+            .err()?;
+        self.told_unwritable.store(true, Ordering::Relaxed);
+        Some(format!(
+            "the targeting cache cannot be written ({e}), {UNUSED} ({advice})"
+        ))
     }
 
     /// What was found wrong in the cache since the last call (each an
