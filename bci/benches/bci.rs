@@ -8,7 +8,7 @@ use divan::{Bencher, black_box};
 use errp_bci::{
     Assessment, AssessmentKind, CalibrationParams, CalibrationSetup, ContinuousFeatures,
     ContinuousSetup, EegGenerator, EpochWindow, ErrorModel, GeneratorParams, LdaDecoder, LdaModel,
-    Montage, Preprocessor, SessionOptions, SvmDecoder, SvmModel, Valid, calibrate,
+    Montage, Preprocessor, Realism, SessionOptions, SvmDecoder, SvmModel, Valid, calibrate,
     calibrate_continuous,
 };
 
@@ -51,6 +51,46 @@ fn generate_one_second(bencher: Bencher) {
     )
     .unwrap();
     bencher.bench_local(|| black_box(g.generate(FS)));
+}
+
+/// One second of all 40 channels with every effect of `Realism` on (drifts,
+/// electrode offsets, EMG bursts, pops, a bad channel, action blinks, and
+/// an ErrP that changes): the cost of the realistic user against
+/// `generate_one_second`.
+#[divan::bench]
+fn generate_one_second_realistic(bencher: Bencher) {
+    let params = Valid::new(GeneratorParams {
+        realism: Realism {
+            background_drift: 0.15,
+            alpha_drift: 0.3,
+            electrode_drift_uv: 20.0,
+            errp_amplitude_per_hour: -0.2,
+            expectancy: 0.5,
+            lapse_rate: 0.05,
+            misjudge_rate: 0.05,
+            emg_rate_hz: 0.1,
+            emg_uv: 20.0,
+            pop_rate_hz: 0.05,
+            pop_uv: 100.0,
+            bad_channel: "C2".into(),
+            bad_channel_uv: 10.0,
+            action_blink_probability: 0.3,
+            ..Realism::default()
+        },
+        ..GeneratorParams::default()
+    })
+    .unwrap();
+    let mut g = EegGenerator::new(&params, &Montage::standard(), 1).unwrap();
+    let mut onset = 0.5;
+    bencher.bench_local(|| {
+        // One action a second, as the e-puck's user judges.
+        g.schedule(Assessment {
+            onset_secs: onset,
+            kind: AssessmentKind::Error,
+        });
+        onset += 1.0;
+        black_box(g.generate(FS))
+    });
 }
 
 /// Preprocess (CAR + EOG regression + notch + band-pass, 8 output channels),

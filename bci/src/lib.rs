@@ -71,7 +71,7 @@ pub use error::{BciError, Result};
 pub use errp_valid::{Check, Valid};
 pub use features::{EpochWindow, FeatureExtractor};
 pub use filter::{Biquad, FilterBank, FilterChain};
-pub use generator::{Assessment, Components, EegBlock, EegGenerator, GeneratorParams};
+pub use generator::{Assessment, Components, EegBlock, EegGenerator, GeneratorParams, Realism};
 pub use lda::{LdaDecoder, LdaModel, Shrinkage, ledoit_wolf_shrinkage, pca_basis};
 pub use montage::{Channel, ChannelKind, DECODING_CHANNELS, Montage};
 pub use noise::{PinkNoise, Resonator};

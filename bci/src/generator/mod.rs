@@ -6,8 +6,11 @@ use serde::{Deserialize, Serialize};
 use crate::erp::AssessmentKind;
 use crate::error::{BciError, Result, check};
 
+mod effects;
+mod realism;
 mod stream;
 
+pub use realism::Realism;
 pub use stream::*;
 
 /// Parameters of the synthetic EEG. Amplitudes are in uV; every default is
@@ -51,6 +54,12 @@ pub struct GeneratorParams {
     pub latency_jitter_ms: f64,
     /// SD of the single-trial amplitude factor (mean 1, clipped at 0).
     pub amplitude_variability: f64,
+    /// How far the user is from the ideal one: drifts, an ErrP that
+    /// changes, lapses, artifacts ([`Realism`]; all off by default). Left
+    /// out of the serde form when ideal, so that the keys of an ideal user
+    /// are what they were before these effects existed.
+    #[serde(skip_serializing_if = "Realism::is_ideal")]
+    pub realism: Realism,
 }
 
 impl Default for GeneratorParams {
@@ -72,6 +81,7 @@ impl Default for GeneratorParams {
             errp_to_noise: 0.5,
             latency_jitter_ms: 25.0,
             amplitude_variability: 0.3,
+            realism: Realism::default(),
         }
     }
 }
@@ -138,7 +148,13 @@ impl GeneratorParams {
             "alpha_bandwidth_hz",
             self.alpha_bandwidth_hz,
             "a finite number > 0",
-        )
+        )?;
+        let montage = crate::montage::Montage::standard();
+        let eeg: Vec<&str> = montage.channels()[..montage.n_eeg()]
+            .iter()
+            .map(|c| c.name.as_str())
+            .collect();
+        self.realism.validate(&eeg)
     }
 }
 

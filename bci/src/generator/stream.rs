@@ -10,6 +10,7 @@ use rand_distr::{Exp, StandardNormal};
 
 use errp_valid::Valid;
 
+use super::effects::RealismState;
 use super::{Assessment, Components, EegBlock, GeneratorParams};
 use crate::erp::{AssessmentKind, ErpTemplates, waveform};
 use crate::error::Result;
@@ -81,6 +82,9 @@ pub struct EegGenerator {
     rng_alpha: ChaCha8Rng,
     rng_artifacts: ChaCha8Rng,
     rng_erp: ChaCha8Rng,
+    realism: RealismState,
+    bg_gain_buf: Vec<f64>,
+    alpha_gain_buf: Vec<f64>,
 }
 
 impl EegGenerator {
@@ -164,6 +168,7 @@ impl EegGenerator {
         .sqrt();
         let erp_scale = params.errp_to_noise * bg_sd_at_centre / templates.difference_peak_uv();
         let topography = templates.topography(montage)?;
+        let realism = RealismState::new(&params.realism, montage, fs, seed)?;
 
         let mut generator = Self {
             components: Components::default(),
@@ -199,6 +204,9 @@ impl EegGenerator {
             rng_alpha,
             rng_artifacts,
             rng_erp,
+            realism,
+            bg_gain_buf: Vec::new(),
+            alpha_gain_buf: Vec::new(),
             params,
         };
         generator.next_blink = generator.draw_interval(generator.params.blink_rate_hz);
@@ -239,18 +247,27 @@ impl EegGenerator {
     }
 
     /// Schedules the ERP of an assessment. Its single-trial latency jitter and
-    /// amplitude are drawn now, from the ERP stream, in scheduling order.
+    /// amplitude are drawn now, from the ERP stream, in scheduling order;
+    /// then what the user makes of the action ([`Realism`](super::Realism):
+    /// a lapse, a misjudgement, the expectancy, the session's slopes, a
+    /// blink after it), from a stream of its own.
     pub fn schedule(&mut self, assessment: Assessment) {
         let jitter_ms =
             self.params.latency_jitter_ms * self.rng_erp.sample::<f64, _>(StandardNormal);
         let gain = (1.0
             + self.params.amplitude_variability * self.rng_erp.sample::<f64, _>(StandardNormal))
         .max(0.0);
+        let perceived = self
+            .realism
+            .perceive(assessment.kind, assessment.onset_secs);
+        let Some(kind) = perceived.kind else {
+            return;
+        };
         let erp = ActiveErp {
             onset_sample: assessment.onset_secs * self.params.sfreq_hz,
-            kind: assessment.kind,
-            jitter_ms,
-            gain,
+            kind,
+            jitter_ms: jitter_ms + perceived.shift_ms,
+            gain: gain * perceived.gain,
         };
         // Kept sorted by onset so that rendering stops at the first future ERP.
         let at = self
@@ -292,6 +309,7 @@ impl EegGenerator {
         let fs = self.params.sfreq_hz;
         let c = self.components;
         let bg = if c.background { 1.0 } else { 0.0 };
+        let start = self.sample;
 
         // 1. White noise: per sample, n_ch drivers of the 1/f sources and
         //    n_ch sensor-noise values, as 16-bit uniforms scaled to unit
@@ -317,6 +335,25 @@ impl EegGenerator {
                 *v = unit(uniforms[t * stride + n_ch + ch]);
             }
         }
+
+        // 2b. Drifts of the background's and alpha's amplitude (Realism).
+        let drifts = self.realism.drifts();
+        if drifts {
+            self.bg_gain_buf.clear();
+            self.alpha_gain_buf.clear();
+            for _ in 0..n {
+                let (g_bg, g_alpha) = self.realism.drift_gains();
+                self.bg_gain_buf.push(g_bg);
+                self.alpha_gain_buf.push(g_alpha);
+            }
+            let (sources, _) = self.scratch.split_at_mut(n_ch * n);
+            for row in sources.chunks_exact_mut(n) {
+                for (v, g) in row.iter_mut().zip(&self.bg_gain_buf) {
+                    *v *= g;
+                }
+            }
+        }
+        let sources = &self.scratch[..n_ch * n];
 
         // 3. Spatial mixing of the EEG sources (lower-triangular), four
         //    sources per pass over the output row; EOG channels keep their own
@@ -352,6 +389,11 @@ impl EegGenerator {
 
         // 4. Sources shared by all channels, one value per sample.
         self.shared_sources(n);
+        if drifts {
+            for (v, g) in self.alpha_buf.iter_mut().zip(&self.alpha_gain_buf) {
+                *v *= g;
+            }
+        }
 
         // 5. Per channel: add everything with that channel's weights.
         let sensor = bg * self.params.sensor_noise_uv;
@@ -380,6 +422,8 @@ impl EegGenerator {
                     + tw * erp[t];
             }
         }
+        let art = if c.artifacts { 1.0 } else { 0.0 };
+        self.realism.add_artifacts(&mut block.data, start, n, art);
         let now = self.sample as f64;
         let erp_len = ERP_LENGTH_SECS * fs;
         self.erps.retain(|e| now < e.onset_sample + erp_len);
@@ -419,6 +463,9 @@ impl EegGenerator {
                 self.blinks.push((self.next_blink, amp));
                 self.next_blink = self.draw_interval(self.params.blink_rate_hz);
             }
+            let (blinks, blink_uv) = (&mut self.blinks, self.params.blink_uv);
+            self.realism
+                .blinks_due(s, |at, amp| blinks.push((at, blink_uv * amp)));
             while s >= self.next_saccade {
                 self.gaze_from = self.gaze_at(s, saccade_len);
                 self.gaze_to =

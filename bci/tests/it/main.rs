@@ -5,3 +5,4 @@ mod continuous;
 mod decoder;
 mod determinism;
 mod eeg;
+mod realism;

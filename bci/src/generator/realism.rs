@@ -1,0 +1,249 @@
+//! The simulated user as real users are: a background that drifts,
+//! electrodes whose offsets wander, an ErrP that changes over the session,
+//! with the recent error rate and with the task, lapses of attention and of
+//! judgement, and artifacts the paper's preprocessing does not remove.
+//!
+//! Every effect is a field of [`Realism`], off at its default (the
+//! idealised user of the paper's reading), and each is drawn from a random
+//! stream of its own: with every effect off the generator's samples are
+//! those of a generator without this module, bit for bit, and switching one
+//! effect on never shifts the draws of another. The sources of each
+//! effect's published size are in the guide's simulation chapter.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{BciError, Result, check};
+
+/// How far from the ideal user the simulated one is. Every field is 0 (or
+/// neutral) by default, which is the idealised user: stationary EEG, the
+/// same ErrP in calibration and control, no lapses, no artifact beyond the
+/// blinks, saccades and mains of [`GeneratorParams`](super::GeneratorParams).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Realism {
+    /// SD of the background's log amplitude (1/f part), a slow
+    /// Ornstein-Uhlenbeck process with time constant `drift_secs`: 0.1
+    /// means the background's amplitude wanders by about +-10 %.
+    pub background_drift: f64,
+    /// SD of the alpha rhythm's log amplitude, likewise (alpha waxes and
+    /// wanes with vigilance: the spectrum's shape drifts).
+    pub alpha_drift: f64,
+    /// Time constant of both drifts (s).
+    pub drift_secs: f64,
+    /// SD of each electrode's slowly wandering offset before the band-pass
+    /// (uV), an Ornstein-Uhlenbeck process with time constant
+    /// `electrode_drift_secs`.
+    pub electrode_drift_uv: f64,
+    /// Time constant of the electrode offsets (s).
+    pub electrode_drift_secs: f64,
+    /// Relative change of the ERP amplitude per hour of session (habituation
+    /// or fatigue when negative): the amplitude factor is
+    /// `max(0, 1 + errp_amplitude_per_hour * hours)`.
+    pub errp_amplitude_per_hour: f64,
+    /// Change of the ERP latency per hour of session (ms per hour).
+    pub errp_latency_ms_per_hour: f64,
+    /// How much the error ERP shrinks as errors become expected: its
+    /// amplitude factor is `max(0, 1 - expectancy * (q - expectancy_reference))`
+    /// where q is the user's recent error rate (an exponentially weighted
+    /// mean over `expectancy_actions` perceived actions).
+    pub expectancy: f64,
+    /// The error rate at which the error ERP has its template amplitude
+    /// (the calibration protocol's 20 %); q starts there.
+    pub expectancy_reference: f64,
+    /// How many recent actions the error rate q weighs (the weight of an
+    /// action falls by e over this many).
+    pub expectancy_actions: f64,
+    /// ERP latency shift of this phase (ms): the task's and the day's, set by
+    /// the task for its closed loop (positive: later).
+    pub erp_latency_shift_ms: f64,
+    /// ERP amplitude factor of this phase: the task's and the day's.
+    pub erp_gain: f64,
+    /// The session clock at the generator's start (s): where in the session
+    /// this stream begins, for the per-hour slopes and the decline of
+    /// attention (a closed loop starts after its calibration).
+    pub clock_offset_secs: f64,
+    /// Fraction of actions not attended: no ERP at all follows them.
+    pub lapse_rate: f64,
+    /// Rise of `lapse_rate` per hour of session (declining attention);
+    /// the sum is capped at 1.
+    pub lapse_per_hour: f64,
+    /// Fraction of attended actions judged the wrong way: an error without
+    /// an ErrP, or an ErrP after a correct action.
+    pub misjudge_rate: f64,
+    /// Rate of muscle (EMG) bursts (per second).
+    pub emg_rate_hz: f64,
+    /// SD of an EMG burst at its peak on the most affected (temporal)
+    /// channels (uV), broadband, so that part of it falls in 1-10 Hz.
+    pub emg_uv: f64,
+    /// Mean duration of an EMG burst (s).
+    pub emg_secs: f64,
+    /// Rate of electrode pops (per second, over the whole montage).
+    pub pop_rate_hz: f64,
+    /// Mean size of an electrode pop (uV): a step that decays with a 0.3 s
+    /// time constant.
+    pub pop_uv: f64,
+    /// An EEG channel with a poor contact ("" for none).
+    pub bad_channel: String,
+    /// SD of the extra broadband noise on `bad_channel` (uV).
+    pub bad_channel_uv: f64,
+    /// Probability that the user blinks after an action they judged.
+    pub action_blink_probability: f64,
+    /// Mean latency of such a blink after the action (ms); its SD is a
+    /// quarter of it.
+    pub action_blink_latency_ms: f64,
+}
+
+impl Default for Realism {
+    fn default() -> Self {
+        Self {
+            background_drift: 0.0,
+            alpha_drift: 0.0,
+            drift_secs: 60.0,
+            electrode_drift_uv: 0.0,
+            electrode_drift_secs: 30.0,
+            errp_amplitude_per_hour: 0.0,
+            errp_latency_ms_per_hour: 0.0,
+            expectancy: 0.0,
+            expectancy_reference: 0.2,
+            expectancy_actions: 10.0,
+            erp_latency_shift_ms: 0.0,
+            erp_gain: 1.0,
+            clock_offset_secs: 0.0,
+            lapse_rate: 0.0,
+            lapse_per_hour: 0.0,
+            misjudge_rate: 0.0,
+            emg_rate_hz: 0.0,
+            emg_uv: 0.0,
+            emg_secs: 1.0,
+            pop_rate_hz: 0.0,
+            pop_uv: 0.0,
+            bad_channel: String::new(),
+            bad_channel_uv: 0.0,
+            action_blink_probability: 0.0,
+            action_blink_latency_ms: 400.0,
+        }
+    }
+}
+
+/// Largest latency shift of a phase, and largest per-hour latency slope
+/// (ms): the ERP window is 1.2 s long.
+const MAX_SHIFT_MS: f64 = 300.0;
+/// Longest session clock (s): a day.
+const MAX_CLOCK_SECS: f64 = 86_400.0;
+
+impl Realism {
+    /// True if every field is at its default: the idealised user.
+    pub fn is_ideal(&self) -> bool {
+        *self == Self::default()
+    }
+
+    /// Checks every field; the error names it (`realism.<field>`) and the
+    /// accepted range.
+    pub(crate) fn validate(&self, montage_names: &[&str]) -> Result<()> {
+        let fraction = "a fraction in [0, 1]";
+        for (name, v) in [
+            ("realism.lapse_rate", self.lapse_rate),
+            ("realism.misjudge_rate", self.misjudge_rate),
+            (
+                "realism.action_blink_probability",
+                self.action_blink_probability,
+            ),
+            ("realism.expectancy_reference", self.expectancy_reference),
+        ] {
+            check((0.0..=1.0).contains(&v), name, v, fraction)?;
+        }
+        for (name, v, max) in [
+            ("realism.background_drift", self.background_drift, 1.0),
+            ("realism.alpha_drift", self.alpha_drift, 1.0),
+            (
+                "realism.electrode_drift_uv",
+                self.electrode_drift_uv,
+                10_000.0,
+            ),
+            ("realism.expectancy", self.expectancy, 10.0),
+            ("realism.lapse_per_hour", self.lapse_per_hour, 10.0),
+            ("realism.emg_rate_hz", self.emg_rate_hz, 10.0),
+            ("realism.emg_uv", self.emg_uv, 1000.0),
+            ("realism.pop_rate_hz", self.pop_rate_hz, 10.0),
+            ("realism.pop_uv", self.pop_uv, 10_000.0),
+            ("realism.bad_channel_uv", self.bad_channel_uv, 1000.0),
+            (
+                "realism.clock_offset_secs",
+                self.clock_offset_secs,
+                MAX_CLOCK_SECS,
+            ),
+            ("realism.erp_gain", self.erp_gain, 10.0),
+        ] {
+            check(
+                v.is_finite() && (0.0..=max).contains(&v),
+                name,
+                v,
+                &format!("a number in [0, {max}]"),
+            )?;
+        }
+        for (name, v, min, max) in [
+            ("realism.drift_secs", self.drift_secs, 1.0, 86_400.0),
+            (
+                "realism.electrode_drift_secs",
+                self.electrode_drift_secs,
+                1.0,
+                86_400.0,
+            ),
+            (
+                "realism.expectancy_actions",
+                self.expectancy_actions,
+                1.0,
+                10_000.0,
+            ),
+            ("realism.emg_secs", self.emg_secs, 0.05, 10.0),
+            (
+                "realism.action_blink_latency_ms",
+                self.action_blink_latency_ms,
+                0.0,
+                2000.0,
+            ),
+        ] {
+            check(
+                v.is_finite() && (min..=max).contains(&v),
+                name,
+                v,
+                &format!("a number in [{min}, {max}]"),
+            )?;
+        }
+        for (name, v, bound) in [
+            (
+                "realism.errp_amplitude_per_hour",
+                self.errp_amplitude_per_hour,
+                1.0,
+            ),
+            (
+                "realism.errp_latency_ms_per_hour",
+                self.errp_latency_ms_per_hour,
+                MAX_SHIFT_MS,
+            ),
+            (
+                "realism.erp_latency_shift_ms",
+                self.erp_latency_shift_ms,
+                MAX_SHIFT_MS,
+            ),
+        ] {
+            check(
+                v.is_finite() && v.abs() <= bound,
+                name,
+                v,
+                &format!("a number in [-{bound}, {bound}]"),
+            )?;
+        }
+        if !self.bad_channel.is_empty() && !montage_names.contains(&self.bad_channel.as_str()) {
+            return Err(BciError::InvalidParameter {
+                name: "realism.bad_channel",
+                value: format!("{:?}", self.bad_channel),
+                expected: format!(
+                    "an EEG channel of the montage ({}), or \"\" for none",
+                    montage_names.join(", ")
+                ),
+            });
+        }
+        Ok(())
+    }
+}
