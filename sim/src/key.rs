@@ -64,6 +64,16 @@ impl StableKey {
         self
     }
 
+    /// The simulated user's realism, unless ideal: an ideal user's key is
+    /// the key from before realism existed, so caches stay valid.
+    pub fn realism(self, realism: &errp_bci::Realism) -> Self {
+        if realism.is_ideal() {
+            self
+        } else {
+            self.value("realism", realism)
+        }
+    }
+
     /// The key.
     pub fn finish(self) -> String {
         self.text

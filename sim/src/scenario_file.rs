@@ -253,6 +253,30 @@ pub(crate) fn field_error(path: &Path, field: &str, value: String, expected: &st
     ))
 }
 
+/// The `[realism]` table of a scenario, checked: the error names the field
+/// (`realism.<name>`), its value and the accepted range.
+pub(crate) fn checked_realism(
+    realism: errp_bci::Realism,
+    path: &Path,
+) -> Result<errp_bci::Realism> {
+    let params = errp_bci::GeneratorParams {
+        realism,
+        ..errp_bci::GeneratorParams::default()
+    };
+    match errp_bci::Valid::new(params) {
+        Ok(p) => Ok(p.into_inner().realism),
+        Err(errp_bci::BciError::InvalidParameter {
+            name,
+            value,
+            expected,
+        }) => Err(field_error(path, name, value, &expected)),
+        Err(other) => Err(SimError::Scenario(format!(
+            "{}: [realism] {other}",
+            path.display()
+        ))),
+    }
+}
+
 /// The scenario's `name`, or its file name without the extension.
 pub(crate) fn scenario_name(name: Option<String>, path: &Path) -> String {
     name.unwrap_or_else(|| {

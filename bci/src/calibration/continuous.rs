@@ -94,7 +94,13 @@ impl Check for ContinuousCalibrationParams {
     }
 }
 
-impl Protocol for ContinuousCalibrationParams {}
+impl Protocol for ContinuousCalibrationParams {
+    fn duration_secs(&self) -> f64 {
+        self.eog_session_secs
+            + 2.0
+            + 2.0 * self.per_class as f64 * 0.5 * (self.interval_min_secs + self.interval_max_secs)
+    }
+}
 
 /// A simulated user and recording for the continuous decoder: the EEG
 /// model, the button-locked protocol, the preprocessing and the montage.

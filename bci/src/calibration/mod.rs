@@ -5,7 +5,7 @@ use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{BciError, Result, check};
-use crate::generator::GeneratorParams;
+use crate::generator::{GeneratorParams, Realism};
 use crate::montage::Montage;
 use crate::preprocess::{PreprocessParams, Preprocessing};
 
@@ -168,6 +168,9 @@ impl GrandAverage {
 pub trait Protocol:
     Check<Error = BciError> + std::fmt::Debug + Clone + PartialEq + Default
 {
+    /// The session's expected length (s): where on the user's session
+    /// clock a closed loop that follows it starts.
+    fn duration_secs(&self) -> f64;
 }
 
 impl Check for CalibrationParams {
@@ -178,7 +181,12 @@ impl Check for CalibrationParams {
     }
 }
 
-impl Protocol for CalibrationParams {}
+impl Protocol for CalibrationParams {
+    fn duration_secs(&self) -> f64 {
+        self.eog_session_secs
+            + self.n_actions as f64 * 0.5 * (self.interval_min_secs + self.interval_max_secs)
+    }
+}
 
 /// How closely and how hard to search for an ErrP-to-noise ratio (for an
 /// accuracy, or for an online hit rate).
@@ -270,6 +278,23 @@ impl<P: Protocol> Setup<P> {
             generator: self.generator.with(|g| g.errp_to_noise = ratio)?,
             ..self.clone()
         })
+    }
+
+    /// This setup with the user of the given `realism` (checked again).
+    pub fn with_realism(&self, realism: &Realism) -> Result<Self> {
+        Ok(Self {
+            generator: self.generator.with(|g| g.realism = realism.clone())?,
+            ..self.clone()
+        })
+    }
+
+    /// The EEG model of the closed loop that follows this calibration by
+    /// user `seed` ([`Realism::closed_loop`]): the same as the
+    /// calibration's for an ideal user.
+    pub fn closed_loop_generator(&self, seed: u64) -> Result<Valid<GeneratorParams>> {
+        let secs = self.calibration.duration_secs();
+        self.generator
+            .with(|g| g.realism = g.realism.closed_loop(secs, seed))
     }
 }
 

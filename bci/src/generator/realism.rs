@@ -10,9 +10,12 @@
 //! effect on never shifts the draws of another. The sources of each
 //! effect's published size are in the guide's simulation chapter.
 
+use rand::Rng;
+use rand_distr::StandardNormal;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{BciError, Result, check};
+use crate::rng::{derive_seed, stream};
 
 /// How far from the ideal user the simulated one is. Every field is 0 (or
 /// neutral) by default, which is the idealised user: stationary EEG, the
@@ -86,6 +89,19 @@ pub struct Realism {
     pub bad_channel: String,
     /// SD of the extra broadband noise on `bad_channel` (uV).
     pub bad_channel_uv: f64,
+    /// ERP latency shift of the closed loop against calibration (ms): the
+    /// task differs (the grid's calibration and control differ little, the
+    /// e-puck's button-locked calibration and continuous motion more).
+    pub task_latency_ms: f64,
+    /// ERP amplitude factor of the closed loop against calibration.
+    pub task_gain: f64,
+    /// Days between the calibration and the closed loop (0: the same
+    /// session). Each day draws its own ERP shift from the user's seed.
+    pub day: u32,
+    /// SD of a day's ERP latency shift (ms).
+    pub day_latency_sd_ms: f64,
+    /// SD of a day's log ERP amplitude factor.
+    pub day_gain_sd: f64,
     /// Probability that the user blinks after an action they judged.
     pub action_blink_probability: f64,
     /// Mean latency of such a blink after the action (ms); its SD is a
@@ -109,6 +125,11 @@ impl Default for Realism {
             erp_latency_shift_ms: 0.0,
             erp_gain: 1.0,
             clock_offset_secs: 0.0,
+            task_latency_ms: 0.0,
+            task_gain: 1.0,
+            day: 0,
+            day_latency_sd_ms: 0.0,
+            day_gain_sd: 0.0,
             lapse_rate: 0.0,
             lapse_per_hour: 0.0,
             misjudge_rate: 0.0,
@@ -135,6 +156,37 @@ impl Realism {
     /// True if every field is at its default: the idealised user.
     pub fn is_ideal(&self) -> bool {
         *self == Self::default()
+    }
+
+    /// The user in the closed loop that follows a calibration of
+    /// `calibration_secs` by this user (`seed`): the task's ERP shift on
+    /// top of this phase's, and, on another day, that day's shift (drawn
+    /// from the seed and the day, so a user's day is the same in every run)
+    /// with a session clock that starts afresh; on the same day the clock
+    /// goes on from the calibration's end. The closed-loop fields
+    /// themselves are kept, so the result is the same user.
+    pub fn closed_loop(&self, calibration_secs: f64, seed: u64) -> Self {
+        let mut online = self.clone();
+        online.erp_latency_shift_ms += self.task_latency_ms;
+        online.erp_gain *= self.task_gain;
+        if self.day == 0 {
+            online.clock_offset_secs =
+                (self.clock_offset_secs + calibration_secs).min(MAX_CLOCK_SECS);
+        } else {
+            let mut rng = stream(
+                derive_seed(seed, "realism/day", u64::from(self.day)),
+                "realism/day",
+            );
+            let z_latency: f64 = rng.sample(StandardNormal);
+            let z_gain: f64 = rng.sample(StandardNormal);
+            online.erp_latency_shift_ms += self.day_latency_sd_ms * z_latency;
+            online.erp_gain *= (self.day_gain_sd * z_gain).exp();
+        }
+        online.erp_latency_shift_ms = online
+            .erp_latency_shift_ms
+            .clamp(-MAX_SHIFT_MS, MAX_SHIFT_MS);
+        online.erp_gain = online.erp_gain.min(10.0);
+        online
     }
 
     /// Checks every field; the error names it (`realism.<field>`) and the
@@ -173,6 +225,9 @@ impl Realism {
                 MAX_CLOCK_SECS,
             ),
             ("realism.erp_gain", self.erp_gain, 10.0),
+            ("realism.task_gain", self.task_gain, 10.0),
+            ("realism.day_latency_sd_ms", self.day_latency_sd_ms, 100.0),
+            ("realism.day_gain_sd", self.day_gain_sd, 1.0),
         ] {
             check(
                 v.is_finite() && (0.0..=max).contains(&v),
@@ -234,6 +289,12 @@ impl Realism {
                 &format!("a number in [-{bound}, {bound}]"),
             )?;
         }
+        check(
+            self.day <= 3650,
+            "realism.day",
+            self.day,
+            "a whole number of days in [0, 3650]",
+        )?;
         if !self.bad_channel.is_empty() && !montage_names.contains(&self.bad_channel.as_str()) {
             return Err(BciError::InvalidParameter {
                 name: "realism.bad_channel",

@@ -5,10 +5,10 @@
 use errp_bci::{
     Accuracy, ContinuousCalibrationParams, ContinuousFeatures, Detector, DetectorMode,
     DetectorParams, EegGenerator, GeneratorParams, Montage, OnlineRecording, OnlineRecordingParams,
-    OnlineStep, OnlineTarget, OnlineTargeting, OperatingPoint, Preprocessor, ResponseSpan,
-    SlidingWindow, SvmDecoder, SvmModel, TargetingParams, TargetingResult, TargetingStep, Valid,
-    calibrate_continuous, detector_span, operating_point, record_online, rng::derive_seed,
-    target_continuous_accuracy, target_online,
+    OnlineStep, OnlineTarget, OnlineTargeting, OperatingPoint, Preprocessor, Protocol,
+    ResponseSpan, SlidingWindow, SvmDecoder, SvmModel, TargetingParams, TargetingResult,
+    TargetingStep, Valid, calibrate_continuous, detector_span, operating_point, record_online,
+    rng::derive_seed, target_continuous_accuracy, target_online,
 };
 
 use crate::calibration::{Report, Request};
@@ -198,7 +198,7 @@ pub fn run_online_calibration(
         .into_iter()
         .find(|(ratio, _, _)| ratio.to_bits() == search.ratio.to_bits())
         .expect("the ratio found is one of the evaluations");
-    let mut decoder = ContinuousDecoder::from_report(&report);
+    let mut decoder = ContinuousDecoder::from_report(&report).with_closed_loop(request.seed)?;
     decoder.online = Some(OnlineReport::from_recording(
         &recording, detector, search.t_e,
     )?);
@@ -222,8 +222,14 @@ fn held_out_seed(seed: u64) -> u64 {
 /// does online.
 #[derive(Debug, Clone)]
 pub struct ContinuousDecoder {
-    /// The synthetic user's EEG model (at the calibrated ErrP-to-noise ratio).
+    /// The synthetic user's EEG model (at the calibrated ErrP-to-noise
+    /// ratio) as calibrated: the held-out recording's.
     pub generator: Valid<GeneratorParams>,
+    /// The same user in the closed loop ([`Realism::closed_loop`]; the same
+    /// model for an ideal user): what the episodes stream.
+    ///
+    /// [`Realism::closed_loop`]: errp_bci::Realism::closed_loop
+    pub closed_loop: Valid<GeneratorParams>,
     /// The montage.
     pub montage: Montage,
     /// Preprocessing fitted during calibration.
@@ -242,12 +248,24 @@ impl ContinuousDecoder {
     pub fn from_report(report: &ContinuousReport) -> Self {
         Self {
             generator: report.generator.clone(),
+            closed_loop: report.generator.clone(),
             montage: Montage::standard(),
             preprocessor: report.calibrated.session.preprocessor.clone(),
             model: report.calibrated.model.clone(),
             features: ContinuousFeatures::paper(report.generator.sfreq_hz),
             online: None,
         }
+    }
+
+    /// This decoder with the closed loop of user `seed` after the
+    /// calibration ([`ContinuousCalibrationParams`]'s session):
+    /// [`Realism::closed_loop`](errp_bci::Realism::closed_loop).
+    pub fn with_closed_loop(mut self, seed: u64) -> Result<Self> {
+        let secs = ContinuousCalibrationParams::default().duration_secs();
+        self.closed_loop = self
+            .generator
+            .with(|g| g.realism = g.realism.closed_loop(secs, seed))?;
+        Ok(self)
     }
 
     /// The held-out continuous recording of this pipeline for a calibration
@@ -310,7 +328,7 @@ impl ContinuousDecoder {
     /// filters settled; episode time 0 is generator time
     /// [`WARM_UP_SECS`](errp_bci::WARM_UP_SECS).
     pub fn start_stream(&self, seed: u64) -> Result<SlidingWindow> {
-        let generator = EegGenerator::new(&self.generator, &self.montage, seed)?;
+        let generator = EegGenerator::new(&self.closed_loop, &self.montage, seed)?;
         Ok(SlidingWindow::start(
             generator,
             &self.preprocessor,

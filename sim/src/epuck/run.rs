@@ -2,7 +2,7 @@
 //! scenario's accuracy, then every run of the episode, each from its own
 //! derived seed (in parallel when no recording watches).
 
-use errp_bci::{Accuracy, OnlineStep, TargetingResult, TargetingStep, rng::derive_seed};
+use errp_bci::{Accuracy, OnlineStep, TargetingResult, TargetingStep, Valid, rng::derive_seed};
 use rayon::prelude::*;
 
 use crate::calibration::{NoCache, TargetingCache};
@@ -62,7 +62,11 @@ pub fn prepare_epuck_decoder(
     mut progress: impl FnMut(&TargetingStep),
     online_progress: impl FnMut(&OnlineStep),
 ) -> Result<PreparedEpuck> {
-    let request = ContinuousRequest::new(scenario.accuracy, scenario.user_seed);
+    let base = ContinuousRequest::new(scenario.accuracy, scenario.user_seed);
+    let request = ContinuousRequest {
+        setup: Valid::new(base.setup.with_realism(&scenario.realism)?)?,
+        ..base
+    };
     match scenario.online_target {
         None => {
             let mut find = || target_continuous(&request, &mut progress);
@@ -118,7 +122,8 @@ pub fn finish_continuous_decoder(
     scenario: &EpuckScenario,
     report: &ContinuousReport,
 ) -> Result<ContinuousDecoder> {
-    let mut decoder = ContinuousDecoder::from_report(report);
+    let mut decoder =
+        ContinuousDecoder::from_report(report).with_closed_loop(scenario.user_seed)?;
     decoder.measure_online(
         scenario.params.detector,
         scenario.params.control.t_e,

@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use errp_bci::{DetectorMode, DetectorParams, MeanAccuracy, OnlineTarget};
+use errp_bci::{DetectorMode, DetectorParams, MeanAccuracy, OnlineTarget, Realism};
 use errp_robot::{ContinuousControlParams, GoalLayout, Pose, Valid};
 
 use crate::epuck::params::{EpuckEpisode, EpuckTaskParams};
@@ -17,7 +17,8 @@ use crate::epuck::user::UserParams;
 use crate::epuck::world::{ArenaSpec, Obstacle};
 use crate::error::{Result, SimError};
 use crate::scenario_file::{
-    field_error, parse_toml, read_scenario, robot_error, scenario_name, table_into, whole,
+    checked_realism, field_error, parse_toml, read_scenario, robot_error, scenario_name,
+    table_into, whole,
 };
 
 /// Most runs of one e-puck scenario.
@@ -79,6 +80,8 @@ pub struct EpuckScenario {
     pub layout: GoalLayout,
     /// Robot, control, user, tracker, avoidance, time-out.
     pub params: EpuckTaskParams,
+    /// How far the simulated user is from the ideal one (`[realism]`).
+    pub realism: Realism,
 }
 
 impl EpuckScenario {
@@ -180,6 +183,7 @@ impl EpuckScenario {
             None => 1,
         };
         let arena = arena(&file, &layout, start, radius_m, path)?;
+        let realism = checked_realism(file.realism.clone(), path)?;
 
         Ok(Self {
             path: path.to_path_buf(),
@@ -194,6 +198,7 @@ impl EpuckScenario {
             arena,
             layout,
             params,
+            realism,
         })
     }
 }

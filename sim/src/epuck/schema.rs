@@ -41,6 +41,10 @@ pub(crate) struct EpuckFile {
     pub(crate) detector: Option<DetectorFile>,
     #[serde(default)]
     pub(crate) arena: Option<ArenaFile>,
+    /// Straight into the EEG model's type: how far the user is from the
+    /// ideal one (all off by default).
+    #[serde(default)]
+    pub(crate) realism: errp_bci::Realism,
 }
 
 #[derive(Debug, Deserialize)]

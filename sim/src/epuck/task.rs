@@ -112,6 +112,7 @@ impl Task for EpuckTask {
             .value("online_target", &s.online_target)
             .value("detector", &s.params.detector)
             .float("t_e", s.params.control.t_e)
+            .realism(&s.realism)
             .finish()
     }
 

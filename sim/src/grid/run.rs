@@ -42,6 +42,14 @@ pub fn pooled_accuracy(episodes: &[GridEpisodeResult]) -> Accuracy {
     Accuracy::pooled(episodes.iter().map(|r| &r.online))
 }
 
+/// The calibration setup of a grid scenario: the paper's protocol and the
+/// default EEG model, with the scenario's user (`[realism]`).
+fn grid_setup(s: &GridScenario) -> Result<Valid<CalibrationSetup>> {
+    Ok(Valid::new(
+        CalibrationSetup::default().with_realism(&s.realism)?,
+    )?)
+}
+
 /// Builds the scenario's decoder: for the EEG decoder, a calibration session
 /// targeted at the scenario's accuracy (`progress` sees the search). The
 /// path of `errp run` and Table 1: [`prepare_grid_decoder`] with nothing
@@ -97,7 +105,7 @@ impl PreparedGrid {
 /// Empty, [`prepare_grid_decoder`] simulates what a scenario needs itself.
 #[derive(Debug, Default)]
 pub struct GridShared {
-    sessions: HashMap<u64, Arc<SessionParts>>,
+    sessions: HashMap<String, Arc<SessionParts>>,
     banks: HashMap<String, Arc<EpochBankParts>>,
     held_out: HashMap<String, Arc<EpochBankParts>>,
 }
@@ -106,16 +114,34 @@ pub struct GridShared {
 /// the measured mean accuracy about 0.7 points at 75 %).
 pub const HELD_OUT_PER_CLASS: usize = 2000;
 
+/// The key of a grid scenario's calibration session: its user.
+fn session_key(s: &GridScenario) -> String {
+    format!("{}{}", s.seed, realism_key(s))
+}
+
+/// The user's realism in a key: nothing for the ideal user, so that the
+/// keys of an ideal user are what they were before realism existed.
+fn realism_key(s: &GridScenario) -> String {
+    if s.realism.is_ideal() {
+        String::new()
+    } else {
+        crate::key::StableKey::new("user", 1)
+            .realism(&s.realism)
+            .finish()
+    }
+}
+
 /// The key of a grid scenario's held-out epochs (what they depend on).
 fn held_out_key(s: &GridScenario) -> String {
     format!(
-        "{:?}",
+        "{:?}{}",
         (
             s.seed,
             HELD_OUT_PER_CLASS,
             s.params.interval_min_secs,
             s.params.interval_max_secs
-        )
+        ),
+        realism_key(s)
     )
 }
 
@@ -139,13 +165,14 @@ fn build_held_out(
 /// The key of a grid scenario's epoch bank: what its epochs depend on.
 fn bank_key(s: &GridScenario) -> String {
     format!(
-        "{:?}",
+        "{:?}{}",
         (
             s.seed,
             s.bank_per_class,
             s.params.interval_min_secs,
             s.params.interval_max_secs
-        )
+        ),
+        realism_key(s)
     )
 }
 
@@ -170,8 +197,9 @@ fn build_bank(
 }
 
 /// `per_class` epochs of each class from `seed`, streamed at `s`'s
-/// inter-action intervals: the EEG of the user of `setup` through
-/// `session`'s preprocessing.
+/// inter-action intervals: the EEG of the user of `setup` in the closed
+/// loop that follows the calibration ([`CalibrationSetup::closed_loop_generator`])
+/// through `session`'s preprocessing.
 fn stream_parts(
     s: &GridScenario,
     setup: &Valid<CalibrationSetup>,
@@ -179,8 +207,9 @@ fn stream_parts(
     per_class: usize,
     seed: u64,
 ) -> Result<EpochBankParts> {
+    let generator = setup.closed_loop_generator(s.seed)?;
     let source = EegSource {
-        generator: &setup.generator,
+        generator: &generator,
         montage: &setup.montage,
         preprocessor: session.preprocessor(),
     };
@@ -193,23 +222,26 @@ impl GridShared {
     /// paper's protocol and the default EEG model, as every grid scenario
     /// is calibrated.
     pub fn build<'a>(scenarios: impl IntoIterator<Item = &'a GridScenario>) -> Result<Self> {
-        let setup: Valid<CalibrationSetup> = Valid::default();
         let mut shared = Self::default();
         for s in scenarios {
             if s.decoder != DecoderChoice::Eeg {
                 continue;
             }
-            if let std::collections::hash_map::Entry::Vacant(slot) = shared.sessions.entry(s.seed) {
+            let setup = grid_setup(s)?;
+            let session = session_key(s);
+            if let std::collections::hash_map::Entry::Vacant(slot) =
+                shared.sessions.entry(session.clone())
+            {
                 slot.insert(Arc::new(simulate_parts(&setup, s.seed)?));
             }
             let key = held_out_key(s);
             if !shared.held_out.contains_key(&key) {
-                let held_out = build_held_out(s, &setup, &shared.sessions[&s.seed])?;
+                let held_out = build_held_out(s, &setup, &shared.sessions[&session])?;
                 shared.held_out.insert(key, Arc::new(held_out));
             }
             let key = bank_key(s);
             if s.eeg == EegMode::Bank && !shared.banks.contains_key(&key) {
-                let bank = build_bank(s, &setup, &shared.sessions[&s.seed])?;
+                let bank = build_bank(s, &setup, &shared.sessions[&session])?;
                 shared.banks.insert(key, Arc::new(bank));
             }
         }
@@ -238,9 +270,12 @@ pub fn prepare_grid_decoder(
             cached: false,
         });
     }
-    let request = CalibrationRequest::new(MeanAccuracy::new(scenario.accuracy)?, scenario.seed);
+    let request = CalibrationRequest {
+        setup: grid_setup(scenario)?,
+        ..CalibrationRequest::new(MeanAccuracy::new(scenario.accuracy)?, scenario.seed)
+    };
     let simulated;
-    let parts = match shared.sessions.get(&scenario.seed) {
+    let parts = match shared.sessions.get(&session_key(scenario)) {
         Some(parts) => parts.as_ref(),
         None => {
             simulated = simulate_parts(&request.setup, scenario.seed)?;
@@ -286,7 +321,11 @@ pub fn prepare_grid_decoder(
         targeting,
         calibrated,
     };
-    let eeg = EegDecoder::from_report(&report, scenario.p_error);
+    let mut eeg = EegDecoder::from_report(&report, scenario.p_error);
+    eeg.generator = request
+        .setup
+        .at_ratio(report.targeting.ratio)?
+        .closed_loop_generator(scenario.seed)?;
     let decoder = match scenario.eeg {
         EegMode::Stream => AssessmentDecoder::Eeg(Box::new(eeg)),
         EegMode::Bank => {
@@ -360,6 +399,7 @@ pub fn eeg_decoder(accuracy: f64, seed: u64) -> Result<AssessmentDecoder> {
         user: String::new(),
         episodes: Vec::new(),
         params: crate::grid::GridTaskParams::default(),
+        realism: errp_bci::Realism::default(),
     };
     Ok(prepare_decoder(&scenario, |_| {})?.0)
 }

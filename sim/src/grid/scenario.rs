@@ -7,7 +7,7 @@
 
 use std::path::{Path, PathBuf};
 
-use errp_bci::{GoalSet, RequestedAccuracy, subject};
+use errp_bci::{GoalSet, Realism, RequestedAccuracy, subject};
 use errp_robot::{Cell, Grid, GridControlParams, Valid};
 use rand::Rng;
 use serde::Deserialize;
@@ -16,7 +16,8 @@ use crate::error::Result;
 use crate::grid::decoder::PErrorChoice;
 use crate::grid::params::GridTaskParams;
 use crate::scenario_file::{
-    Pair, field_error, parse_toml, read_scenario, robot_error, scenario_name, table_into, whole,
+    Pair, checked_realism, field_error, parse_toml, read_scenario, robot_error, scenario_name,
+    table_into, whole,
 };
 
 /// Most epochs per class in an epoch bank (about 9 KB each, per level of a
@@ -71,6 +72,10 @@ struct ScenarioFile {
     control: GridControlParams,
     #[serde(default)]
     timing: Option<TimingFile>,
+    /// Straight into the EEG model's type: how far the user is from the
+    /// ideal one (all off by default).
+    #[serde(default)]
+    realism: Realism,
 }
 
 fn default_seed() -> u64 {
@@ -164,6 +169,8 @@ pub struct GridScenario {
     pub episodes: Vec<(Cell, Cell)>,
     /// Strategy and timing.
     pub params: GridTaskParams,
+    /// How far the simulated user is from the ideal one (`[realism]`).
+    pub realism: Realism,
 }
 
 impl GridScenario {
@@ -239,6 +246,7 @@ impl GridScenario {
             ));
         }
         let episodes = (0..repeats).flat_map(|_| pairs.iter().copied()).collect();
+        let realism = checked_realism(file.realism, path)?;
         Ok(Self {
             path: path.to_path_buf(),
             name: scenario_name(file.name, path),
@@ -252,6 +260,7 @@ impl GridScenario {
             user,
             episodes,
             params,
+            realism,
         })
     }
 }

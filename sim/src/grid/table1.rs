@@ -118,6 +118,7 @@ pub fn run_table1(
                 user: name.clone(),
                 episodes: Vec::new(),
                 params: options.params,
+                realism: errp_bci::Realism::default(),
             };
             let label = format!(
                 "{name} {}",

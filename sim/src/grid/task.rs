@@ -130,6 +130,7 @@ impl Task for GridTask {
             .int("bank_per_class", s.bank_per_class as u64)
             .float("interval_min_secs", s.params.interval_min_secs)
             .float("interval_max_secs", s.params.interval_max_secs)
+            .realism(&s.realism)
             .finish()
     }
 

@@ -6,4 +6,5 @@ mod determinism;
 mod epuck;
 mod grid;
 mod hooks;
+mod realism;
 mod scenario_fuzz;

@@ -348,6 +348,7 @@ fn scenario(accuracy: f64, seed: u64, subject: &str, params: GridTaskParams) -> 
         user: subject.to_string(),
         episodes: Vec::new(),
         params,
+        realism: errp_bci::Realism::default(),
     }
 }
 
