@@ -56,6 +56,11 @@ enum Command {
     /// likelihoods.
     #[command(subcommand)]
     Fit(fit::FitCommand),
+    /// The simulated user's statistics beside published recordings of
+    /// people: the background EEG, the ErrP at FCz, the decoders' per-class
+    /// rates, calibration against the closed loop; each row with the
+    /// published range, its source and whether the user falls inside it.
+    Realism(commands::realism::RealismArgs),
     /// Read recordings back: what a `.rrd` holds and how to make it again,
     /// each run recomputed from it (the table `errp run` printed), tidy CSV
     /// tables, and the paper's Fig. 5 (e-puck) or Fig. 4 (grid).
@@ -70,6 +75,7 @@ fn main() -> ExitCode {
         Command::Run(args) => run::run(&args),
         Command::Table1(args) => table1::table1(&args),
         Command::Subjects => calibrate::print_subjects(),
+        Command::Realism(args) => commands::realism::realism(&args),
         Command::Merge(args) => sweep::merge(&args),
         #[cfg(feature = "rerun")]
         Command::Inspect(args) => commands::inspect::inspect(&args),

@@ -53,6 +53,28 @@ fn generate_one_second(bencher: Bencher) {
     bencher.bench_local(|| black_box(g.generate(FS)));
 }
 
+/// One second of all 40 channels of the ideal user judging one action a
+/// second: the reference for `generate_one_second_realistic`, which has the
+/// same schedule.
+#[divan::bench]
+fn generate_one_second_with_actions(bencher: Bencher) {
+    let mut g = EegGenerator::new(
+        &Valid::<GeneratorParams>::default(),
+        &Montage::standard(),
+        1,
+    )
+    .unwrap();
+    let mut onset = 0.5;
+    bencher.bench_local(|| {
+        g.schedule(Assessment {
+            onset_secs: onset,
+            kind: AssessmentKind::Error,
+        });
+        onset += 1.0;
+        black_box(g.generate(FS))
+    });
+}
+
 /// One second of all 40 channels with every effect of `Realism` on (drifts,
 /// electrode offsets, EMG bursts, pops, a bad channel, action blinks, and
 /// an ErrP that changes): the cost of the realistic user against

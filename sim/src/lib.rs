@@ -34,6 +34,7 @@ pub mod inspect;
 mod key;
 mod output;
 mod paper;
+pub mod realism;
 #[cfg(feature = "rerun")]
 pub mod record;
 mod scenario;

@@ -5,6 +5,7 @@
 mod commands;
 mod hostile;
 mod inspect;
+mod realism;
 mod reliability;
 
 use std::path::{Path, PathBuf};

@@ -63,6 +63,8 @@ pub(crate) struct RealismState {
     log_bg: f64,
     log_alpha: f64,
     drift_pole: f64,
+    gain_from: (f64, f64),
+    gain_to: (f64, f64),
     offsets_from: Vec<f64>,
     offsets_to: Vec<f64>,
     offset_pole: f64,
@@ -102,7 +104,7 @@ impl RealismState {
         let mut rng_drift = stream(seed, "eeg/realism/drift");
         let mut rng_offsets = stream(seed, "eeg/realism/offsets");
         let dt = 1.0 / fs;
-        let (drift_pole, _) = ou_step(1.0, p.drift_secs, dt);
+        let (drift_pole, _) = ou_step(1.0, p.drift_secs, OFFSET_KNOT as f64 * dt);
         let (offset_pole, offset_step) = ou_step(
             p.electrode_drift_uv,
             p.electrode_drift_secs,
@@ -139,6 +141,11 @@ impl RealismState {
             log_bg,
             log_alpha,
             drift_pole,
+            gain_from: (1.0, 1.0),
+            gain_to: (
+                (log_bg - p.background_drift.powi(2)).exp(),
+                (log_alpha - p.alpha_drift.powi(2)).exp(),
+            ),
             offsets_from,
             offsets_to,
             offset_pole,
@@ -236,20 +243,40 @@ impl RealismState {
         }
     }
 
-    /// Advances the two drifts by one sample: the background's and alpha's
-    /// amplitude factors (mean square 1).
-    pub(crate) fn drift_gains(&mut self) -> (f64, f64) {
+    /// The two drifts' amplitude factors (mean square 1) for samples
+    /// `start..start + n`, into `bg` and `alpha`: the processes advance at
+    /// knots every [`OFFSET_KNOT`] samples (their time constants are tens of
+    /// seconds), the factors are linear between knots.
+    pub(crate) fn drift_gains(
+        &mut self,
+        start: u64,
+        n: usize,
+        bg: &mut Vec<f64>,
+        alpha: &mut Vec<f64>,
+    ) {
+        bg.clear();
+        alpha.clear();
         let a = self.drift_pole;
         let b = (1.0 - a * a).sqrt();
-        let z1: f64 = self.rng_drift.sample(StandardNormal);
-        let z2: f64 = self.rng_drift.sample(StandardNormal);
         let (sb, sa) = (self.p.background_drift, self.p.alpha_drift);
-        self.log_bg = a * self.log_bg + b * sb * z1;
-        self.log_alpha = a * self.log_alpha + b * sa * z2;
-        (
-            (self.log_bg - sb * sb).exp(),
-            (self.log_alpha - sa * sa).exp(),
-        )
+        for t in 0..n {
+            let s = start + t as u64;
+            if s.is_multiple_of(OFFSET_KNOT) {
+                let z1: f64 = self.rng_drift.sample(StandardNormal);
+                let z2: f64 = self.rng_drift.sample(StandardNormal);
+                self.log_bg = a * self.log_bg + b * sb * z1;
+                self.log_alpha = a * self.log_alpha + b * sa * z2;
+                self.gain_from = self.gain_to;
+                self.gain_to = (
+                    (self.log_bg - sb * sb).exp(),
+                    (self.log_alpha - sa * sa).exp(),
+                );
+            }
+            let x = (s % OFFSET_KNOT) as f64 / OFFSET_KNOT as f64;
+            let (f, to) = (self.gain_from, self.gain_to);
+            bg.push(f.0 + (to.0 - f.0) * x);
+            alpha.push(f.1 + (to.1 - f.1) * x);
+        }
     }
 
     /// True if the drifts are on (otherwise [`drift_gains`] is 1, 1 and

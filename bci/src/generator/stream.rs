@@ -339,13 +339,8 @@ impl EegGenerator {
         // 2b. Drifts of the background's and alpha's amplitude (Realism).
         let drifts = self.realism.drifts();
         if drifts {
-            self.bg_gain_buf.clear();
-            self.alpha_gain_buf.clear();
-            for _ in 0..n {
-                let (g_bg, g_alpha) = self.realism.drift_gains();
-                self.bg_gain_buf.push(g_bg);
-                self.alpha_gain_buf.push(g_alpha);
-            }
+            self.realism
+                .drift_gains(start, n, &mut self.bg_gain_buf, &mut self.alpha_gain_buf);
             let (sources, _) = self.scratch.split_at_mut(n_ch * n);
             for row in sources.chunks_exact_mut(n) {
                 for (v, g) in row.iter_mut().zip(&self.bg_gain_buf) {

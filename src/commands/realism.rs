@@ -1,0 +1,65 @@
+//! `errp realism`: the simulated user's statistics beside published
+//! recordings of people.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Result, bail};
+use errp_sim::realism::measure_realism;
+use errp_sim::{AnyScenario, load_scenario_with};
+
+use crate::out::{errln, out};
+
+#[derive(clap::Args)]
+pub(crate) struct RealismArgs {
+    /// The grid scenario whose user (its `[realism]` table) and decoder are
+    /// measured: the background, the ErrP, the discrete decoder's
+    /// per-class rates, calibration against the closed loop.
+    #[arg(
+        long,
+        value_name = "FILE.toml",
+        default_value = "scenarios/grid_fixed_goals.toml"
+    )]
+    pub(crate) grid: PathBuf,
+    /// The e-puck scenario whose detector is measured (per-trial TPR and TNR).
+    #[arg(
+        long,
+        value_name = "FILE.toml",
+        default_value = "scenarios/mexico_to_pisa.toml"
+    )]
+    pub(crate) epuck: PathBuf,
+    /// Print only the table.
+    #[arg(long, short)]
+    pub(crate) quiet: bool,
+}
+
+pub(crate) fn realism(args: &RealismArgs) -> Result<()> {
+    let grid = match load_scenario_with(&args.grid, &[])? {
+        AnyScenario::Grid(s) => s,
+        AnyScenario::Epuck(_) => wrong_task(&args.grid, "--grid", "grid")?,
+    };
+    let epuck = match load_scenario_with(&args.epuck, &[])? {
+        AnyScenario::Epuck(s) => s,
+        AnyScenario::Grid(_) => wrong_task(&args.epuck, "--epuck", "epuck")?,
+    };
+    let quiet = args.quiet;
+    let report = measure_realism(&grid, &epuck, &mut |stage: &str| {
+        if !quiet {
+            errln!("  measuring {stage} ...");
+        }
+    })?;
+    out!("{report}")?;
+    Ok(())
+}
+
+fn wrong_task<T>(path: &Path, flag: &str, task: &str) -> Result<T> {
+    bail!(
+        "{flag} {}: field `task` is not \"{task}\": give a {task} scenario, e.g. \
+         scenarios/{}",
+        path.display(),
+        if task == "grid" {
+            "grid_fixed_goals.toml"
+        } else {
+            "mexico_to_pisa.toml"
+        }
+    )
+}
