@@ -35,6 +35,8 @@ FIGURES=(
   "fit_grid|slow|fit grid --out OUT_DIR --quiet"
   "fit_grid_epsilon0|slow|fit grid --epsilon 0 --out OUT_DIR --quiet"
   "table1_seeds|slow|sh: python3 scripts/table1_seeds.py --seeds 10"
+  "realism|cheap|realism --quiet"
+  "sweep_realism|cheap|sweep --task grid --accuracy 0.75 --param realism.lapse_rate=0,0.1,0.2 --param realism.background_drift=0,0.3 --param strategy=greedy,thompson --episodes 200 --seed 1 --out OUT_DIR --quiet"
   "python_decoders|slow|sh: \${PYTHON:-target/ci-venv/bin/python} python/examples/decoders_in_the_loop.py 2>/dev/null | sed -E 's/ +\\([0-9.]+ s\\)\$//'"
   "python_cross_validation|slow|sh: \${PYTHON:-target/ci-venv/bin/python} python/examples/cross_validate_decoders.py 2>/dev/null"
   "python_cv_seeds|slow|sh: \${PYTHON:-target/ci-venv/bin/python} python/examples/cross_validate_decoders.py --seeds 12 --draws 10 2>/dev/null"

@@ -173,6 +173,23 @@ pub(crate) fn toml_value(key: &str, v: &Bound<'_, PyAny>) -> PyResult<toml::Valu
     if v.is_instance_of::<PyString>() {
         return Ok(toml::Value::String(v.extract()?));
     }
+    if v.is_instance_of::<PyDict>() {
+        // A table of its own (the EEG model's `realism`, say): its keys
+        // named under this one in errors.
+        let mut table = toml::Table::new();
+        for (k, x) in v.extract::<Bound<'_, PyDict>>()?.iter() {
+            let name: String = k.extract().map_err(|_| {
+                value_error(
+                    &format!("overrides[\"{key}\"]"),
+                    &k,
+                    "a dict with string keys",
+                )
+            })?;
+            let value = toml_value(&format!("{key}.{name}"), &x)?;
+            table.insert(name, value);
+        }
+        return Ok(toml::Value::Table(table));
+    }
     if let Ok(items) = v.extract::<Vec<Bound<'_, PyAny>>>() {
         return Ok(toml::Value::Array(
             items

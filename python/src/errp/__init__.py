@@ -99,7 +99,10 @@ class EegGenerator:
         its user.
     params : dict, optional
         Other fields of the EEG model by name (``background_uv``,
-        ``blink_rate_hz``, ...), checked as a scenario's.
+        ``blink_rate_hz``, ...), checked as a scenario's. ``realism`` is a
+        dict of the effects that make the user less ideal (drifts, lapses,
+        artifacts: a scenario's ``[realism]`` keys, all off by default;
+        the guide's chapter "The simulated user as real users are").
     """
 
     def __init__(
