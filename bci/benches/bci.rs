@@ -58,12 +58,13 @@ fn generate_one_second(bencher: Bencher) {
 /// same schedule.
 #[divan::bench]
 fn generate_one_second_with_actions(bencher: Bencher) {
-    let mut g = EegGenerator::new(
-        &Valid::<GeneratorParams>::default(),
-        &Montage::standard(),
-        1,
-    )
-    .unwrap();
+    one_action_a_second(bencher, &Valid::default());
+}
+
+/// Benches one second of the user of `params` judging one action in it, as
+/// the e-puck's user judges.
+fn one_action_a_second(bencher: Bencher, params: &Valid<GeneratorParams>) {
+    let mut g = EegGenerator::new(params, &Montage::standard(), 1).unwrap();
     let mut onset = 0.5;
     bencher.bench_local(|| {
         g.schedule(Assessment {
@@ -102,17 +103,7 @@ fn generate_one_second_realistic(bencher: Bencher) {
         ..GeneratorParams::default()
     })
     .unwrap();
-    let mut g = EegGenerator::new(&params, &Montage::standard(), 1).unwrap();
-    let mut onset = 0.5;
-    bencher.bench_local(|| {
-        // One action a second, as the e-puck's user judges.
-        g.schedule(Assessment {
-            onset_secs: onset,
-            kind: AssessmentKind::Error,
-        });
-        onset += 1.0;
-        black_box(g.generate(FS))
-    });
+    one_action_a_second(bencher, &params);
 }
 
 /// Preprocess (CAR + EOG regression + notch + band-pass, 8 output channels),
