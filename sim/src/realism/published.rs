@@ -81,9 +81,12 @@ pub static PUBLISHED: &[Published] = &[
         key: "errp_negative_ms",
         what: "ErrP at FCz: negative peak latency",
         unit: "ms",
-        value: f64::NAN,
+        value: 250.0,
         range: None,
-        source: None,
+        source: Some(Source {
+            cite: "Ferrez & Millan 2008, IEEE TBME 55:923, as Fidencio et al. 2024 simulate it",
+            doi: "10.3389/fnhum.2024.1390714",
+        }),
     },
     Published {
         key: "errp_negative_uv",
@@ -97,9 +100,12 @@ pub static PUBLISHED: &[Published] = &[
         key: "errp_positive_ms",
         what: "ErrP at FCz: positive peak latency",
         unit: "ms",
-        value: f64::NAN,
+        value: 320.0,
         range: None,
-        source: None,
+        source: Some(Source {
+            cite: "Ferrez & Millan 2008, IEEE TBME 55:923, as Fidencio et al. 2024 simulate it",
+            doi: "10.3389/fnhum.2024.1390714",
+        }),
     },
     Published {
         key: "errp_positive_uv",
@@ -113,9 +119,25 @@ pub static PUBLISHED: &[Published] = &[
         key: "latency_jitter_ms",
         what: "ErrP: single-trial latency SD",
         unit: "ms",
-        value: f64::NAN,
-        range: None,
-        source: None,
+        value: 19.0,
+        // SEREEGA's 20 % six-sigma deviation: an SD of 6.7 % of the
+        // N250's and the P320's latencies.
+        range: Some((16.7, 21.3)),
+        source: Some(Source {
+            cite: "Fidencio et al. 2024, Front. Hum. Neurosci. 18:1390714 (simulation)",
+            doi: "10.3389/fnhum.2024.1390714",
+        }),
+    },
+    Published {
+        key: "blinks_per_min",
+        what: "blinks per minute (the model's rate)",
+        unit: "",
+        value: 14.5,
+        range: Some((8.0, 21.0)),
+        source: Some(Source {
+            cite: "Optom. Vis. Sci. 2001, 78:712 (primary gaze, 8.0-21.0 a minute)",
+            doi: "10.1097/00006324-200110000-00011",
+        }),
     },
     Published {
         key: "discrete_error_class",
