@@ -8,7 +8,8 @@
 //! stream of its own: with every effect off the generator's samples are
 //! those of a generator without this module, bit for bit, and switching one
 //! effect on never shifts the draws of another. The sources of each
-//! effect's published size are in the guide's simulation chapter.
+//! effect's published size are in the guide's chapter "The simulated user
+//! as real users are" (`docs/guide/realism.md`); each field says it too.
 
 use rand::Rng;
 use rand_distr::StandardNormal;
@@ -26,29 +27,37 @@ use crate::rng::{derive_seed, stream};
 pub struct Realism {
     /// SD of the background's log amplitude (1/f part), a slow
     /// Ornstein-Uhlenbeck process with time constant `drift_secs`: 0.1
-    /// means the background's amplitude wanders by about +-10 %.
+    /// means the background's amplitude wanders by about +-10 %. No
+    /// published size found: off.
     pub background_drift: f64,
     /// SD of the alpha rhythm's log amplitude, likewise (alpha waxes and
-    /// wanes with vigilance: the spectrum's shape drifts).
+    /// wanes with vigilance: the spectrum's shape drifts). Off: the one size
+    /// found is a trend, alpha power +44 % over up to 3 h of fatigue (Trejo
+    /// et al. 2015, Psychology 6:5, doi:10.4236/psych.2015.65055).
     pub alpha_drift: f64,
     /// Time constant of both drifts (s).
     pub drift_secs: f64,
     /// SD of each electrode's slowly wandering offset before the band-pass
     /// (uV), an Ornstein-Uhlenbeck process with time constant
-    /// `electrode_drift_secs`.
+    /// `electrode_drift_secs`. No published size found: off.
     pub electrode_drift_uv: f64,
     /// Time constant of the electrode offsets (s).
     pub electrode_drift_secs: f64,
     /// Relative change of the ERP amplitude per hour of session (habituation
     /// or fatigue when negative): the amplitude factor is
-    /// `max(0, 1 + errp_amplitude_per_hour * hours)`.
+    /// `max(0, 1 + errp_amplitude_per_hour * hours)`. The ERN and Pe decline
+    /// within a task (Clayson et al. 2025, Psychophysiology 62:e14731,
+    /// doi:10.1111/psyp.14731), with no slope given: off.
     pub errp_amplitude_per_hour: f64,
-    /// Change of the ERP latency per hour of session (ms per hour).
+    /// Change of the ERP latency per hour of session (ms per hour). No
+    /// published size found: off.
     pub errp_latency_ms_per_hour: f64,
     /// How much the error ERP shrinks as errors become expected: its
     /// amplitude factor is `max(0, 1 - expectancy * (q - expectancy_reference))`
     /// where q is the user's recent error rate (an exponentially weighted
-    /// mean over `expectancy_actions` perceived actions).
+    /// mean over `expectancy_actions` perceived actions). No published size
+    /// found (what we found speaks for an error's significance, not its
+    /// expectancy: Maier et al. 2012, Psychophysiology): off.
     pub expectancy: f64,
     /// The error rate at which the error ERP has its template amplitude
     /// (the calibration protocol's 20 %); q starts there.
@@ -65,44 +74,61 @@ pub struct Realism {
     /// this stream begins, for the per-hour slopes and the decline of
     /// attention (a closed loop starts after its calibration).
     pub clock_offset_secs: f64,
-    /// Fraction of actions not attended: no ERP at all follows them.
+    /// Fraction of actions not attended: no ERP at all follows them. No
+    /// published rate for ErrP users found: off.
     pub lapse_rate: f64,
     /// Rise of `lapse_rate` per hour of session (declining attention);
-    /// the sum is capped at 1.
+    /// the sum is capped at 1. No published size found: off.
     pub lapse_per_hour: f64,
     /// Fraction of attended actions judged the wrong way: an error without
-    /// an ErrP, or an ErrP after a correct action.
+    /// an ErrP, or an ErrP after a correct action. No published rate found:
+    /// off.
     pub misjudge_rate: f64,
-    /// Rate of muscle (EMG) bursts (per second).
+    /// Rate of muscle (EMG) bursts (per second). EMG reaches down to the
+    /// alpha band (Shackman et al. 2009, Brain Topogr.,
+    /// doi:10.1007/s10548-009-0079-4); no rate or size found: off.
     pub emg_rate_hz: f64,
     /// SD of an EMG burst at its peak on the most affected (temporal)
     /// channels (uV), broadband, so that part of it falls in 1-10 Hz.
     pub emg_uv: f64,
     /// Mean duration of an EMG burst (s).
     pub emg_secs: f64,
-    /// Rate of electrode pops (per second, over the whole montage).
+    /// Rate of electrode pops (per second, over the whole montage). No
+    /// published rate found: off.
     pub pop_rate_hz: f64,
     /// Mean size of an electrode pop (uV): a step that decays with a 0.3 s
     /// time constant.
     pub pop_uv: f64,
-    /// An EEG channel with a poor contact ("" for none).
+    /// An EEG channel with a poor contact ("" for none). No published
+    /// prevalence found: none.
     pub bad_channel: String,
     /// SD of the extra broadband noise on `bad_channel` (uV).
     pub bad_channel_uv: f64,
     /// ERP latency shift of the closed loop against calibration (ms): the
     /// task differs (the grid's calibration and control differ little, the
-    /// e-puck's button-locked calibration and continuous motion more).
+    /// e-puck's button-locked calibration and continuous motion more). A
+    /// protocol moves the latency (Iturrate et al. 2014, J. Neural Eng.
+    /// 11:036005, doi:10.1088/1741-2560/11/3/036005) by no figure we found:
+    /// 0.
     pub task_latency_ms: f64,
-    /// ERP amplitude factor of the closed loop against calibration.
+    /// ERP amplitude factor of the closed loop against calibration: 1, as a
+    /// protocol changes "the latency of the recorded potentials but not the
+    /// amplitudes" (Iturrate et al. 2014, J. Neural Eng. 11:036005).
     pub task_gain: f64,
     /// Days between the calibration and the closed loop (0: the same
     /// session). Each day draws its own ERP shift from the user's seed.
     pub day: u32,
-    /// SD of a day's ERP latency shift (ms).
+    /// SD of a day's ERP latency shift (ms). ErrPs are "stable over long
+    /// periods of time (from 50 to >600 days)" (Chavarriaga & Millan 2010,
+    /// IEEE TNSRE 18:381, doi:10.1109/TNSRE.2010.2053387), with no SD
+    /// given: 0.
     pub day_latency_sd_ms: f64,
-    /// SD of a day's log ERP amplitude factor.
+    /// SD of a day's log ERP amplitude factor: 0, likewise.
     pub day_gain_sd: f64,
-    /// Probability that the user blinks after an action they judged.
+    /// Probability that the user blinks after an action they judged. No
+    /// published figure for blinks locked to judged actions found: off
+    /// (people blink 8-21 times a minute at rest, Optom. Vis. Sci. 2001,
+    /// 78:712, which the EEG model's 12 a minute already gives).
     pub action_blink_probability: f64,
     /// Mean latency of such a blink after the action (ms); its SD is a
     /// quarter of it.
