@@ -149,10 +149,12 @@ impl GeneratorParams {
             self.alpha_bandwidth_hz,
             "a finite number > 0",
         )?;
-        let montage = crate::montage::Montage::standard();
-        let eeg: Vec<&str> = montage.channels()[..montage.n_eeg()]
+        // The montage's names only where a bad channel is named.
+        let montage =
+            (!self.realism.bad_channel.is_empty()).then(crate::montage::Montage::standard);
+        let eeg: Vec<&str> = montage
             .iter()
-            .map(|c| c.name.as_str())
+            .flat_map(|m| m.channels()[..m.n_eeg()].iter().map(|c| c.name.as_str()))
             .collect();
         self.realism.validate(&eeg)
     }

@@ -192,6 +192,10 @@ impl Realism {
     /// goes on from the calibration's end. The closed-loop fields
     /// themselves are kept, so the result is the same user.
     pub fn closed_loop(&self, calibration_secs: f64, seed: u64) -> Self {
+        if self.is_ideal() {
+            // Nothing depends on the clock or the phase: the same user.
+            return self.clone();
+        }
         let mut online = self.clone();
         online.erp_latency_shift_ms += self.task_latency_ms;
         online.erp_gain *= self.task_gain;
