@@ -3,9 +3,9 @@
 //! that slides every 62.5 ms over streamed EEG.
 
 use errp_bci::{
-    Accuracy, ContinuousCalibrationParams, ContinuousFeatures, Detector, DetectorMode,
-    DetectorParams, EegGenerator, GeneratorParams, Montage, OnlineRecording, OnlineRecordingParams,
-    OnlineStep, OnlineTarget, OnlineTargeting, OperatingPoint, Preprocessor, Protocol,
+    Accuracy, ContinuousCalibrationParams, ContinuousFeatures, ContinuousSetup, Detector,
+    DetectorMode, DetectorParams, EegGenerator, GeneratorParams, Montage, OnlineRecording,
+    OnlineRecordingParams, OnlineStep, OnlineTarget, OnlineTargeting, OperatingPoint, Preprocessor,
     ResponseSpan, SlidingWindow, SvmDecoder, SvmModel, TargetingParams, TargetingResult,
     TargetingStep, Valid, calibrate_continuous, detector_span, operating_point, record_online,
     rng::derive_seed, target_continuous_accuracy, target_online,
@@ -198,7 +198,8 @@ pub fn run_online_calibration(
         .into_iter()
         .find(|(ratio, _, _)| ratio.to_bits() == search.ratio.to_bits())
         .expect("the ratio found is one of the evaluations");
-    let mut decoder = ContinuousDecoder::from_report(&report).with_closed_loop(request.seed)?;
+    let mut decoder =
+        ContinuousDecoder::from_report(&report).with_closed_loop(&request.setup, request.seed)?;
     decoder.online = Some(OnlineReport::from_recording(
         &recording, detector, search.t_e,
     )?);
@@ -257,14 +258,15 @@ impl ContinuousDecoder {
         }
     }
 
-    /// This decoder with the closed loop of user `seed` after the
-    /// calibration ([`ContinuousCalibrationParams`]'s session):
-    /// [`Realism::closed_loop`](errp_bci::Realism::closed_loop).
-    pub fn with_closed_loop(mut self, seed: u64) -> Result<Self> {
-        let secs = ContinuousCalibrationParams::default().duration_secs();
-        self.closed_loop = self
-            .generator
-            .with(|g| g.realism = g.realism.closed_loop(secs, seed))?;
+    /// This decoder with the closed loop that follows the calibration of
+    /// `setup` by user `seed` ([`Setup::closed_loop_generator`] at this
+    /// decoder's ratio).
+    ///
+    /// [`Setup::closed_loop_generator`]: errp_bci::Setup::closed_loop_generator
+    pub fn with_closed_loop(mut self, setup: &ContinuousSetup, seed: u64) -> Result<Self> {
+        self.closed_loop = setup
+            .at_ratio(self.generator.errp_to_noise)?
+            .closed_loop_generator(seed)?;
         Ok(self)
     }
 

@@ -50,6 +50,16 @@ pub struct PreparedEpuck {
     pub cached: bool,
 }
 
+/// The calibration of a scenario's continuous decoder: the paper's
+/// protocol and EEG model, with the scenario's user (`[realism]`).
+fn continuous_request(scenario: &EpuckScenario) -> Result<ContinuousRequest> {
+    let base = ContinuousRequest::new(scenario.accuracy, scenario.user_seed);
+    Ok(ContinuousRequest {
+        setup: Valid::new(base.setup.with_realism(&scenario.realism)?)?,
+        ..base
+    })
+}
+
 /// Builds the scenario's continuous decoder, the one path of every e-puck
 /// command. With an accuracy target: the ratio from `cache` (or searched;
 /// `progress` sees the search), the calibration session at it, then the
@@ -62,11 +72,7 @@ pub fn prepare_epuck_decoder(
     mut progress: impl FnMut(&TargetingStep),
     online_progress: impl FnMut(&OnlineStep),
 ) -> Result<PreparedEpuck> {
-    let base = ContinuousRequest::new(scenario.accuracy, scenario.user_seed);
-    let request = ContinuousRequest {
-        setup: Valid::new(base.setup.with_realism(&scenario.realism)?)?,
-        ..base
-    };
+    let request = continuous_request(scenario)?;
     match scenario.online_target {
         None => {
             let mut find = || target_continuous(&request, &mut progress);
@@ -122,8 +128,9 @@ pub fn finish_continuous_decoder(
     scenario: &EpuckScenario,
     report: &ContinuousReport,
 ) -> Result<ContinuousDecoder> {
+    let setup = continuous_request(scenario)?.setup;
     let mut decoder =
-        ContinuousDecoder::from_report(report).with_closed_loop(scenario.user_seed)?;
+        ContinuousDecoder::from_report(report).with_closed_loop(&setup, scenario.user_seed)?;
     decoder.measure_online(
         scenario.params.detector,
         scenario.params.control.t_e,

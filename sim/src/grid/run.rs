@@ -219,8 +219,8 @@ fn stream_parts(
 impl GridShared {
     /// Simulates once what `scenarios` share: one calibration session per
     /// seed, one epoch bank per bank key (EEG decoders only), with the
-    /// paper's protocol and the default EEG model, as every grid scenario
-    /// is calibrated.
+    /// paper's protocol and the default EEG model with each scenario's
+    /// user (`[realism]`), as every grid scenario is calibrated.
     pub fn build<'a>(scenarios: impl IntoIterator<Item = &'a GridScenario>) -> Result<Self> {
         let mut shared = Self::default();
         for s in scenarios {
