@@ -11,6 +11,9 @@
 #                                       per run)
 #
 # Every command is seeded; the cache is off, so each run targets afresh.
+# The scenarios are the idealised user's (scenarios/variants/*_ideal.toml,
+# byte for byte the shipped scenarios before they had a [realism] table), so
+# that a recording made before the realistic user compares with one after.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -32,18 +35,18 @@ record() {
   }
   run calibrate calibrate --accuracy 0.7438 --seed 1 --quiet \
     --save "$out/calib.rrd" --export "$out/calib.edf"
-  run grid run scenarios/grid_fixed_goals.toml --seed 1 --quiet --save "$out/grid.rrd"
-  run epuck run scenarios/mexico_to_pisa.toml --seed 1 --quiet --save "$out/epuck.rrd"
-  run epuck-20 run scenarios/mexico_to_pisa.toml --runs 20 --quiet
-  run lisbon run scenarios/lisbon_to_tokyo.toml --runs 3 --seed 2 --quiet
-  run grid-free run scenarios/grid_free_goals.toml --seed 2 --quiet
-  run table1 table1 --seed 1 --quiet
-  run sweep-grid sweep --task grid --accuracy 0.6,0.8 --param strategy=greedy,info_gain \
+  run grid run scenarios/variants/grid_fixed_goals_ideal.toml --seed 1 --quiet --save "$out/grid.rrd"
+  run epuck run scenarios/variants/mexico_to_pisa_ideal.toml --seed 1 --quiet --save "$out/epuck.rrd"
+  run epuck-20 run scenarios/variants/mexico_to_pisa_ideal.toml --runs 20 --quiet
+  run lisbon run scenarios/variants/lisbon_to_tokyo_ideal.toml --runs 3 --seed 2 --quiet
+  run grid-free run scenarios/variants/grid_free_goals_ideal.toml --seed 2 --quiet
+  run table1 table1 --seed 1 --realism scenarios/variants/grid_fixed_goals_ideal.toml --quiet
+  run sweep-grid sweep --scenario scenarios/variants/grid_fixed_goals_ideal.toml --accuracy 0.6,0.8 --param strategy=greedy,info_gain \
     --episodes 40 --seed 1 --no-cache --quiet --out "$out/sweep-grid"
-  run sweep-epuck sweep --task epuck --accuracy 0.8,0.95 --episodes 6 --seed 1 \
+  run sweep-epuck sweep --scenario scenarios/variants/mexico_to_pisa_ideal.toml --accuracy 0.8,0.95 --episodes 6 --seed 1 \
     --no-cache --quiet --out "$out/sweep-epuck"
   for k in 1 2; do
-    run "shard-$k" sweep --task grid --accuracy 0.6,0.8 --episodes 40 --seed 1 --no-cache \
+    run "shard-$k" sweep --scenario scenarios/variants/grid_fixed_goals_ideal.toml --accuracy 0.6,0.8 --episodes 40 --seed 1 --no-cache \
       --quiet --shard "$k/2" --out "$out/shard-$k"
   done
   run merge merge "$out/shard-1" "$out/shard-2" --out "$out/merged"

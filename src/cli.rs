@@ -122,6 +122,11 @@ pub(crate) struct Table1Args {
     /// 1000 per class streamed in advance (much faster).
     #[arg(long, value_enum, default_value = "stream")]
     pub(crate) eeg: EegArg,
+    /// The simulated users: the `[realism]` table of this scenario file
+    /// (e.g. scenarios/variants/grid_fixed_goals_ideal.toml for the
+    /// idealised user). Default: the shipped scenarios' user.
+    #[arg(long, value_name = "SCENARIO")]
+    pub(crate) realism: Option<PathBuf>,
     /// Print only the results.
     #[arg(long, short)]
     pub(crate) quiet: bool,

@@ -91,7 +91,9 @@ def main():
     except ImportError:
         print("(pyRiemann is not installed: pip install pyriemann)")
 
-    scenario = "scenarios/grid_fixed_goals.toml"
+    # The idealised user, the session's (errp.simulate_session simulates it),
+    # so that every decoder is trained and used on one user.
+    scenario = "scenarios/variants/grid_fixed_goals_ideal.toml"
     overrides = {"repeats": args.repeats, "eeg": "bank"}
     t = time.perf_counter()
     builtin = errp.GridTask(scenario, overrides=overrides, seed=args.seed)

@@ -70,7 +70,9 @@ REPEATS = {"repeats": 20, "eeg": "bank"}
 
 
 def test_an_sklearn_lda_in_the_loop_matches_the_builtin_decoder(lda, session, root):
-    scenario = root / "scenarios/grid_fixed_goals.toml"
+    # The idealised user, as the session's (errp.simulate_session simulates
+    # it unless given a realism table).
+    scenario = root / "scenarios/variants/grid_fixed_goals_ideal.toml"
     builtin = errp.GridTask(scenario, overrides=REPEATS)
     # The same user: the session and the task's calibration share the seed
     # and target the same accuracy, the session by cross-validation and the
@@ -108,7 +110,7 @@ def test_a_per_epoch_decoder_sees_every_action(lda, root):
         assert task.ch_names == lda.names
         return lda(x)
 
-    task = errp.GridTask(root / "scenarios/grid_fixed_goals.toml", decoder=f)
+    task = errp.GridTask(root / "scenarios/variants/grid_fixed_goals_ideal.toml", decoder=f)
     df = task.run()
     assert len(calls) == df.actions.sum() == task.decoder_calls
     assert set(calls) == {(8, task.n_samples)}

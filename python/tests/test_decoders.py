@@ -211,7 +211,8 @@ def test_the_fitted_decoder_drives_the_grid_task(session, root):
 
     model = discrete_decoder(random_state=session.seed).fit(session.epochs, session.y)
     task = errp.GridTask(
-        root / "scenarios" / "grid_fixed_goals.toml",
+        # The session's user, the idealised one.
+        root / "scenarios" / "variants" / "grid_fixed_goals_ideal.toml",
         batch_decoder=lambda e: model.predict_proba(e)[:, 1],
         overrides={"repeats": 4, "eeg": "bank"},
     )

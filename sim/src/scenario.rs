@@ -29,6 +29,15 @@ impl AnyScenario {
         };
         any.downcast_ref()
     }
+
+    /// The scenario's simulated user (its `[realism]` table; the ideal
+    /// user if it has none).
+    pub fn realism(&self) -> &errp_bci::Realism {
+        match self {
+            AnyScenario::Grid(s) => &s.realism,
+            AnyScenario::Epuck(s) => &s.realism,
+        }
+    }
 }
 
 /// Reads a scenario file and validates it according to its `task` field.

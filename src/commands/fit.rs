@@ -67,6 +67,11 @@ pub struct GridFitArgs {
     /// error (10 to 10000).
     #[arg(long, default_value_t = 200)]
     bootstrap: usize,
+    /// The simulated users: the `[realism]` table of this scenario file
+    /// (e.g. scenarios/variants/grid_fixed_goals_ideal.toml for the
+    /// idealised user). Default: the shipped scenarios' user.
+    #[arg(long, value_name = "SCENARIO")]
+    realism: Option<PathBuf>,
     /// Output directory: fit.json, surface.csv, fit.svg, fit.png.
     #[arg(long, value_name = "DIR", default_value = "fit-grid")]
     out: PathBuf,
@@ -83,8 +88,13 @@ pub struct EpuckFitArgs {
     /// The accuracy grid: start:stop:step (stop included) or a,b,c, each in
     /// (0.5, 1). The default spans what online asynchronous ErrP studies
     /// report (about 75-78 % balanced accuracy) up to the time-locked
-    /// ceiling (about 90 %) and the old hand-picked 95 %.
-    #[arg(long, default_value = "0.65:0.95:0.025", allow_negative_numbers = true)]
+    /// ceiling (about 90 %), the old hand-picked 95 % and one step beyond,
+    /// where the realistic user's likelihood still rises.
+    #[arg(
+        long,
+        default_value = "0.65:0.975:0.025",
+        allow_negative_numbers = true
+    )]
     accuracy: String,
     /// Calibrations at each accuracy (1 to 100): simulated users whose
     /// decoders reach the accuracy, each from its own sweep seed.
@@ -321,6 +331,7 @@ fn fit_grid(args: &GridFitArgs) -> Result<bool> {
         repeats: args.repeats,
         seed: args.seed,
         bootstrap: args.bootstrap,
+        realism: crate::commands::user_realism(args.realism.as_deref())?,
     };
     let (cache, pool, threads, progress) = start(&args.workers, args.quiet)?;
     progress.line(&format!(

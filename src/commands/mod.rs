@@ -8,3 +8,13 @@ pub(crate) mod realism;
 pub(crate) mod run;
 pub(crate) mod sweep;
 pub(crate) mod table1;
+
+/// The simulated users of `errp table1` and `errp fit grid`: the
+/// `[realism]` table of the scenario file at `path` (the ideal user if it
+/// has none), or the shipped scenarios' user, [`errp_bci::Realism::published`].
+pub(crate) fn user_realism(path: Option<&std::path::Path>) -> anyhow::Result<errp_bci::Realism> {
+    Ok(match path {
+        Some(path) => errp_sim::load_scenario(path)?.realism().clone(),
+        None => errp_bci::Realism::published(),
+    })
+}

@@ -16,6 +16,7 @@ pub(crate) fn table1(args: &Table1Args) -> Result<()> {
         },
         eeg: args.eeg.mode(),
         params: errp_sim::grid::GridTaskParams::default(),
+        realism: crate::commands::user_realism(args.realism.as_deref())?,
     };
     let quiet = args.quiet;
     if !quiet {

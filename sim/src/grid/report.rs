@@ -211,6 +211,30 @@ impl fmt::Display for Table1Report<'_> {
                 f,
                 "           accuracy vs total time ({set_name} goals): {ours_r}   [paper: r = {paper_r}, p = {paper_p:.2e}]"
             )?;
+            // Calibration against online: what an experimenter sees as the
+            // gap between the calibration session and the closed loop.
+            let gaps: Vec<String> = cells
+                .iter()
+                .filter(|c| c.goals == set)
+                .filter_map(|c| {
+                    c.calibration.map(|(cv, online)| {
+                        format!(
+                            "{} {:.2}/{:.2} ({:+.2})",
+                            c.subject,
+                            100.0 * cv,
+                            100.0 * online,
+                            100.0 * (cv - online)
+                        )
+                    })
+                })
+                .collect();
+            if !gaps.is_empty() {
+                writeln!(
+                    f,
+                    "           calibration cross-validated / online held-out accuracy (%): {}",
+                    gaps.join(", ")
+                )?;
+            }
         }
         Ok(())
     }
@@ -260,6 +284,7 @@ accuracy = 0.8
             decoder: DecoderChoice::Oracle,
             eeg: EegMode::Bank,
             params: crate::grid::params::GridTaskParams::default(),
+            realism: errp_bci::Realism::default(),
         };
         run_table1(&options, |_, _| {}).unwrap()
     }

@@ -34,6 +34,10 @@ pub struct Table1Cell {
     pub accuracy: f64,
     /// Every run.
     pub runs: Vec<GridEpisodeResult>,
+    /// The EEG decoder's calibration, as (cross-validated accuracy on the
+    /// calibration session, accuracy on held-out closed-loop epochs, which
+    /// the targeting hits): `None` for the oracle.
+    pub calibration: Option<(f64, f64)>,
 }
 
 impl Table1Cell {
@@ -52,7 +56,7 @@ impl Table1Cell {
 }
 
 /// Options of a Table 1 run.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct Table1Options {
     /// Runs per start/goal pair (the paper: 1, so 5 runs per cell).
     pub repeats: usize,
@@ -64,6 +68,9 @@ pub struct Table1Options {
     pub eeg: EegMode,
     /// Strategy and timing.
     pub params: GridTaskParams,
+    /// The simulated users (the same effects for every subject; each
+    /// subject's calibration is targeted at its Table 1 accuracy online).
+    pub realism: errp_bci::Realism,
 }
 
 /// Runs the eight cells (in parallel; the results do not depend on the
@@ -118,7 +125,7 @@ pub fn run_table1(
                 user: name.clone(),
                 episodes: Vec::new(),
                 params: options.params,
-                realism: errp_bci::Realism::default(),
+                realism: options.realism.clone(),
             };
             let label = format!(
                 "{name} {}",
@@ -128,7 +135,7 @@ pub fn run_table1(
                     "free"
                 }
             );
-            let (decoder, _) = prepare_decoder(&scenario, |s| progress(&label, s))?;
+            let (decoder, report) = prepare_decoder(&scenario, |s| progress(&label, s))?;
             let mut runs = Vec::new();
             for r in 0..options.repeats {
                 for (j, &(start, goal)) in pairs.iter().enumerate() {
@@ -149,6 +156,8 @@ pub fn run_table1(
                 goals: *goals,
                 accuracy: *accuracy,
                 runs,
+                calibration: report
+                    .map(|r| (r.calibrated.accuracy.mean(), r.targeting.accuracy.mean())),
             })
         })
         .collect()

@@ -48,6 +48,7 @@ fn table1_gives_the_same_results_on_one_and_two_threads() {
         decoder: errp_sim::grid::DecoderChoice::Oracle,
         eeg: errp_sim::grid::EegMode::Stream,
         params: GridTaskParams::default(),
+        realism: errp_bci::Realism::published(),
     };
     let on = |threads| {
         rayon::ThreadPoolBuilder::new()
@@ -66,7 +67,8 @@ fn table1_gives_the_same_results_on_one_and_two_threads() {
 
 #[test]
 fn the_same_seed_gives_the_same_run() {
-    let mut s = epuck::scenario("lisbon_to_tokyo.toml");
+    // The idealised user, whose pinned digest predates the realistic one.
+    let mut s = epuck::scenario("variants/lisbon_to_tokyo_ideal.toml");
     s.params.max_secs = 40.0;
     let (decoder, _) = prepare_continuous_decoder(&s, |_| {}).unwrap();
     let a = run_epuck_once(&s, &decoder, 3, &mut ()).unwrap();

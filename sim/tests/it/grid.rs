@@ -180,9 +180,11 @@ fn the_grid_decoder_is_targeted_on_held_out_epochs_not_by_cross_validation() {
     // Table 1's accuracy row is the online accuracy: the decoder trained on
     // the whole session, scored on epochs it has not seen. The targeting
     // hits that; cross-validation, which trains on 4/5 of the session, reads
-    // lower at the same ErrP-to-noise ratio.
+    // lower at the same ErrP-to-noise ratio (for the idealised user, whose
+    // calibration and closed loop are one user).
     let scenario = errp_sim::grid::GridScenario::load(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/grid_fixed_goals.toml"),
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../scenarios/variants/grid_fixed_goals_ideal.toml"),
     )
     .unwrap();
     let (_, report) = errp_sim::grid::prepare_decoder(&scenario, |_| {}).unwrap();

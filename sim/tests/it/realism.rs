@@ -18,7 +18,7 @@ fn scenario_text(name: &str) -> String {
 fn a_bad_realism_field_is_named_with_its_value_and_range() {
     let text = format!(
         "{}\n[realism]\nlapse_rate = 1.5\n",
-        scenario_text("grid_fixed_goals.toml")
+        scenario_text("variants/grid_fixed_goals_ideal.toml")
     );
     let err = GridScenario::parse(&text, Path::new("bad.toml"))
         .unwrap_err()
@@ -30,7 +30,7 @@ fn a_bad_realism_field_is_named_with_its_value_and_range() {
     assert!(err.contains("[0, 1]"), "{err}");
     let text = format!(
         "{}\n[realism]\nbad_channel = \"Q9\"\n",
-        scenario_text("mexico_to_pisa.toml")
+        scenario_text("variants/mexico_to_pisa_ideal.toml")
     );
     let err = EpuckScenario::parse(&text, Path::new("bad.toml"))
         .unwrap_err()
@@ -41,7 +41,7 @@ fn a_bad_realism_field_is_named_with_its_value_and_range() {
     );
     let text = format!(
         "{}\n[realism]\nlapse = 0.1\n",
-        scenario_text("mexico_to_pisa.toml")
+        scenario_text("variants/mexico_to_pisa_ideal.toml")
     );
     let err = EpuckScenario::parse(&text, Path::new("bad.toml"))
         .unwrap_err()
@@ -51,11 +51,14 @@ fn a_bad_realism_field_is_named_with_its_value_and_range() {
 
 #[test]
 fn an_ideal_realism_table_is_the_ideal_user() {
-    let plain =
-        GridScenario::parse(&scenario_text("grid_fixed_goals.toml"), Path::new("a")).unwrap();
+    let plain = GridScenario::parse(
+        &scenario_text("variants/grid_fixed_goals_ideal.toml"),
+        Path::new("a"),
+    )
+    .unwrap();
     let text = format!(
         "{}\n[realism]\nlapse_rate = 0.0\n",
-        scenario_text("grid_fixed_goals.toml")
+        scenario_text("variants/grid_fixed_goals_ideal.toml")
     );
     let explicit = GridScenario::parse(&text, Path::new("a")).unwrap();
     assert_eq!(plain, explicit);
@@ -71,7 +74,7 @@ fn a_task_shift_puts_online_accuracy_below_calibration() {
     // above the online accuracy (for the ideal user it is below it).
     let text = format!(
         "{}\n[realism]\ntask_gain = 0.6\n",
-        scenario_text("grid_fixed_goals.toml")
+        scenario_text("variants/grid_fixed_goals_ideal.toml")
     );
     let shifted = GridScenario::parse(&text, Path::new("shifted.toml")).unwrap();
     let (_, report) = prepare_decoder(&shifted, |_| {}).unwrap();
@@ -80,4 +83,91 @@ fn a_task_shift_puts_online_accuracy_below_calibration() {
     let cv = report.calibrated.accuracy.mean();
     assert!((online - 0.7438).abs() <= 0.005, "online {online}");
     assert!(cv > online + 0.05, "calibration {cv} vs online {online}");
+}
+
+/// The shipped scenarios and their variants.
+fn shipped() -> Vec<std::path::PathBuf> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios");
+    let mut files = Vec::new();
+    for dir in [root.clone(), root.join("variants")] {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().is_some_and(|e| e == "toml") {
+                files.push(path);
+            }
+        }
+    }
+    files.sort();
+    files
+}
+
+#[test]
+fn the_shipped_user_is_the_published_one_and_the_ideal_grid_variants_differ_only_by_it() {
+    let files = shipped();
+    assert!(files.len() >= 16, "{files:?}");
+    for path in &files {
+        let scenario = errp_sim::load_scenario(path).unwrap();
+        let name = path.file_name().unwrap().to_string_lossy();
+        if let Some(base) = name.strip_suffix("_ideal.toml") {
+            assert!(scenario.realism().is_ideal(), "{name}");
+            if matches!(scenario, errp_sim::AnyScenario::Epuck(_)) {
+                // The e-puck's keep the idealised user's own fit (90 %)
+                // and runs seed; the grid's differ only by the user.
+                continue;
+            }
+            // The same scenario as the shipped one but for the user.
+            let shipped =
+                errp_sim::load_scenario(path.parent().unwrap().join(format!("../{base}.toml")))
+                    .unwrap();
+            let strip = |s: &errp_sim::AnyScenario| {
+                format!("{s:?}")
+                    .replace(&format!("{:?}", s.realism()), "")
+                    .replace(&format!("{base}_ideal"), base)
+            };
+            let (a, b) = (strip(&scenario), strip(&shipped));
+            // The file's path is the one difference left.
+            let path_free = |s: String| match s.find("path: \"") {
+                Some(i) => {
+                    let rest = &s[i + 7..];
+                    let end = rest.find('"').unwrap();
+                    format!("{}{}", &s[..i], &rest[end + 1..])
+                }
+                None => s,
+            };
+            assert_eq!(path_free(a), path_free(b), "{name}");
+        } else {
+            let published = match scenario {
+                errp_sim::AnyScenario::Grid(_) => errp_bci::Realism::published(),
+                errp_sim::AnyScenario::Epuck(_) => errp_bci::Realism::published_continuous(),
+            };
+            assert_eq!(
+                *scenario.realism(),
+                published,
+                "{name}: the shipped user is Realism::published() (grid) or \
+                 published_continuous() (e-puck)"
+            );
+        }
+    }
+}
+
+#[test]
+fn at_the_continuous_task_shift_calibration_is_above_online_accuracy() {
+    // The grid with the e-puck's shipped user: the ErrP 33.3 ms later in
+    // the closed loop and a background that drifts. The decoder is targeted
+    // at Table 1's accuracy online, so the calibration session's
+    // cross-validated accuracy comes out well above it (the idealised
+    // user's, at this seed, is 1.65 points below: a shift of 0 fails).
+    let text = format!(
+        "{}\n[realism]\nbackground_drift = 0.13\nalpha_drift = 0.18\ndrift_secs = 1800\n\
+         task_latency_ms = 33.3\n",
+        scenario_text("variants/grid_fixed_goals_ideal.toml")
+    );
+    let shifted = GridScenario::parse(&text, Path::new("shifted.toml")).unwrap();
+    assert_eq!(shifted.realism, errp_bci::Realism::published_continuous());
+    let (_, report) = prepare_decoder(&shifted, |_| {}).unwrap();
+    let report = report.unwrap();
+    let online = report.targeting.accuracy.mean();
+    let cv = report.calibrated.accuracy.mean();
+    assert!((online - 0.7438).abs() <= 0.005, "online {online}");
+    assert!(cv > online + 0.03, "calibration {cv} vs online {online}");
 }

@@ -59,6 +59,9 @@ pub struct GridFitSpec {
     pub seed: u64,
     /// Bootstrap replicates for the Monte Carlo error.
     pub bootstrap: usize,
+    /// The simulated users (left out of the written spec when ideal).
+    #[serde(skip_serializing_if = "errp_bci::Realism::is_ideal")]
+    pub realism: errp_bci::Realism,
 }
 
 /// Epochs per class in each calibration's bank.
@@ -334,7 +337,13 @@ fn check_out(out: &Path) -> Result<()> {
 
 /// The scenario of one calibration: the subject's accuracy, the paper's
 /// task with `params`, epochs from a bank.
-fn scenario(accuracy: f64, seed: u64, subject: &str, params: GridTaskParams) -> GridScenario {
+fn scenario(
+    accuracy: f64,
+    seed: u64,
+    subject: &str,
+    params: GridTaskParams,
+    realism: &errp_bci::Realism,
+) -> GridScenario {
     GridScenario {
         path: "fit grid".into(),
         name: format!("{subject} (fit grid)"),
@@ -348,7 +357,7 @@ fn scenario(accuracy: f64, seed: u64, subject: &str, params: GridTaskParams) -> 
         user: subject.to_string(),
         episodes: Vec::new(),
         params,
-        realism: errp_bci::Realism::default(),
+        realism: realism.clone(),
     }
 }
 
@@ -407,7 +416,7 @@ pub fn run_grid_fit(
                 &free
             };
             let row = &rows[subject];
-            let s = scenario(row.accuracy, seed, &row.subject, base);
+            let s = scenario(row.accuracy, seed, &row.subject, base, &spec.realism);
             let prepared = prepare_grid_decoder(&s, &GridShared::default(), cache, |_| {})?;
             observer.decoder_ready(
                 &prepared.info(&s),

@@ -355,6 +355,7 @@ fn a_small_grid_fit_writes_its_files_and_refuses_bad_settings() {
         repeats: 2,
         seed: 5,
         bootstrap: 10,
+        realism: errp_bci::Realism::published(),
     };
     let cancel = AtomicBool::new(false);
     let GridFitOutcome::Complete(fit, files) =
