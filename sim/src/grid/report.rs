@@ -97,6 +97,35 @@ impl fmt::Display for GridRunReport {
     }
 }
 
+/// Calibration against online for each subject of a goal set: what an
+/// experimenter sees as the gap between the calibration session and the
+/// closed loop (nothing for the oracle, which has no calibration).
+fn calibration_gaps(f: &mut fmt::Formatter<'_>, cells: &[Table1Cell], set: GoalSet) -> fmt::Result {
+    let gaps: Vec<String> = cells
+        .iter()
+        .filter(|c| c.goals == set)
+        .filter_map(|c| {
+            c.calibration.map(|(cv, online)| {
+                format!(
+                    "{} {:.2}/{:.2} ({:+.2})",
+                    c.subject,
+                    100.0 * cv,
+                    100.0 * online,
+                    100.0 * (cv - online)
+                )
+            })
+        })
+        .collect();
+    if gaps.is_empty() {
+        return Ok(());
+    }
+    writeln!(
+        f,
+        "           calibration cross-validated / online held-out accuracy (%): {}",
+        gaps.join(", ")
+    )
+}
+
 /// Table 1 as `errp table1` prints it: one row per subject and goal set,
 /// ours beside the paper's, the pooled rows and the accuracy-time
 /// correlations.
@@ -211,30 +240,7 @@ impl fmt::Display for Table1Report<'_> {
                 f,
                 "           accuracy vs total time ({set_name} goals): {ours_r}   [paper: r = {paper_r}, p = {paper_p:.2e}]"
             )?;
-            // Calibration against online: what an experimenter sees as the
-            // gap between the calibration session and the closed loop.
-            let gaps: Vec<String> = cells
-                .iter()
-                .filter(|c| c.goals == set)
-                .filter_map(|c| {
-                    c.calibration.map(|(cv, online)| {
-                        format!(
-                            "{} {:.2}/{:.2} ({:+.2})",
-                            c.subject,
-                            100.0 * cv,
-                            100.0 * online,
-                            100.0 * (cv - online)
-                        )
-                    })
-                })
-                .collect();
-            if !gaps.is_empty() {
-                writeln!(
-                    f,
-                    "           calibration cross-validated / online held-out accuracy (%): {}",
-                    gaps.join(", ")
-                )?;
-            }
+            calibration_gaps(f, cells, set)?;
         }
         Ok(())
     }
