@@ -79,11 +79,11 @@ fn main() {
             reward: Some(1.0),
         },
         Variant {
-            label: "Platt, goal reward 9.5 (the fit's unconstrained estimate)",
+            label: "Platt, goal reward 9 (the fit's unconstrained estimate)",
             platt: Some(true),
             epsilon: 0.1,
             discount: 0.9,
-            reward: Some(9.5),
+            reward: Some(9.0),
         },
         Variant {
             label: "oracle decoder, p = accuracy",
