@@ -20,6 +20,8 @@
 //!   ([`target_continuous_accuracy`]), and its online side: the sliding
 //!   window ([`SlidingWindow`]), the asynchronous [`Detector`] and its
 //!   operating point on a held-out recording ([`operating_point`]);
+//! * the information one decoded action carries about the user's verdict
+//!   ([`ActionInformation`]);
 //! * the subjects of Table 1 ([`subject`]) and EDF+ export ([`EdfWriter`]).
 
 #![warn(clippy::unwrap_used, clippy::print_stdout, clippy::iter_over_hash_type)]
@@ -35,6 +37,7 @@ mod error;
 mod features;
 mod filter;
 mod generator;
+mod information;
 mod lda;
 mod montage;
 mod noise;
@@ -72,6 +75,10 @@ pub use errp_valid::{Check, Valid};
 pub use features::{EpochWindow, FeatureExtractor};
 pub use filter::{Biquad, FilterBank, FilterChain};
 pub use generator::{Assessment, Components, EegBlock, EegGenerator, GeneratorParams, Realism};
+pub use information::{
+    ActionInformation, INFORMATION_BINS, binary_channel_bits, binary_entropy,
+    binary_symmetric_bits, erasure_bits,
+};
 pub use lda::{LdaDecoder, LdaModel, Shrinkage, ledoit_wolf_shrinkage, pca_basis};
 pub use montage::{Channel, ChannelKind, DECODING_CHANNELS, Montage};
 pub use noise::{PinkNoise, Resonator};

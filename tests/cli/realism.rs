@@ -37,6 +37,19 @@ fn realism_sets_the_shipped_user_beside_published_figures() {
         error < correct && mean > 74.4 - 3.0 && mean < 74.4 + 10.0,
         "{mean}"
     );
+    // What the class rates alone carry, as a binary channel (1 - H(a) at
+    // equal rates), and what the graded p(error) carries: more.
+    let binary = value("discrete decoder: information in its class rates");
+    let expected = errp_bci::binary_channel_bits(error / 100.0, correct / 100.0);
+    assert!(
+        (binary - expected).abs() <= 0.006,
+        "{binary} against {expected}"
+    );
+    let bits = value("discrete decoder: information in p(error)");
+    assert!(
+        bits > binary + 0.02 && bits < 1.0,
+        "{bits} against {binary}"
+    );
     assert!(out.contains("Chavarriaga & Millan 2010"), "{out}");
     assert!(out.contains("Lopes-Dias et al. 2019"), "{out}");
 }

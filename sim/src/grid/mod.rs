@@ -14,8 +14,8 @@ pub(crate) mod task;
 pub(crate) mod view;
 
 pub use decoder::{
-    AssessmentDecoder, EegDecoder, EegSource, EpochBank, EpochBankParts, EpochBlocks, PErrorChoice,
-    PErrorMapping,
+    AssessmentDecoder, EegDecoder, EegSource, EpochBank, EpochBankParts, EpochBlocks,
+    INFORMATION_PER_CLASS, PErrorChoice, PErrorMapping,
 };
 pub use environment::{GridEnvironment, GridFeedback};
 pub use episode::{

@@ -126,6 +126,31 @@ fn calibration_gaps(f: &mut fmt::Formatter<'_>, cells: &[Table1Cell], set: GoalS
     )
 }
 
+/// The information per action of each subject's decoder on a goal set,
+/// between what a binary symmetric channel and an erasure channel at the
+/// same accuracy carry (the least and the most at that accuracy).
+fn information(f: &mut fmt::Formatter<'_>, cells: &[Table1Cell], set: GoalSet) -> fmt::Result {
+    let bits: Vec<String> = cells
+        .iter()
+        .filter(|c| c.goals == set)
+        .map(|c| {
+            let i = &c.information;
+            format!(
+                "{} {:.3} [{:.3}-{:.3}]",
+                c.subject,
+                i.bits,
+                i.binary_symmetric_bits(),
+                i.erasure_bits()
+            )
+        })
+        .collect();
+    writeln!(
+        f,
+        "           information per action (bits, equal priors) [binary symmetric-erasure channel at its accuracy]: {}",
+        bits.join(", ")
+    )
+}
+
 /// Table 1 as `errp table1` prints it: one row per subject and goal set,
 /// ours beside the paper's, the pooled rows and the accuracy-time
 /// correlations.
@@ -241,6 +266,7 @@ impl fmt::Display for Table1Report<'_> {
                 "           accuracy vs total time ({set_name} goals): {ours_r}   [paper: r = {paper_r}, p = {paper_p:.2e}]"
             )?;
             calibration_gaps(f, cells, set)?;
+            information(f, cells, set)?;
         }
         Ok(())
     }

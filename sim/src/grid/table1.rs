@@ -1,12 +1,12 @@
 //! Table 1 of the paper, re-run: the four subjects at their accuracies, on
 //! the fixed and the free goals.
 
-use errp_bci::{GoalSet, TargetingStep, rng::derive_seed, subjects};
+use errp_bci::{ActionInformation, GoalSet, TargetingStep, rng::derive_seed, subjects};
 use errp_robot::{Cell, Grid, GridControlParams, QTable};
 use rayon::prelude::*;
 
 use crate::error::Result;
-use crate::grid::decoder::PErrorChoice;
+use crate::grid::decoder::{INFORMATION_PER_CLASS, PErrorChoice};
 use crate::grid::episode::{GridEpisodeResult, run_grid_episode};
 use crate::grid::params::GridTaskParams;
 use crate::grid::run::prepare_decoder;
@@ -38,6 +38,9 @@ pub struct Table1Cell {
     /// calibration session, accuracy on held-out closed-loop epochs, which
     /// the targeting hits): `None` for the oracle.
     pub calibration: Option<(f64, f64)>,
+    /// What one action's p(error) tells of the user's verdict, measured on
+    /// [`INFORMATION_PER_CLASS`] fresh closed-loop actions of each class.
+    pub information: ActionInformation,
 }
 
 impl Table1Cell {
@@ -136,6 +139,11 @@ pub fn run_table1(
                 }
             );
             let (decoder, report) = prepare_decoder(&scenario, |s| progress(&label, s))?;
+            let information = decoder.information(
+                &options.params,
+                INFORMATION_PER_CLASS,
+                derive_seed(cell_seed, "table1/information", 0),
+            )?;
             let mut runs = Vec::new();
             for r in 0..options.repeats {
                 for (j, &(start, goal)) in pairs.iter().enumerate() {
@@ -158,6 +166,7 @@ pub fn run_table1(
                 runs,
                 calibration: report
                     .map(|r| (r.calibrated.accuracy.mean(), r.targeting.accuracy.mean())),
+                information,
             })
         })
         .collect()

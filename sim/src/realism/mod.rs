@@ -14,7 +14,9 @@ use errp_bci::{
 use crate::calibration::NoCache;
 use crate::epuck::{EpuckScenario, prepare_epuck_decoder};
 use crate::error::Result;
-use crate::grid::{GridScenario, pooled_accuracy, prepare_decoder, run_grid_scenario};
+use crate::grid::{
+    GridScenario, INFORMATION_PER_CLASS, pooled_accuracy, prepare_decoder, run_grid_scenario,
+};
 
 pub use published::{PUBLISHED, Published, Source};
 use spectrum::{alpha_peak_hz, aperiodic_exponent, band, excess_kurtosis, sd, welch};
@@ -169,6 +171,11 @@ fn grid_values(s: &GridScenario) -> Result<Vec<(&'static str, f64)>> {
     let (neg_ms, neg_uv) = at(150.0, 320.0, -1.0);
     let (pos_ms, pos_uv) = at(250.0, 450.0, 1.0);
     let cv = report.calibrated.accuracy;
+    let information = decoder.information(
+        &s.params,
+        INFORMATION_PER_CLASS,
+        errp_bci::rng::derive_seed(s.seed, "realism/information", 0),
+    )?;
     let episodes = run_grid_scenario(s, &decoder, false, |_, _| {})?;
     let online = pooled_accuracy(&episodes);
     Ok(vec![
@@ -180,6 +187,11 @@ fn grid_values(s: &GridScenario) -> Result<Vec<(&'static str, f64)>> {
         ("blinks_per_min", 60.0 * setup.generator.blink_rate_hz),
         ("discrete_error_class", 100.0 * cv.error),
         ("discrete_correct_class", 100.0 * cv.correct),
+        (
+            "binary_channel_bits",
+            errp_bci::binary_channel_bits(cv.error, cv.correct),
+        ),
+        ("information_bits", information.bits),
         (
             "calibration_minus_online",
             100.0 * (cv.mean() - online.mean()),

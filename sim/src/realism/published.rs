@@ -163,6 +163,26 @@ pub static PUBLISHED: &[Published] = &[
         }),
     },
     Published {
+        key: "binary_channel_bits",
+        what: "discrete decoder: information in its class rates",
+        unit: "bits",
+        value: 0.21,
+        range: Some((0.11, 0.31)),
+        source: Some(Source {
+            cite: "the class rates above as a binary channel at equal priors: \
+                   Chavarriaga & Millan 2010 (0.11), Ferrez & Millan 2008 (0.31)",
+            doi: "10.1109/TNSRE.2010.2053387",
+        }),
+    },
+    Published {
+        key: "information_bits",
+        what: "discrete decoder: information in p(error)",
+        unit: "bits",
+        value: f64::NAN,
+        range: None,
+        source: None,
+    },
+    Published {
         key: "calibration_minus_online",
         what: "grid: calibration (cross-validated) minus online",
         unit: "points",

@@ -205,3 +205,39 @@ fn the_grid_decoder_is_targeted_on_held_out_epochs_not_by_cross_validation() {
         held_out.mean()
     );
 }
+
+/// The oracle is a binary symmetric channel: its p(error) carries 1 - H(a)
+/// bits at equal priors (analytic), and the measure finds that.
+#[test]
+fn the_oracle_carries_what_a_binary_symmetric_channel_does() {
+    let params = GridTaskParams::default();
+    for a in [0.6, 0.7438, 0.9] {
+        let m = AssessmentDecoder::Oracle { accuracy: a }
+            .information(&params, 20_000, 1)
+            .unwrap();
+        let analytic = errp_bci::binary_symmetric_bits(a);
+        assert!((m.accuracy - a).abs() < 0.01, "{a}: {m:?}");
+        assert!(
+            (m.bits - analytic).abs() < 0.01,
+            "{a}: {m:?} against {analytic}"
+        );
+    }
+}
+
+/// The EEG decoder's p(error) is graded, not a class: at 74.38 % it carries
+/// clearly more than a binary symmetric channel at its accuracy, and less
+/// than an erasure channel, the most a decoder at that accuracy can carry.
+#[test]
+fn the_eeg_decoder_carries_more_than_its_class_alone() {
+    let params = GridTaskParams::default();
+    let d = eeg_decoder(0.7438, 1);
+    let m = d.information(&params, 500, 1).unwrap();
+    assert!((m.accuracy - 0.7438).abs() < 0.04, "{m:?}");
+    assert!(
+        m.bits > m.binary_symmetric_bits() + 0.02 && m.bits < m.erasure_bits() - 0.05,
+        "{m:?}: bounds {} to {}",
+        m.binary_symmetric_bits(),
+        m.erasure_bits()
+    );
+    assert_eq!(d.information(&params, 500, 1).unwrap(), m);
+}
