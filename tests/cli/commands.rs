@@ -581,6 +581,12 @@ fn bad_fit_input_is_exit_2_naming_the_flag() {
         (&["--goal-reward", "abc"][..], "--goal-reward \"abc\""),
         (&["--goal-reward", "0:1:0.5"][..], "(0, 100]"),
         (&["--repeats", "1"][..], "2 to 1000"),
+        (
+            &["--pair-length", "4:8:1"][..],
+            "--pair-length 4 is invalid",
+        ),
+        (&["--pair-length", "8.5"][..], "--pair-length \"8.5\""),
+        (&["--pair-length", "40"][..], "5 to 36"),
     ] {
         let mut full = vec!["fit", "grid"];
         full.extend_from_slice(args);

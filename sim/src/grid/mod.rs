@@ -4,6 +4,7 @@
 pub(crate) mod decoder;
 pub(crate) mod environment;
 pub(crate) mod episode;
+pub(crate) mod pairs;
 pub(crate) mod params;
 pub(crate) mod report;
 pub(crate) mod run;
@@ -21,6 +22,9 @@ pub use environment::{GridEnvironment, GridFeedback};
 pub use episode::{
     EpochDecoder, GridDecoding, GridEpisodeResult, GridStep, run_grid_episode,
     run_grid_episode_with,
+};
+pub use pairs::{
+    CENTRAL_RUN, PAIRS_PER_SET, PairFamily, keeps_to_the_centre, manhattan, total_length,
 };
 pub use params::GridTaskParams;
 pub use report::{GridEpisodeHeader, GridEpisodeRow, Table1Report};

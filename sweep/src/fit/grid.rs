@@ -30,7 +30,8 @@ use errp_bci::{GoalSet, subjects};
 use errp_robot::{Cell, Grid, GridControlParams, QTable};
 use errp_sim::grid::{
     AssessmentDecoder, DecoderChoice, EegMode, FIXED_PAIRS, GridEpisodeResult, GridScenario,
-    GridShared, GridTaskParams, PErrorChoice, free_pairs, prepare_grid_decoder, run_grid_episode,
+    GridShared, GridTaskParams, PErrorChoice, PairFamily, free_pairs, prepare_grid_decoder,
+    run_grid_episode,
 };
 use errp_sim::{PAPER, Result, SimError, create_dir, mean_sd, pearson};
 use rayon::prelude::*;
@@ -62,7 +63,15 @@ pub struct GridFitSpec {
     /// The simulated users (left out of the written spec when ideal).
     #[serde(skip_serializing_if = "errp_bci::Realism::is_ideal")]
     pub realism: errp_bci::Realism,
+    /// The fixed pairs' total Manhattan lengths, fitted jointly with the
+    /// goal reward ([`PairFamily`]: each group of five runs draws its own
+    /// set of that length); empty: the shipped pairs ([`FIXED_PAIRS`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub pair_lengths: Vec<usize>,
 }
+
+/// The largest number of pair lengths in one fit.
+pub const MAX_PAIR_LENGTHS: usize = 32;
 
 /// Epochs per class in each calibration's bank.
 pub const GRID_FIT_BANK: usize = 1000;
@@ -189,10 +198,54 @@ pub struct GridFit {
     pub reached_estimate: Option<f64>,
     /// How the likelihood is estimated, in words.
     pub density: String,
+    /// The fixed pairs' length fitted jointly with the goal reward, when
+    /// asked for (`spec.pair_lengths`); the rest of this result is then the
+    /// fit at [`PairsFit::chosen`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pairs: Option<PairsFit>,
     /// What was run.
     pub spec: GridFitSpec,
     /// How.
     pub provenance: Provenance,
+}
+
+/// The fixed pairs' total Manhattan length, profiled over the goal reward.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PairsFit {
+    /// The candidate lengths.
+    pub lengths: Vec<usize>,
+    /// Per length: the fixed rows' log-likelihood maximised over the goal
+    /// reward (the profile likelihood of the length).
+    pub profile: Vec<f64>,
+    /// Per length: the goal reward at that maximum.
+    pub goal_reward: Vec<f64>,
+    /// Per length: P(all 40 of the paper's goals reached) there.
+    pub p_all_reached: Vec<f64>,
+    /// Per length: the largest-likelihood goal reward among those that keep
+    /// the paper's 40/40 (P >= [`REACHED_LEVEL`]), and its log-likelihood.
+    pub reached: Vec<Option<(f64, f64)>>,
+    /// `fixed_actions[length][subject][goal reward]`: the mean actions of
+    /// the fixed-goal runs.
+    pub fixed_actions: Vec<Vec<Vec<f64>>>,
+    /// `fixed_z[length][subject]`: the fixed rows' z at the length's
+    /// maximum-likelihood goal reward.
+    pub fixed_z: Vec<Vec<f64>>,
+    /// `free_z[length][subject]`: the held-out free rows' z there.
+    pub free_z: Vec<Vec<f64>>,
+    /// The maximum-likelihood length.
+    pub estimate: usize,
+    /// Its 95 % likelihood-ratio interval (the profile within 1.92 of its
+    /// maximum).
+    pub interval_95: (usize, usize),
+    /// The largest-likelihood (length, goal reward) that keeps the paper's
+    /// 40/40; none if no point does.
+    pub reached_estimate: Option<(usize, f64)>,
+    /// The length the rest of the result is fitted at: the 40/40 estimate's,
+    /// or the maximum-likelihood one if none keeps 40/40.
+    pub chosen: usize,
+    /// One set of the chosen length, drawn from the family with the fit's
+    /// seed: a pair set that a scenario can take.
+    pub example: Vec<(Cell, Cell)>,
 }
 
 /// Result file format written by this version.
@@ -320,6 +373,24 @@ fn check_spec(spec: &GridFitSpec) -> Result<()> {
             spec.repeats
         ));
     }
+    let lengths = PairFamily::paper().lengths();
+    if spec.pair_lengths.len() > MAX_PAIR_LENGTHS {
+        return bad(format!(
+            "--pair-length gives {} values: at most {MAX_PAIR_LENGTHS}",
+            spec.pair_lengths.len()
+        ));
+    }
+    if let Some(v) = spec.pair_lengths.iter().find(|v| !lengths.contains(*v)) {
+        return bad(format!(
+            "--pair-length {v} is invalid: five fixed pairs whose third keeps to the centre have a \
+             total Manhattan length of {} to {}",
+            lengths.start(),
+            lengths.end()
+        ));
+    }
+    if spec.pair_lengths.windows(2).any(|w| w[1] <= w[0]) {
+        return bad("--pair-length must list increasing values".into());
+    }
     if spec.bootstrap < 10 || spec.bootstrap > super::MAX_BOOTSTRAP {
         return bad(format!(
             "--bootstrap {} is invalid: expected 10 to {} replicates",
@@ -438,61 +509,246 @@ pub fn run_grid_fit(
     if calibrations.len() != jobs.len() {
         return Ok(GridFitOutcome::Interrupted);
     }
-    // runs[point][calibration][repeat][pair]
-    let points = spec.goal_rewards.len();
-    let per_point = calibrations.len() * spec.repeats;
-    let total = points * per_point * 5;
-    let episodes = AtomicUsize::new(0);
-    let mut runs: Vec<Vec<Vec<Vec<Run>>>> = Vec::with_capacity(points);
-    for &g in &spec.goal_rewards {
-        let mut params = base;
-        params.control = base.control.with(|c| {
-            c.goal_reward = g;
-            c.epsilon = spec.epsilon;
-        })?;
-        let table = QTable::compute(Grid::paper(), &params.control.part(GridControlParams::q))?;
-        let at_point: Vec<Vec<Vec<Run>>> = calibrations
-            .par_iter()
-            .map(|c| {
-                (0..spec.repeats)
-                    .map(|r| {
-                        if cancel.load(Ordering::Relaxed) {
-                            return Err(SimError::Sweep("interrupted".into()));
-                        }
-                        let group = pairs(c.goals, c.seed, r)
-                            .into_iter()
-                            .enumerate()
-                            .map(|(j, (start, goal))| {
-                                let seed = derive_seed(c.seed, "fit/grid/run", (r * 5 + j) as u64);
-                                run_grid_episode(
-                                    start, goal, &table, &params, &c.decoder, seed, false,
-                                )
-                                .map(|e| Run::from(&e))
-                            })
-                            .collect::<Result<Vec<Run>>>()?;
-                        let n = episodes.fetch_add(5, Ordering::Relaxed) + 5;
-                        observer.episodes_done(n, total);
-                        Ok(group)
-                    })
-                    .collect::<Result<Vec<_>>>()
-            })
-            .collect::<Result<Vec<_>>>()
-            .or_else(|e| {
-                if cancel.load(Ordering::Relaxed) {
-                    Ok(Vec::new())
-                } else {
-                    Err(e)
-                }
-            })?;
-        if at_point.len() != calibrations.len() {
+    let family = PairFamily::paper();
+    let sets = spec.pair_lengths.len();
+    let per_set = spec.goal_rewards.len() * spec.repeats * 5 * calibrations.len() / 2;
+    let episodes = Episodes {
+        spec,
+        calibrations: &calibrations,
+        base,
+        family: &family,
+        cancel,
+        observer,
+        done: AtomicUsize::new(0),
+        total: per_set * (sets.max(1) + 1),
+    };
+    let fit = if sets == 0 {
+        let Some(runs) = episodes.run(None, None)? else {
             return Ok(GridFitOutcome::Interrupted);
+        };
+        analyse(spec, &calibrations, &runs, &fixed, &free, provenance)
+    } else {
+        let Some(free_runs) = episodes.run(Some(GoalSet::Free), None)? else {
+            return Ok(GridFitOutcome::Interrupted);
+        };
+        let mut fits = Vec::with_capacity(sets);
+        for &length in &spec.pair_lengths {
+            let Some(fixed_runs) = episodes.run(Some(GoalSet::Fixed), Some(length))? else {
+                return Ok(GridFitOutcome::Interrupted);
+            };
+            // runs[point][calibration]: the fixed calibrations' runs at this
+            // length, the free ones' (which no length changes) shared.
+            let runs: PointRuns = fixed_runs
+                .into_iter()
+                .zip(&free_runs)
+                .map(|(at_fixed, at_free)| {
+                    at_fixed
+                        .into_iter()
+                        .zip(at_free)
+                        .zip(&calibrations)
+                        .map(|((f, r), c)| {
+                            if c.goals == GoalSet::Fixed {
+                                f
+                            } else {
+                                r.clone()
+                            }
+                        })
+                        .collect()
+                })
+                .collect();
+            fits.push(analyse(
+                spec,
+                &calibrations,
+                &runs,
+                &fixed,
+                &free,
+                provenance.clone(),
+            ));
         }
-        runs.push(at_point);
-    }
-    let fit = analyse(spec, &calibrations, &runs, &fixed, &free, provenance);
+        pairs_fit(spec, &family, fits)
+    };
     create_dir(out)?;
     let files = write_fit(&fit, out)?;
     Ok(GridFitOutcome::Complete(Box::new(fit), files))
+}
+
+/// `runs[point][calibration][repeat][pair]`.
+type PointRuns = Vec<Vec<Vec<Vec<Run>>>>;
+
+/// The episodes of a fit: every calibration's groups of five runs at every
+/// goal reward.
+struct Episodes<'a> {
+    spec: &'a GridFitSpec,
+    calibrations: &'a [Calibration],
+    base: GridTaskParams,
+    family: &'a PairFamily,
+    cancel: &'a AtomicBool,
+    observer: &'a dyn SweepObserver,
+    done: AtomicUsize,
+    total: usize,
+}
+
+impl Episodes<'_> {
+    /// `runs[point][calibration][repeat][pair]` of the calibrations of
+    /// `goals` (all if none; the others' lists are empty), the fixed pairs
+    /// drawn from the family at `length` if given (one set per group, the
+    /// same at every goal reward); `None` if cancelled.
+    fn run(
+        &self,
+        goals: Option<GoalSet>,
+        length: Option<usize>,
+    ) -> Result<Option<PointRuns>> {
+        let spec = self.spec;
+        let mut runs = Vec::with_capacity(spec.goal_rewards.len());
+        for &g in &spec.goal_rewards {
+            let mut params = self.base;
+            params.control = self.base.control.with(|c| {
+                c.goal_reward = g;
+                c.epsilon = spec.epsilon;
+            })?;
+            let table = QTable::compute(Grid::paper(), &params.control.part(GridControlParams::q))?;
+            let at_point: Vec<Vec<Vec<Run>>> = self
+                .calibrations
+                .par_iter()
+                .map(|c| {
+                    if goals.is_some_and(|goals| goals != c.goals) {
+                        return Ok(Vec::new());
+                    }
+                    (0..spec.repeats)
+                        .map(|r| self.group(c, r, length, &table, &params))
+                        .collect::<Result<Vec<_>>>()
+                })
+                .collect::<Result<Vec<_>>>()
+                .or_else(|e| {
+                    if self.cancel.load(Ordering::Relaxed) {
+                        Ok(Vec::new())
+                    } else {
+                        Err(e)
+                    }
+                })?;
+            if at_point.len() != self.calibrations.len() {
+                return Ok(None);
+            }
+            runs.push(at_point);
+        }
+        Ok(Some(runs))
+    }
+
+    /// Group `r` of calibration `c`: five runs, one per pair.
+    fn group(
+        &self,
+        c: &Calibration,
+        r: usize,
+        length: Option<usize>,
+        table: &QTable,
+        params: &GridTaskParams,
+    ) -> Result<Vec<Run>> {
+        if self.cancel.load(Ordering::Relaxed) {
+            return Err(SimError::Sweep("interrupted".into()));
+        }
+        let group_pairs = match (c.goals, length) {
+            (GoalSet::Fixed, Some(length)) => {
+                let mut rng = stream(derive_seed(c.seed, "fit/grid/pairs", r as u64), "pairs");
+                self.family.draw(length, &mut rng).ok_or_else(|| {
+                    SimError::Sweep(format!("no fixed pair set has total length {length}"))
+                })?
+            }
+            _ => pairs(c.goals, c.seed, r),
+        };
+        let group = group_pairs
+            .into_iter()
+            .enumerate()
+            .map(|(j, (start, goal))| {
+                let seed = derive_seed(c.seed, "fit/grid/run", (r * 5 + j) as u64);
+                run_grid_episode(start, goal, table, params, &c.decoder, seed, false)
+                    .map(|e| Run::from(&e))
+            })
+            .collect::<Result<Vec<Run>>>()?;
+        let n = self.done.fetch_add(5, Ordering::Relaxed) + 5;
+        self.observer.episodes_done(n, self.total);
+        Ok(group)
+    }
+}
+
+/// The fit over the pairs' lengths: the profile of each length over the
+/// goal reward, the estimates, and the fit at the chosen length.
+fn pairs_fit(spec: &GridFitSpec, family: &PairFamily, fits: Vec<GridFit>) -> GridFit {
+    let lengths = spec.pair_lengths.clone();
+    let best: Vec<usize> = fits.iter().map(|f| argmax(&f.surface.total)).collect();
+    let profile: Vec<f64> = fits
+        .iter()
+        .zip(&best)
+        .map(|(f, &j)| f.surface.total[j])
+        .collect();
+    let reached: Vec<Option<(f64, f64)>> = fits
+        .iter()
+        .map(|f| {
+            f.reached_estimate.map(|g| {
+                let j = spec
+                    .goal_rewards
+                    .iter()
+                    .position(|&x| x == g)
+                    .expect("the 40/40 estimate is a grid point");
+                (g, f.surface.total[j])
+            })
+        })
+        .collect();
+    let top = argmax(&profile);
+    let within: Vec<usize> = (0..lengths.len())
+        .filter(|&k| profile[k] >= profile[top] - super::surface::CHI2_1_95 / 2.0)
+        .collect();
+    let reached_at = (0..lengths.len())
+        .filter(|&k| reached[k].is_some())
+        .max_by(|&a, &b| {
+            let l = |k: usize| reached[k].map_or(f64::NEG_INFINITY, |r| r.1);
+            l(a).total_cmp(&l(b))
+        });
+    let chosen = reached_at.unwrap_or(top);
+    let mut rng = stream(derive_seed(spec.seed, "fit/grid/pairs/example", 0), "pairs");
+    let example = family
+        .draw(lengths[chosen], &mut rng)
+        .expect("every fitted length has sets");
+    let pairs = PairsFit {
+        profile,
+        goal_reward: best.iter().map(|&j| spec.goal_rewards[j]).collect(),
+        p_all_reached: fits
+            .iter()
+            .zip(&best)
+            .map(|(f, &j)| f.p_all_reached[j])
+            .collect(),
+        reached: reached.clone(),
+        fixed_actions: fits
+            .iter()
+            .map(|f| {
+                f.fixed_stats
+                    .iter()
+                    .map(|per_point| per_point.iter().map(|c| c.actions.0).collect())
+                    .collect()
+            })
+            .collect(),
+        fixed_z: fits
+            .iter()
+            .zip(&best)
+            .map(|(f, &j)| f.fixed_stats.iter().map(|p| p[j].z).collect())
+            .collect(),
+        free_z: fits
+            .iter()
+            .zip(&best)
+            .map(|(f, &j)| f.free_stats.iter().map(|p| p[j].z).collect())
+            .collect(),
+        estimate: lengths[top],
+        interval_95: (
+            lengths[*within.first().unwrap_or(&top)],
+            lengths[*within.last().unwrap_or(&top)],
+        ),
+        reached_estimate: reached_at.and_then(|k| reached[k].map(|(g, _)| (lengths[k], g))),
+        chosen: lengths[chosen],
+        example,
+        lengths,
+    };
+    let mut fit = fits.into_iter().nth(chosen).expect("one fit per length");
+    fit.pairs = Some(pairs);
+    fit
 }
 
 /// The groups of one subject on one goal set at a grid point, as
@@ -709,6 +965,7 @@ fn analyse(
         own_estimates,
         free_log_lik,
         density: GRID_DENSITY.into(),
+        pairs: None,
         spec: spec.clone(),
         provenance,
     }

@@ -359,6 +359,7 @@ fn a_small_grid_fit_writes_its_files_and_refuses_bad_settings() {
         seed: 5,
         bootstrap: 10,
         realism: errp_bci::Realism::published(),
+        pair_lengths: Vec::new(),
     };
     let cancel = AtomicBool::new(false);
     let GridFitOutcome::Complete(fit, files) =
@@ -417,6 +418,20 @@ fn a_small_grid_fit_writes_its_files_and_refuses_bad_settings() {
             },
             "--repeats 1",
         ),
+        (
+            GridFitSpec {
+                pair_lengths: vec![4],
+                ..spec.clone()
+            },
+            "--pair-length 4 is invalid",
+        ),
+        (
+            GridFitSpec {
+                pair_lengths: vec![12, 8],
+                ..spec.clone()
+            },
+            "--pair-length must list increasing",
+        ),
     ] {
         let e = run_grid_fit(&bad, &out, &cache(), provenance(), &cancel, &())
             .unwrap_err()
@@ -425,4 +440,47 @@ fn a_small_grid_fit_writes_its_files_and_refuses_bad_settings() {
     }
     let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_dir_all(&foreign);
+}
+
+/// The fixed pairs' length fitted with the goal reward: a profile per
+/// length, shorter pairs taking fewer actions at every goal reward, and the
+/// chosen length's example set of that length, with run 3 central.
+#[test]
+fn a_grid_fit_over_pair_lengths_profiles_each_length() {
+    let out = temp_dir("fit-grid-pairs");
+    let spec = GridFitSpec {
+        goal_rewards: vec![1.0, 8.0],
+        epsilon: 0.1,
+        calibrations: 1,
+        repeats: 4,
+        seed: 5,
+        bootstrap: 10,
+        realism: errp_bci::Realism::published(),
+        pair_lengths: vec![8, 28],
+    };
+    let cancel = AtomicBool::new(false);
+    let GridFitOutcome::Complete(fit, _) =
+        run_grid_fit(&spec, &out, &cache(), provenance(), &cancel, &()).unwrap()
+    else {
+        panic!("not interrupted")
+    };
+    let pairs = fit.pairs.as_ref().expect("fitted over lengths");
+    assert_eq!(pairs.lengths, vec![8, 28]);
+    assert!(pairs.profile.iter().all(|l| !l.is_nan()), "{pairs:?}");
+    for subject in 0..4 {
+        for point in 0..2 {
+            let (short, long) = (
+                pairs.fixed_actions[0][subject][point],
+                pairs.fixed_actions[1][subject][point],
+            );
+            assert!(short < long, "S{}: {short} against {long}", subject + 1);
+        }
+    }
+    assert!(spec.pair_lengths.contains(&pairs.chosen));
+    let family = errp_sim::grid::PairFamily::paper();
+    assert!(family.contains(&pairs.example));
+    assert_eq!(errp_sim::grid::total_length(&pairs.example), pairs.chosen);
+    let json = std::fs::read_to_string(out.join("fit.json")).unwrap();
+    assert!(json.contains("\"pair_lengths\"") && json.contains("\"example\""));
+    let _ = std::fs::remove_dir_all(&out);
 }
