@@ -41,7 +41,6 @@ FIGURES=(
   "grid_sensitivity|slow|sh: cargo run --release --locked --quiet -p errp_sim --example grid_sensitivity"
   "sweep_grid|slow|sweep --task grid --accuracy 0.55:0.95:0.04 --param strategy=greedy,info_gain,thompson --episodes 200 --seed 1 --out OUT_DIR --quiet"
   "fit_grid|slow|fit grid --out OUT_DIR --quiet"
-  "fit_grid_pairs|slow|fit grid --pair-length 5:28:1 --out OUT_DIR --quiet"
   "fit_grid_epsilon0|slow|fit grid --epsilon 0 --out OUT_DIR --quiet"
   "table1_seeds|slow|sh: python3 scripts/table1_seeds.py --seeds 10"
   "realism|cheap|realism --quiet"

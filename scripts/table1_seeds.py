@@ -46,12 +46,15 @@ def main():
     # (subject, goals) -> list of (reached, mean actions, sd actions, accuracy)
     cells = {k: [] for k in PAPER}
     rs = {"fixed": [], "free": []}
+    setting = None
     for seed in range(1, args.seeds + 1):
         out = subprocess.run(
             [args.errp, "table1", "--seed", str(seed), "--quiet"],
             check=True, capture_output=True, text=True,
         ).stdout
         for line in out.splitlines():
+            if line.startswith("Fixed pairs"):
+                setting = line
             m = ROW.match(line)
             if m:
                 s, g, reached, mean, sd, acc, pooled = m.groups()
@@ -63,7 +66,7 @@ def main():
                 rs[m.group(1)].append(float(m.group(2)))
         print(f"seed {seed} done", file=sys.stderr)
     n = args.seeds
-    print(f"errp table1, seeds 1-{n} ({5 * n} runs per subject and goal set):")
+    print(f"errp table1, seeds 1-{n} ({5 * n} runs per subject and goal set); {setting}:")
     print(
         "| subject | actions ours [paper] | z | within | accuracy ours [paper] | within 2 points "
         "| pooled accuracy |"

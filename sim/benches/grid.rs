@@ -6,7 +6,7 @@ use std::sync::LazyLock;
 use divan::{Bencher, black_box};
 use errp_robot::{Grid, GridControlParams, QTable};
 use errp_sim::grid::{
-    AssessmentDecoder, EpochBank, FIXED_PAIRS, GridTaskParams, eeg_decoder, run_grid_episode,
+    AssessmentDecoder, CORNER_PAIRS, EpochBank, GridTaskParams, eeg_decoder, run_grid_episode,
 };
 
 fn main() {
@@ -15,12 +15,15 @@ fn main() {
 
 static EEG: LazyLock<AssessmentDecoder> = LazyLock::new(|| eeg_decoder(0.7438, 1).unwrap());
 
+/// Episodes of the corner pairs at goal reward 2 (long runs; the workload
+/// the guide's speed table measures).
 fn episodes(bencher: Bencher, decoder: &AssessmentDecoder) {
-    let params = GridTaskParams::default();
+    let mut params = GridTaskParams::default();
+    params.control = params.control.with(|c| c.goal_reward = 2.0).unwrap();
     let table = QTable::compute(Grid::paper(), &params.control.part(GridControlParams::q)).unwrap();
     let mut k = 0u64;
     bencher.bench_local(|| {
-        let (start, goal) = FIXED_PAIRS[(k % 5) as usize];
+        let (start, goal) = CORNER_PAIRS[(k % 5) as usize];
         k += 1;
         black_box(run_grid_episode(start, goal, &table, &params, decoder, k, false).unwrap())
     });

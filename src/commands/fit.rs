@@ -72,12 +72,12 @@ pub struct GridFitArgs {
     /// idealised user). Default: the shipped scenarios' user.
     #[arg(long, value_name = "SCENARIO")]
     realism: Option<PathBuf>,
-    /// Fit the fixed pairs' total Manhattan length too, over these lengths
-    /// (start:stop:step or a,b,c, each 5 to 36): every group of five runs
-    /// draws its own set of that length whose third pair keeps to the
-    /// centre. Default: the shipped pairs only.
-    #[arg(long, value_name = "LENGTHS")]
-    pair_length: Option<String>,
+    /// The fixed pairs' total Manhattan lengths, fitted jointly with the
+    /// goal reward (start:stop:step or a,b,c, each 5 to 36): every group of
+    /// five runs draws its own set of that length whose third pair keeps to
+    /// the centre. `shipped`: the shipped pairs only, no length fitted.
+    #[arg(long, value_name = "LENGTHS", default_value = "5:28:1")]
+    pair_length: String,
     /// Output directory: fit.json, surface.csv, fit.svg, fit.png.
     #[arg(long, value_name = "DIR", default_value = "fit-grid")]
     out: PathBuf,
@@ -351,18 +351,25 @@ fn fit_grid(args: &GridFitArgs) -> Result<bool> {
         seed: args.seed,
         bootstrap: args.bootstrap,
         realism: crate::commands::user_realism(args.realism.as_deref())?,
-        pair_lengths: args
-            .pair_length
-            .as_deref()
-            .map(parse_pair_lengths)
-            .transpose()?
-            .unwrap_or_default(),
+        pair_lengths: if args.pair_length == "shipped" {
+            Vec::new()
+        } else {
+            parse_pair_lengths(&args.pair_length)?
+        },
     };
     let (cache, pool, threads, progress) = start(&args.workers, args.quiet)?;
     progress.line(&format!(
-        "Fitting the grid's Q-value scale to Table 1's fixed goals: {} goal rewards x 4 subjects \
-         x 2 goal sets x {} calibrations x {} groups of 5 runs, seed {}, epsilon {}, into {} on \
-         {threads} thread(s)",
+        "Fitting the grid's Q-value scale{} to Table 1's fixed goals: {} goal rewards x 4 \
+         subjects x 2 goal sets x {} calibrations x {} groups of 5 runs, seed {}, epsilon {}, \
+         into {} on {threads} thread(s)",
+        if spec.pair_lengths.is_empty() {
+            String::new()
+        } else {
+            format!(
+                " and the fixed pairs' length ({} lengths)",
+                spec.pair_lengths.len()
+            )
+        },
         spec.goal_rewards.len(),
         spec.calibrations,
         spec.repeats,
@@ -555,11 +562,7 @@ fn print_pairs_fit(p: &errp_sweep::fit::PairsFit) -> Result<()> {
                 num(g)
             )),
         p.chosen,
-        p.example
-            .iter()
-            .map(|(s, g)| format!("({},{})->({},{})", s.x, s.y, g.x, g.y))
-            .collect::<Vec<_>>()
-            .join(" ")
+        errp_sim::grid::pairs_text(&p.example)
     )?;
     Ok(())
 }

@@ -1,7 +1,7 @@
 //! `errp table1`: Table 1 of the paper, re-run.
 
 use anyhow::Result;
-use errp_sim::grid::{DecoderChoice, Table1Options, Table1Report, run_table1};
+use errp_sim::grid::{DecoderChoice, FIXED_PAIRS, Table1Options, Table1Report, run_table1};
 
 use crate::cli::{DecoderArg, Table1Args};
 use crate::out::{errln, out};
@@ -35,6 +35,13 @@ pub(crate) fn table1(args: &Table1Args) -> Result<()> {
             );
         }
     })?;
-    out!("{}", Table1Report(&cells))?;
+    out!(
+        "Fixed pairs (total length {}): {}; goal reward {}, epsilon {}\n{}",
+        errp_sim::grid::total_length(&FIXED_PAIRS),
+        errp_sim::grid::pairs_text(&FIXED_PAIRS),
+        errp_sim::task::format_number(options.params.control.goal_reward),
+        errp_sim::task::format_number(options.params.control.epsilon),
+        Table1Report(&cells)
+    )?;
     Ok(())
 }

@@ -24,7 +24,8 @@ pub use episode::{
     run_grid_episode_with,
 };
 pub use pairs::{
-    CENTRAL_RUN, PAIRS_PER_SET, PairFamily, keeps_to_the_centre, manhattan, total_length,
+    CENTRAL_RUN, PAIRS_PER_SET, PairFamily, keeps_to_the_centre, manhattan, pairs_text,
+    total_length,
 };
 pub use params::GridTaskParams;
 pub use report::{GridEpisodeHeader, GridEpisodeRow, Table1Report};
@@ -37,7 +38,9 @@ pub use scenario::{
     DecoderChoice, EegMode, GridScenario, MAX_ACTIONS, MAX_BANK_PER_CLASS, MAX_EPISODES,
     MAX_INTERVAL_SECS, MAX_PAIRS, free_pairs,
 };
-pub use table1::{FIXED_PAIRS, Table1Cell, Table1Options, accuracy_time_correlation, run_table1};
+pub use table1::{
+    CORNER_PAIRS, FIXED_PAIRS, Table1Cell, Table1Options, accuracy_time_correlation, run_table1,
+};
 pub use task::{GridRunner, GridTask, grid_row};
 #[cfg(feature = "rerun")]
 pub use view::{GridRecorder, grid_recording, record_grid_run};

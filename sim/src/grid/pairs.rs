@@ -31,6 +31,15 @@ pub fn total_length(pairs: &[(Cell, Cell)]) -> usize {
     pairs.iter().map(|&(s, g)| manhattan(s, g)).sum()
 }
 
+/// `pairs` as text: `(x,y)->(x,y)` each, space-separated.
+pub fn pairs_text(pairs: &[(Cell, Cell)]) -> String {
+    pairs
+        .iter()
+        .map(|(s, g)| format!("({},{})->({},{})", s.x, s.y, g.x, g.y))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
 /// True if a run from `start` to `goal` keeps to the centre of `grid`: the
 /// rectangle they span holds the centre cell, and all of its cells but
 /// `start` and `goal` are off the border.
@@ -172,7 +181,7 @@ impl PairFamily {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::grid::FIXED_PAIRS;
+    use crate::grid::{CORNER_PAIRS, FIXED_PAIRS};
     use errp_bci::rng::stream;
 
     #[test]
@@ -190,10 +199,11 @@ mod tests {
     }
 
     #[test]
-    fn the_shipped_corner_pairs_are_a_set_of_length_28() {
+    fn the_shipped_and_the_corner_pairs_are_sets_of_the_family() {
         let family = PairFamily::paper();
         assert!(family.contains(&FIXED_PAIRS));
-        assert_eq!(total_length(&FIXED_PAIRS), 28);
+        assert!(family.contains(&CORNER_PAIRS));
+        assert_eq!(total_length(&CORNER_PAIRS), 28);
         assert_eq!(family.lengths(), 5..=36);
     }
 

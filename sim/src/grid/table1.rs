@@ -14,8 +14,23 @@ use crate::grid::scenario::{DecoderChoice, EegMode, GridScenario, free_pairs};
 use crate::stats::mean_sd;
 use crate::stats::pearson;
 
-/// The five fixed start/goal pairs (`scenarios/grid_fixed_goals.toml`).
+/// The five fixed start/goal pairs (`scenarios/grid_fixed_goals.toml`): a
+/// set of the total length `errp fit grid` estimates from Table 1 (8), as
+/// the fit draws it (`fits/grid.json`, `pairs.example`).
 pub const FIXED_PAIRS: [(Cell, Cell); 5] = [
+    (Cell::new(3, 0), Cell::new(3, 2)),
+    (Cell::new(2, 1), Cell::new(2, 0)),
+    (Cell::new(3, 2), Cell::new(1, 2)),
+    (Cell::new(1, 2), Cell::new(0, 2)),
+    (Cell::new(2, 2), Cell::new(3, 3)),
+];
+
+/// The fixed pairs chosen before they were fitted, to resemble Fig. 4:
+/// corner to corner, across the middle row and column, a diagonal through
+/// the centre (total length 28;
+/// `scenarios/variants/grid_fixed_goals_corners.toml`). Long runs, for
+/// tests and benchmarks of the decoder in the loop.
+pub const CORNER_PAIRS: [(Cell, Cell); 5] = [
     (Cell::new(0, 0), Cell::new(4, 4)),
     (Cell::new(4, 0), Cell::new(0, 4)),
     (Cell::new(0, 2), Cell::new(4, 2)),

@@ -4,7 +4,7 @@
 use errp_bci::Accuracy;
 use errp_robot::{Grid, GridControlParams, QTable};
 use errp_sim::grid::{
-    AssessmentDecoder, EegDecoder, FIXED_PAIRS, GridTaskParams, run_grid_episode,
+    AssessmentDecoder, CORNER_PAIRS, EegDecoder, GridTaskParams, run_grid_episode,
 };
 
 pub(crate) fn eeg_decoder(accuracy: f64, seed: u64) -> AssessmentDecoder {
@@ -19,6 +19,14 @@ fn streamed(accuracy: f64, seed: u64) -> EegDecoder {
     }
 }
 
+/// Long runs, for the decoder's statistics in the loop: the corner pairs'
+/// Q scale (goal reward 2, what `errp fit grid --pair-length 28` keeps).
+pub(crate) fn long_runs() -> GridTaskParams {
+    let mut params = GridTaskParams::default();
+    params.control = params.control.with(|c| c.goal_reward = 2.0).unwrap();
+    params
+}
+
 pub(crate) fn table(params: &GridTaskParams) -> QTable {
     QTable::compute(Grid::paper(), &params.control.part(GridControlParams::q)).unwrap()
 }
@@ -28,11 +36,11 @@ fn episodes(
     n: usize,
     seed: u64,
 ) -> Vec<errp_sim::grid::GridEpisodeResult> {
-    let params = GridTaskParams::default();
+    let params = long_runs();
     let t = table(&params);
     (0..n)
         .map(|k| {
-            let (s, g) = FIXED_PAIRS[k % FIXED_PAIRS.len()];
+            let (s, g) = CORNER_PAIRS[k % CORNER_PAIRS.len()];
             run_grid_episode(s, g, &t, &params, decoder, seed * 1000 + k as u64, false).unwrap()
         })
         .collect()

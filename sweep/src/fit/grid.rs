@@ -593,11 +593,7 @@ impl Episodes<'_> {
     /// `goals` (all if none; the others' lists are empty), the fixed pairs
     /// drawn from the family at `length` if given (one set per group, the
     /// same at every goal reward); `None` if cancelled.
-    fn run(
-        &self,
-        goals: Option<GoalSet>,
-        length: Option<usize>,
-    ) -> Result<Option<PointRuns>> {
+    fn run(&self, goals: Option<GoalSet>, length: Option<usize>) -> Result<Option<PointRuns>> {
         let spec = self.spec;
         let mut runs = Vec::with_capacity(spec.goal_rewards.len());
         for &g in &spec.goal_rewards {

@@ -9,6 +9,9 @@ use errp_sweep::fit::{
     run_grid_fit,
 };
 
+use errp_robot::Cell;
+use errp_sim::grid::FIXED_PAIRS;
+
 use crate::{cache, temp_dir};
 
 fn repo(path: &str) -> std::path::PathBuf {
@@ -345,6 +348,72 @@ fn the_shipped_grid_q_scale_is_the_committed_fit() {
     assert_eq!(
         control("scenarios/variants/grid_fixed_goals_mle.toml")["goal_reward"].as_float(),
         Some(estimate)
+    );
+    // The fixed pairs: fitted over the default lengths, the shipped ones
+    // are the fit's set of the chosen length, in the scenario files, in
+    // `FIXED_PAIRS` (what `errp table1` runs), and in the ten-seed Table 1.
+    let pairs = &fit["pairs"];
+    let lengths: Vec<f64> = numbers(&fit["spec"]["pair_lengths"]);
+    assert_eq!(lengths, (5..=28).map(f64::from).collect::<Vec<_>>());
+    let example: Vec<(Cell, Cell)> = pairs["example"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| {
+            let cell = |c: &serde_json::Value| {
+                Cell::new(
+                    c["x"].as_u64().unwrap() as usize,
+                    c["y"].as_u64().unwrap() as usize,
+                )
+            };
+            (cell(&p[0]), cell(&p[1]))
+        })
+        .collect();
+    assert_eq!(example, FIXED_PAIRS.to_vec());
+    assert_eq!(
+        pairs["chosen"].as_u64(),
+        Some(errp_sim::grid::total_length(&FIXED_PAIRS) as u64)
+    );
+    assert_eq!(
+        pairs["reached_estimate"][1].as_f64(),
+        Some(shipped),
+        "the 40/40 point's goal reward is the shipped one"
+    );
+    let episodes = |file: &str| -> Vec<(Cell, Cell)> {
+        let text = std::fs::read_to_string(repo(file)).unwrap();
+        let table: toml::Table = toml::from_str(&text).unwrap();
+        table["episode"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|e| {
+                let cell = |k: &str| {
+                    let v = e[k].as_array().unwrap();
+                    Cell::new(
+                        v[0].as_integer().unwrap() as usize,
+                        v[1].as_integer().unwrap() as usize,
+                    )
+                };
+                (cell("start"), cell("goal"))
+            })
+            .collect()
+    };
+    for file in [
+        "scenarios/grid_fixed_goals.toml",
+        "scenarios/variants/grid_fixed_goals_ideal.toml",
+        "scenarios/variants/grid_fixed_goals_mle.toml",
+    ] {
+        assert_eq!(episodes(file), FIXED_PAIRS.to_vec(), "{file}");
+    }
+    let seeds = std::fs::read_to_string(repo("docs/figures/table1_seeds.txt")).unwrap();
+    let header = seeds.lines().next().unwrap();
+    assert!(
+        header.contains(&errp_sim::grid::pairs_text(&FIXED_PAIRS))
+            && header.contains(&format!(
+                "goal reward {}",
+                errp_sim::task::format_number(shipped)
+            )),
+        "docs/figures/table1_seeds.txt was run with other pairs or another goal reward: {header}"
     );
 }
 
