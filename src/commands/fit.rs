@@ -418,8 +418,12 @@ fn fit_grid(args: &GridFitArgs) -> Result<bool> {
 fn print_grid_fit(fit: &GridFit) -> Result<()> {
     let s = &fit.surface;
     outln!(
-        "Grid Q-value scale (goal reward at tau = 0.3) fitted to Table 1's fixed goals ({} \
+        "Grid Q-value scale (goal reward at tau = 0.3) fitted to Table 1's fixed goals{} ({} \
          calibrations x {} groups of 5 runs per subject and point, epsilon {}, seed {}):",
+        fit.pairs.as_ref().map_or(String::new(), |p| format!(
+            ", at the fixed pairs' fitted total length {} (below)",
+            p.chosen
+        )),
         fit.spec.calibrations,
         fit.spec.repeats,
         fit.spec.epsilon,
@@ -523,7 +527,7 @@ fn print_pairs_fit(p: &errp_sweep::fit::PairsFit) -> Result<()> {
     outln!(
         "The fixed pairs' total Manhattan length, fitted jointly with the goal reward (each \
          group of five runs draws a set of that length whose third pair keeps to the centre; \
-         the shipped corner pairs: 28, random pairs: about 17):"
+         the corner pairs of earlier versions: 28, random pairs: about 17):"
     )?;
     outln!(
         "length  best reward  log L (profile)  P(all 40)  40/40 reward (log L)  fixed z S1..S4 \
