@@ -4,6 +4,7 @@
 use std::fmt;
 
 use errp_bci::GoalSet;
+use errp_robot::Grid;
 
 use crate::grid::episode::GridEpisodeResult;
 use crate::grid::run::GridRunReport;
@@ -128,25 +129,31 @@ fn calibration_gaps(f: &mut fmt::Formatter<'_>, cells: &[Table1Cell], set: GoalS
 
 /// The information per action of each subject's decoder on a goal set,
 /// between what a binary symmetric channel and an erasure channel at the
-/// same accuracy carry (the least and the most at that accuracy).
+/// same accuracy carry (the least and the most at that accuracy), and the
+/// fewest actions that much information allows for singling out one goal
+/// of the grid's 25: log2(25) / bits (about: the closed loop's verdicts are
+/// not exactly half errors, and no action tells more of the goal than of
+/// the verdict).
 fn information(f: &mut fmt::Formatter<'_>, cells: &[Table1Cell], set: GoalSet) -> fmt::Result {
+    let goals = Grid::paper().n_cells() as f64;
     let bits: Vec<String> = cells
         .iter()
         .filter(|c| c.goals == set)
         .map(|c| {
             let i = &c.information;
             format!(
-                "{} {:.3} [{:.3}-{:.3}]",
+                "{} {:.3} [{:.3}-{:.3}] {:.1}",
                 c.subject,
                 i.bits,
                 i.binary_symmetric_bits(),
-                i.erasure_bits()
+                i.erasure_bits(),
+                goals.log2() / i.bits
             )
         })
         .collect();
     writeln!(
         f,
-        "           information per action (bits, equal priors) [binary symmetric-erasure channel at its accuracy]: {}",
+        "           information per action (bits, equal priors) [binary symmetric-erasure channel at its accuracy] and the fewest actions it allows (log2 25 / bits): {}",
         bits.join(", ")
     )
 }

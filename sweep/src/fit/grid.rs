@@ -1087,14 +1087,15 @@ pub fn grid_fit_plot(fit: &GridFit) -> FitPlot {
     let (lo, hi) = fit.interval_95;
     FitPlot {
         title: format!(
-            "Grid Q-value scale fitted to Table 1's fixed goals: goal reward {} (95 % LR \
-             interval {lo}-{hi}); {} keeps the paper's 40/40 (P >= {REACHED_LEVEL}); {} \
-             calibrations x {} groups of 5 runs per subject and point",
+            "Grid fit to Table 1's fixed goals: goal reward {} (95 % LR {lo}-{hi}), {} keeps \
+             the paper's 40/40 (P >= {REACHED_LEVEL}){}",
             errp_sim::task::format_number(fit.estimate),
             fit.reached_estimate
                 .map_or("none".into(), errp_sim::task::format_number),
-            fit.spec.calibrations,
-            fit.spec.repeats
+            fit.pairs.as_ref().map_or(String::new(), |p| format!(
+                "; at the fixed pairs' length {} (estimate {}, 95 % LR {}-{})",
+                p.chosen, p.estimate, p.interval_95.0, p.interval_95.1
+            ))
         ),
         x_desc: "goal reward (Q-value scale at tau = 0.3)".into(),
         estimate: fit.estimate,
