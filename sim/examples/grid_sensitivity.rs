@@ -72,18 +72,18 @@ fn main() {
             reward: None,
         },
         Variant {
-            label: "Platt, goal reward 1 (before the fit)",
+            label: "Platt, goal reward 2 (fitted to the corner pairs)",
             platt: Some(true),
             epsilon: 0.1,
             discount: 0.9,
-            reward: Some(1.0),
+            reward: Some(2.0),
         },
         Variant {
-            label: "Platt, goal reward 9 (the fit's unconstrained estimate)",
+            label: "Platt, goal reward 6 (the fit's unconstrained estimate)",
             platt: Some(true),
             epsilon: 0.1,
             discount: 0.9,
-            reward: Some(9.0),
+            reward: Some(6.0),
         },
         Variant {
             label: "oracle decoder, p = accuracy",

@@ -415,6 +415,12 @@ fn fit_grid(args: &GridFitArgs) -> Result<bool> {
     }
 }
 
+/// `x` to three decimals: a bootstrap quantile is interpolated between grid
+/// points, and its last bits are noise.
+fn round3(x: f64) -> f64 {
+    (x * 1000.0).round() / 1000.0
+}
+
 fn print_grid_fit(fit: &GridFit) -> Result<()> {
     let s = &fit.surface;
     outln!(
@@ -475,8 +481,8 @@ fn print_grid_fit(fit: &GridFit) -> Result<()> {
         num(fit.interval_95.1),
         edge(fit.interval_at_edge.1),
         fit.spec.bootstrap,
-        num(fit.mc_interval_90.0),
-        num(fit.mc_interval_90.1)
+        num(round3(fit.mc_interval_90.0)),
+        num(round3(fit.mc_interval_90.1))
     )?;
     let own: Vec<String> = fit
         .fixed
