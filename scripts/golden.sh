@@ -11,9 +11,10 @@
 #                                       per run)
 #
 # Every command is seeded; the cache is off, so each run targets afresh.
-# The scenarios are the idealised user's (scenarios/variants/*_ideal.toml,
-# byte for byte the shipped scenarios before they had a [realism] table), so
-# that a recording made before the realistic user compares with one after.
+# The scenarios are the idealised user's (scenarios/variants/*_ideal.toml:
+# the shipped scenarios without their [realism] table), so that what a
+# change of the simulated user moves is kept out of a restructuring's
+# comparison.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 

@@ -463,8 +463,13 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(3);
         for params in [
             GridControlParams::default(),
+            // A nearly hard soft-max: tau 0.01 at goal reward 2. (At the
+            // shipped goal reward 5 and tau 0.01 a p(error) of exactly 0 or
+            // 1 can leave every goal at likelihood 0, which `observe`
+            // refuses with an error rather than a NaN belief.)
             GridControlParams {
                 tau: 0.01,
+                goal_reward: 2.0,
                 ..GridControlParams::default()
             },
         ] {

@@ -19,9 +19,9 @@ fn digest(value: &impl std::fmt::Debug) -> u64 {
 }
 
 /// The episode from (0, 0) to (3, 4) with `decoder` and `seed`, every
-/// action recorded.
+/// action recorded, at goal reward 2 (the golden digest's Q scale).
 fn episode(decoder: &AssessmentDecoder, seed: u64) -> GridEpisodeResult {
-    let params = GridTaskParams::default();
+    let params = grid::long_runs();
     let t = grid::table(&params);
     let (start, goal) = (Cell::new(0, 0), Cell::new(3, 4));
     run_grid_episode(start, goal, &t, &params, decoder, seed, true).unwrap()
