@@ -24,9 +24,14 @@ CALLS = {
 @pytest.mark.parametrize("name", CALLS)
 def test_ctrl_c_stops_a_long_call_within_a_second(name, tmp_path):
     code = f"import errp\nprint('ready', flush=True)\n{CALLS[name]}\n"
+    # A shell that starts pytest in the background without job control
+    # leaves SIGINT ignored, and Python then never raises
+    # KeyboardInterrupt: the child gets the default disposition back, as a
+    # terminal's process has.
     p = subprocess.Popen(
         [sys.executable, "-c", code], cwd=tmp_path,
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     assert p.stdout.readline().strip() == "ready"
     time.sleep(3.0)
