@@ -33,7 +33,7 @@ FIGURES=(
   "table1|cheap|table1 --seed 1 --quiet"
   "grid_fixed_run|cheap|run scenarios/grid_fixed_goals.toml --quiet"
   "table1_bank|cheap|table1 --seed 1 --eeg bank --quiet"
-  "table1_ideal|cheap|table1 --seed 1 --realism scenarios/variants/grid_fixed_goals_ideal.toml --quiet"
+  "table1_ideal|slow|table1 --seed 1 --realism scenarios/variants/grid_fixed_goals_ideal.toml --quiet"
   "table1_oracle|cheap|table1 --seed 1 --decoder oracle --quiet"
   "table1_continuous_shift|cheap|table1 --seed 1 --realism scenarios/mexico_to_pisa.toml --quiet"
   "task_shift_bound|slow|sh: scripts/task_shift_bound.sh"
