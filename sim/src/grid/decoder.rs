@@ -58,10 +58,7 @@ impl AssessmentDecoder {
                 let mut rng = stream(seed, "grid/information/oracle");
                 let mut draw = |error: bool| -> Vec<(f64, bool)> {
                     (0..per_class)
-                        .map(|_| {
-                            let says = (rng.random::<f64>() < *accuracy) == error;
-                            (if says { *accuracy } else { 1.0 - accuracy }, says)
-                        })
+                        .map(|_| oracle_report(*accuracy, error, &mut rng))
                         .collect()
                 };
                 let error = draw(true);
@@ -81,6 +78,18 @@ impl AssessmentDecoder {
         )?;
         measured(&error, &correct)
     }
+}
+
+/// What the oracle reports of a verdict (`error`): the verdict, flipped
+/// with probability 1 - `accuracy`, as (p(error), says error), p(error)
+/// being `accuracy` or 1 - `accuracy`.
+pub(crate) fn oracle_report(accuracy: f64, error: bool, rng: &mut impl Rng) -> (f64, bool) {
+    let right = rng.random::<f64>() < accuracy;
+    let says_error = if right { error } else { !error };
+    (
+        if says_error { accuracy } else { 1.0 - accuracy },
+        says_error,
+    )
 }
 
 /// [`ActionInformation::measure`], or an error naming what was wrong.

@@ -8,7 +8,7 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 use crate::error::{Result, SimError, check_p_error};
-use crate::grid::decoder::{AssessmentDecoder, EegSource, OnlineEeg, decide};
+use crate::grid::decoder::{AssessmentDecoder, EegSource, OnlineEeg, decide, oracle_report};
 use crate::grid::params::GridTaskParams;
 
 /// One action of an episode, as recorded.
@@ -325,13 +325,7 @@ impl ActionDecoder {
         let mut epoch = None;
         let (p_error, says_error, fcz) = match (decoding, self.online.as_mut()) {
             (GridDecoding::Builtin(AssessmentDecoder::Oracle { accuracy }), _) => {
-                let right = self.rng_oracle.random::<f64>() < *accuracy;
-                let says_error = if right { error } else { !error };
-                let p = if says_error {
-                    *accuracy
-                } else {
-                    1.0 - accuracy
-                };
+                let (p, says_error) = oracle_report(*accuracy, error, &mut self.rng_oracle);
                 (p, says_error, Vec::new())
             }
             (GridDecoding::Builtin(AssessmentDecoder::Eeg(d)), Some(eeg)) if keep_epoch => {

@@ -417,10 +417,10 @@ fn the_shipped_grid_q_scale_is_the_committed_fit() {
     );
 }
 
-#[test]
-fn a_small_grid_fit_writes_its_files_and_refuses_bad_settings() {
-    let out = temp_dir("fit-grid");
-    let spec = GridFitSpec {
+/// A grid fit small enough for a test: two goal rewards, one calibration
+/// per subject and goal set, two groups, the shipped pairs.
+fn small_grid_spec() -> GridFitSpec {
+    GridFitSpec {
         goal_rewards: vec![1.0, 8.0],
         epsilon: 0.1,
         calibrations: 1,
@@ -429,7 +429,13 @@ fn a_small_grid_fit_writes_its_files_and_refuses_bad_settings() {
         bootstrap: 10,
         realism: errp_bci::Realism::published(),
         pair_lengths: Vec::new(),
-    };
+    }
+}
+
+#[test]
+fn a_small_grid_fit_writes_its_files_and_refuses_bad_settings() {
+    let out = temp_dir("fit-grid");
+    let spec = small_grid_spec();
     let cancel = AtomicBool::new(false);
     let GridFitOutcome::Complete(fit, files) =
         run_grid_fit(&spec, &out, &cache(), provenance(), &cancel, &()).unwrap()
@@ -518,14 +524,9 @@ fn a_small_grid_fit_writes_its_files_and_refuses_bad_settings() {
 fn a_grid_fit_over_pair_lengths_profiles_each_length() {
     let out = temp_dir("fit-grid-pairs");
     let spec = GridFitSpec {
-        goal_rewards: vec![1.0, 8.0],
-        epsilon: 0.1,
-        calibrations: 1,
         repeats: 4,
-        seed: 5,
-        bootstrap: 10,
-        realism: errp_bci::Realism::published(),
         pair_lengths: vec![8, 28],
+        ..small_grid_spec()
     };
     let cancel = AtomicBool::new(false);
     let GridFitOutcome::Complete(fit, _) =
