@@ -42,6 +42,7 @@ FIGURES=(
   "sweep_grid|slow|sweep --task grid --accuracy 0.55:0.95:0.04 --param strategy=greedy,info_gain,thompson --episodes 200 --seed 1 --out OUT_DIR --quiet"
   "fit_grid|slow|fit grid --out OUT_DIR --quiet"
   "fit_grid_epsilon0|slow|fit grid --epsilon 0 --out OUT_DIR --quiet"
+  "fit_grid_trial_latency|slow|fit grid --trial-latency-sd 16.7,19,21.3,25 --out OUT_DIR --quiet"
   "table1_seeds|slow|sh: python3 scripts/table1_seeds.py --seeds 10"
   "realism|cheap|realism --quiet"
   "sweep_realism|cheap|sweep --task grid --accuracy 0.75 --param realism.lapse_rate=0,0.1,0.2 --param realism.background_drift=0,0.3 --param strategy=greedy,thompson --episodes 200 --seed 1 --out OUT_DIR --quiet"

@@ -587,6 +587,15 @@ fn bad_fit_input_is_exit_2_naming_the_flag() {
         ),
         (&["--pair-length", "8.5"][..], "--pair-length \"8.5\""),
         (&["--pair-length", "40"][..], "5 to 36"),
+        (
+            &["--trial-latency-sd", "16.7,abc"][..],
+            "--trial-latency-sd \"16.7,abc\"",
+        ),
+        (&["--trial-latency-sd", "-5"][..], "[0, 100] ms"),
+        (
+            &["--trial-latency-sd", "25,19"][..],
+            "--trial-latency-sd must list increasing",
+        ),
     ] {
         let mut full = vec!["fit", "grid"];
         full.extend_from_slice(args);

@@ -98,6 +98,15 @@ impl Check for GeneratorParams {
 }
 
 impl GeneratorParams {
+    /// SD of the ERPs' single-trial latency (ms): the user's
+    /// ([`Realism::trial_latency_sd_ms`]) if set, else the EEG model's
+    /// `latency_jitter_ms`.
+    pub fn trial_latency_sd_ms(&self) -> f64 {
+        self.realism
+            .trial_latency_sd_ms
+            .unwrap_or(self.latency_jitter_ms)
+    }
+
     /// Checks every field; the error names the field and the accepted range.
     fn validate(&self) -> Result<()> {
         let finite_nonneg = |v: f64| v.is_finite() && v >= 0.0;

@@ -253,7 +253,7 @@ impl EegGenerator {
     /// blink after it), from a stream of its own.
     pub fn schedule(&mut self, assessment: Assessment) {
         let jitter_ms =
-            self.params.latency_jitter_ms * self.rng_erp.sample::<f64, _>(StandardNormal);
+            self.params.trial_latency_sd_ms() * self.rng_erp.sample::<f64, _>(StandardNormal);
         let gain = (1.0
             + self.params.amplitude_variability * self.rng_erp.sample::<f64, _>(StandardNormal))
         .max(0.0);

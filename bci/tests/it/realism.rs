@@ -301,6 +301,73 @@ fn a_task_shift_moves_the_peak_by_the_shift_and_scales_it_by_the_gain() {
     assert!((p1 / p0 - 0.7).abs() < 0.01, "amplitude {p0} -> {p1}");
 }
 
+/// The SD (ms) of the positive peak's time over `n` error ERPs, 2 s
+/// apart, with no amplitude variability: the single-trial latency spread.
+fn peak_time_sd(realism: Realism, n: usize) -> f64 {
+    let m = Montage::standard();
+    let p = Valid::new(GeneratorParams {
+        amplitude_variability: 0.0,
+        realism,
+        ..GeneratorParams::default()
+    })
+    .unwrap();
+    let mut g = EegGenerator::new(&p, &m, 3).unwrap().with_components(ERP);
+    for k in 0..n {
+        g.schedule(Assessment {
+            onset_secs: 0.5 + 2.0 * k as f64,
+            kind: AssessmentKind::Error,
+        });
+    }
+    let b = g.generate(((0.5 + 2.0 * n as f64) * FS as f64) as usize);
+    let fcz = channel(&b, &m, "FCz");
+    let times: Vec<f64> = (0..n)
+        .map(|k| {
+            let from = ((0.5 + 2.0 * k as f64) * FS as f64).round() as usize;
+            let window = &fcz[from..from + (1.2 * FS as f64) as usize];
+            let (i, _) = window
+                .iter()
+                .enumerate()
+                .fold((0, f64::MIN), |a, (i, &v)| if v > a.1 { (i, v) } else { a });
+            i as f64 * 1000.0 / FS as f64
+        })
+        .collect();
+    sd(&times)
+}
+
+#[test]
+fn the_single_trial_latency_sd_sets_the_spread_of_the_peaks() {
+    // Unset, the EEG model's own 25 ms; set to it, the same samples.
+    let mut a = generator(Realism::default(), 9, ERP);
+    let mut b = generator(
+        Realism {
+            trial_latency_sd_ms: Some(25.0),
+            ..Realism::default()
+        },
+        9,
+        ERP,
+    );
+    schedule_alternating(&mut a, 30, 1.5);
+    schedule_alternating(&mut b, 30, 1.5);
+    let n = 50 * FS;
+    assert_eq!(a.generate(n).data, b.generate(n).data);
+    // The peaks spread by the SD set: none at 0, about 20 ms at 20.
+    let at = |sd: f64| {
+        peak_time_sd(
+            Realism {
+                trial_latency_sd_ms: Some(sd),
+                ..Realism::default()
+            },
+            300,
+        )
+    };
+    let (none, twenty) = (at(0.0), at(20.0));
+    assert!(none < 1.0, "peak times spread by {none} ms with no jitter");
+    assert!(
+        (twenty - 20.0).abs() < 3.0,
+        "peak times spread by {twenty} ms at 20 ms"
+    );
+}
+
 #[test]
 fn the_errp_changes_along_the_session_by_its_slopes() {
     let (p0, t0) = erp_response(Realism::default(), AssessmentKind::Error, &[]);
@@ -582,6 +649,13 @@ fn bad_fields_are_named_with_their_range() {
                 ..Realism::default()
             },
             "realism.drift_secs",
+        ),
+        (
+            Realism {
+                trial_latency_sd_ms: Some(-1.0),
+                ..Realism::default()
+            },
+            "realism.trial_latency_sd_ms",
         ),
     ];
     for (r, name) in cases {

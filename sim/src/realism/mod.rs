@@ -183,7 +183,7 @@ fn grid_values(s: &GridScenario) -> Result<Vec<(&'static str, f64)>> {
         ("errp_negative_uv", neg_uv),
         ("errp_positive_ms", pos_ms),
         ("errp_positive_uv", pos_uv),
-        ("latency_jitter_ms", setup.generator.latency_jitter_ms),
+        ("latency_jitter_ms", setup.generator.trial_latency_sd_ms()),
         ("blinks_per_min", 60.0 * setup.generator.blink_rate_hz),
         ("discrete_error_class", 100.0 * cv.error),
         ("discrete_correct_class", 100.0 * cv.correct),

@@ -41,6 +41,7 @@ use super::density::{SimRun, percentile_of, quantile, resample};
 use super::epuck::Provenance;
 use super::files;
 use super::grid_pairs::{PairsFit, pairs_fit};
+use super::grid_trial::{TrialLatencyFit, trial_latency_fit};
 use super::surface::{Surface, argmax};
 use crate::cache::TargetCache;
 use crate::observer::SweepObserver;
@@ -69,10 +70,19 @@ pub struct GridFitSpec {
     /// set of that length); empty: the shipped pairs ([`FIXED_PAIRS`]).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub pair_lengths: Vec<usize>,
+    /// The ErrP's single-trial latency SDs (ms,
+    /// [`Realism::trial_latency_sd_ms`](errp_bci::Realism::trial_latency_sd_ms)),
+    /// fitted jointly with the rest: the whole fit is run at each
+    /// ([`TrialLatencyFit`]); empty: the users' own.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub trial_latency_sds: Vec<f64>,
 }
 
 /// The largest number of pair lengths in one fit.
 pub const MAX_PAIR_LENGTHS: usize = 32;
+/// The largest number of single-trial latency SDs in one fit (each runs
+/// the whole fit).
+pub const MAX_TRIAL_LATENCY_SDS: usize = 16;
 
 /// Epochs per class in each calibration's bank.
 pub const GRID_FIT_BANK: usize = 1000;
@@ -204,6 +214,11 @@ pub struct GridFit {
     /// fit at [`PairsFit::chosen`].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pairs: Option<PairsFit>,
+    /// The single-trial latency SD fitted jointly with the rest, when asked
+    /// for (`spec.trial_latency_sds`); the rest of this result is then the
+    /// fit at [`TrialLatencyFit::chosen`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub trial_latency: Option<TrialLatencyFit>,
     /// What was run.
     pub spec: GridFitSpec,
     /// How.
@@ -353,6 +368,25 @@ fn check_spec(spec: &GridFitSpec) -> Result<()> {
     if spec.pair_lengths.windows(2).any(|w| w[1] <= w[0]) {
         return bad("--pair-length must list increasing values".into());
     }
+    if spec.trial_latency_sds.len() > MAX_TRIAL_LATENCY_SDS {
+        return bad(format!(
+            "--trial-latency-sd gives {} values: at most {MAX_TRIAL_LATENCY_SDS} (each runs the \
+             whole fit)",
+            spec.trial_latency_sds.len()
+        ));
+    }
+    if let Some(v) = spec
+        .trial_latency_sds
+        .iter()
+        .find(|v| !(v.is_finite() && (0.0..=100.0).contains(*v)))
+    {
+        return bad(format!(
+            "--trial-latency-sd {v} is invalid: expected single-trial latency SDs in [0, 100] ms"
+        ));
+    }
+    if spec.trial_latency_sds.windows(2).any(|w| w[1] <= w[0]) {
+        return bad("--trial-latency-sd must list increasing values".into());
+    }
     if spec.bootstrap < 10 || spec.bootstrap > super::MAX_BOOTSTRAP {
         return bad(format!(
             "--bootstrap {} is invalid: expected 10 to {} replicates",
@@ -419,6 +453,39 @@ pub fn run_grid_fit(
 ) -> Result<GridFitOutcome> {
     check_spec(spec)?;
     check_out(out)?;
+    let fit = if spec.trial_latency_sds.is_empty() {
+        fit_users(spec, cache, provenance, cancel, observer)?
+    } else {
+        let mut fits = Vec::with_capacity(spec.trial_latency_sds.len());
+        for &sd in &spec.trial_latency_sds {
+            let mut at = spec.clone();
+            at.realism.trial_latency_sd_ms = Some(sd);
+            at.trial_latency_sds = Vec::new();
+            match fit_users(&at, cache, provenance.clone(), cancel, observer)? {
+                Some(fit) => fits.push(fit),
+                None => return Ok(GridFitOutcome::Interrupted),
+            }
+        }
+        Some(trial_latency_fit(spec, fits))
+    };
+    let Some(fit) = fit else {
+        return Ok(GridFitOutcome::Interrupted);
+    };
+    create_dir(out)?;
+    let files = write_fit(&fit, out)?;
+    Ok(GridFitOutcome::Complete(Box::new(fit), files))
+}
+
+/// The fit for the users of `spec.realism`: every subject's decoders
+/// calibrated, every grid point (and pair length) run and analysed; `None`
+/// if cancelled.
+fn fit_users(
+    spec: &GridFitSpec,
+    cache: &TargetCache,
+    provenance: Provenance,
+    cancel: &AtomicBool,
+    observer: &dyn SweepObserver,
+) -> Result<Option<GridFit>> {
     let fixed = paper_rows(GoalSet::Fixed);
     let free = paper_rows(GoalSet::Free);
     let base = GridTaskParams::default();
@@ -469,7 +536,7 @@ pub fn run_grid_fit(
         .collect::<Option<Vec<_>>>()
         .unwrap_or_default();
     if calibrations.len() != jobs.len() {
-        return Ok(GridFitOutcome::Interrupted);
+        return Ok(None);
     }
     let family = PairFamily::paper();
     let sets = spec.pair_lengths.len();
@@ -486,17 +553,17 @@ pub fn run_grid_fit(
     };
     let fit = if sets == 0 {
         let Some(runs) = episodes.run(None, None)? else {
-            return Ok(GridFitOutcome::Interrupted);
+            return Ok(None);
         };
         analyse(spec, &calibrations, &runs, &fixed, &free, provenance)
     } else {
         let Some(free_runs) = episodes.run(Some(GoalSet::Free), None)? else {
-            return Ok(GridFitOutcome::Interrupted);
+            return Ok(None);
         };
         let mut fits = Vec::with_capacity(sets);
         for &length in &spec.pair_lengths {
             let Some(fixed_runs) = episodes.run(Some(GoalSet::Fixed), Some(length))? else {
-                return Ok(GridFitOutcome::Interrupted);
+                return Ok(None);
             };
             // runs[point][calibration]: the fixed calibrations' runs at this
             // length, the free ones' (which no length changes) shared.
@@ -529,9 +596,7 @@ pub fn run_grid_fit(
         }
         pairs_fit(spec, &family, fits)
     };
-    create_dir(out)?;
-    let files = write_fit(&fit, out)?;
-    Ok(GridFitOutcome::Complete(Box::new(fit), files))
+    Ok(Some(fit))
 }
 
 /// `runs[point][calibration][repeat][pair]`.
@@ -843,6 +908,7 @@ fn analyse(
         free_log_lik,
         density: GRID_DENSITY.into(),
         pairs: None,
+        trial_latency: None,
         spec: spec.clone(),
         provenance,
     }

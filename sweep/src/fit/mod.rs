@@ -6,6 +6,7 @@ mod epuck;
 mod files;
 mod grid;
 mod grid_pairs;
+mod grid_trial;
 mod surface;
 
 pub use density::{Observed, SimRun, log_kde, log_likelihood, percentile_of, quantile, resample};
@@ -17,8 +18,9 @@ pub use epuck::{
 pub use grid::{
     CellStats, GRID_DENSITY, GRID_FIT_BANK, GRID_FIT_FILES, GRID_FIT_FORMAT, GridFit,
     GridFitOutcome, GridFitSpec, MAX_GRID_CALIBRATIONS, MAX_GRID_REPEATS, MAX_PAIR_LENGTHS,
-    PaperRow, REACHED_LEVEL, TableStats, grid_fit_plot, grid_surface_csv, group_log_likelihood,
-    log_normal_density, paper_rows, run_grid_fit,
+    MAX_TRIAL_LATENCY_SDS, PaperRow, REACHED_LEVEL, TableStats, grid_fit_plot, grid_surface_csv,
+    group_log_likelihood, log_normal_density, paper_rows, run_grid_fit,
 };
 pub use grid_pairs::PairsFit;
+pub use grid_trial::TrialLatencyFit;
 pub use surface::{CHI2_1_95, Surface, argmax};

@@ -429,6 +429,7 @@ fn small_grid_spec() -> GridFitSpec {
         bootstrap: 10,
         realism: errp_bci::Realism::published(),
         pair_lengths: Vec::new(),
+        trial_latency_sds: Vec::new(),
     }
 }
 
@@ -507,6 +508,20 @@ fn a_small_grid_fit_writes_its_files_and_refuses_bad_settings() {
             },
             "--pair-length must list increasing",
         ),
+        (
+            GridFitSpec {
+                trial_latency_sds: vec![150.0],
+                ..spec.clone()
+            },
+            "--trial-latency-sd 150 is invalid",
+        ),
+        (
+            GridFitSpec {
+                trial_latency_sds: vec![21.3, 16.7],
+                ..spec.clone()
+            },
+            "--trial-latency-sd must list increasing",
+        ),
     ] {
         let e = run_grid_fit(&bad, &out, &cache(), provenance(), &cancel, &())
             .unwrap_err()
@@ -552,5 +567,34 @@ fn a_grid_fit_over_pair_lengths_profiles_each_length() {
     assert_eq!(errp_sim::grid::total_length(&pairs.example), pairs.chosen);
     let json = std::fs::read_to_string(out.join("fit.json")).unwrap();
     assert!(json.contains("\"pair_lengths\"") && json.contains("\"example\""));
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// The single-trial latency SD fitted with the rest: one whole fit per SD,
+/// each at its own users (with common random numbers, users that ignored
+/// the SD would give the same runs bit for bit), and the result at the
+/// chosen SD.
+#[test]
+fn a_grid_fit_over_trial_latency_sds_runs_each_users() {
+    let out = temp_dir("fit-grid-trial");
+    let spec = GridFitSpec {
+        trial_latency_sds: vec![5.0, 60.0],
+        ..small_grid_spec()
+    };
+    let cancel = AtomicBool::new(false);
+    let GridFitOutcome::Complete(fit, _) =
+        run_grid_fit(&spec, &out, &cache(), provenance(), &cancel, &()).unwrap()
+    else {
+        panic!("not interrupted")
+    };
+    let trial = fit.trial_latency.as_ref().expect("fitted over SDs");
+    assert_eq!(trial.sds, vec![5.0, 60.0]);
+    assert!(trial.profile.iter().all(|l| !l.is_nan()), "{trial:?}");
+    assert!(trial.sds.contains(&trial.chosen) && trial.sds.contains(&trial.estimate));
+    assert_ne!(trial.fixed_z[0], trial.fixed_z[1], "{trial:?}");
+    assert_ne!(trial.free_z[0], trial.free_z[1], "{trial:?}");
+    assert_eq!(fit.spec, spec);
+    let json = std::fs::read_to_string(out.join("fit.json")).unwrap();
+    assert!(json.contains("\"trial_latency\"") && json.contains("\"trial_latency_sds\""));
     let _ = std::fs::remove_dir_all(&out);
 }
