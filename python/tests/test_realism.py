@@ -25,10 +25,24 @@ def test_an_empty_realism_is_the_ideal_user():
     np.testing.assert_array_equal(a, b)
 
 
+def test_the_trial_latency_sd_set_to_the_models_own_is_the_same_user():
+    # The EEG model's single-trial latency SD is 25 ms: set to it, the same
+    # samples; set to another, other ERPs.
+    def erps(realism):
+        g = errp.EegGenerator(seed=5, params={"realism": realism})
+        for k in range(6):
+            g.schedule(0.5 + 1.5 * k, "error")
+        return g.generate(10 * 256)
+
+    np.testing.assert_array_equal(erps({}), erps({"trial_latency_sd_ms": 25.0}))
+    assert not np.array_equal(erps({}), erps({"trial_latency_sd_ms": 17.0}))
+
+
 @pytest.mark.parametrize("realism, name", [
     ({"lapse_rate": 1.5}, "realism.lapse_rate"),
     ({"bad_channel": "Q9"}, "realism.bad_channel"),
     ({"lapse": 0.1}, "lapse"),
+    ({"trial_latency_sd_ms": 150.0}, "realism.trial_latency_sd_ms"),
 ])
 def test_a_bad_effect_is_a_value_error_naming_it(realism, name):
     with pytest.raises(ValueError, match=name.replace(".", r"\.")):
