@@ -13,6 +13,11 @@ paints each cell flat in turn and checks that the check then fails.
 
 import sys
 
+if __name__ == "__main__" and {"-h", "--help"} & set(sys.argv[1:]):
+    print(__doc__.strip())
+    sys.exit(0)
+
+
 import numpy as np
 from PIL import Image
 

@@ -13,6 +13,9 @@
 # stand for all 25 (a corner, its edge neighbour, the middle of an edge, two
 # inner cells, the centre), each against every other cell: 144 trips.
 # Output: CSV on stdout.
+case "${1:-}" in
+  -h | --help) awk 'NR > 1 && /^#SBATCH/ { exit } NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
+esac
 set -euo pipefail
 cd "$(dirname "$0")/.."
 runs=${1:-100}

@@ -33,6 +33,9 @@ def main(out):
 
 
 if __name__ == "__main__":
+    if {"-h", "--help"} & set(sys.argv[1:]):
+        print(__doc__.strip())
+        sys.exit(0)
     if len(sys.argv) != 2:
         sys.exit("usage: fit_tables.py FIT_DIR")
     main(sys.argv[1])

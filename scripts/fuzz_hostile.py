@@ -407,3 +407,11 @@ def signal_cases(n, seed):
         out.append((at, Case(f"SIGTERM {at} s into a sweep, then resumed", SIGNALLED,
                              expect=(0, 130), may_change=("ref",))))
     return out
+
+
+if __name__ == "__main__":
+    # A module of fuzz_cli.py: it runs nothing by itself.
+    import sys as _sys
+
+    print(__doc__.strip())
+    _sys.exit(0 if {"-h", "--help"} & set(_sys.argv[1:]) else 2)

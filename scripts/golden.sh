@@ -15,6 +15,9 @@
 # the shipped scenarios without their [realism] table), so that what a
 # change of the simulated user moves is kept out of a restructuring's
 # comparison.
+case "${1:-}" in
+  -h | --help) awk 'NR > 1 && /^#SBATCH/ { exit } NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
+esac
 set -euo pipefail
 cd "$(dirname "$0")/.."
 

@@ -106,6 +106,9 @@ def layer_errors(root: str, graph: dict[str, set[str]], layers: list[set[str]]) 
 
 
 if __name__ == "__main__":
+    if {"-h", "--help"} & set(sys.argv[1:]):
+        print(__doc__.strip())
+        sys.exit(0)
     args = sys.argv[1:]
     plan = None
     if args[:1] == ["--layers"]:

@@ -12,6 +12,11 @@ import hashlib
 import json
 import sys
 
+if __name__ == "__main__" and {"-h", "--help"} & set(sys.argv[1:]):
+    print(__doc__.strip())
+    sys.exit(0)
+
+
 import rerun as rr
 
 

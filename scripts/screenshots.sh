@@ -13,6 +13,9 @@
 # and Debian's xvfb, xdotool and mesa-vulkan-drivers. The viewer exits with 102 once
 # the screenshot is written. Port 9877, not the default 9876: a viewer
 # already running there would receive the file instead.
+case "${1:-}" in
+  -h | --help) awk 'NR > 1 && /^#SBATCH/ { exit } NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
+esac
 set -euo pipefail
 out=${1:?usage: scripts/screenshots.sh OUT_DIR [ERRP]}
 errp=${2:-target/debug/errp}

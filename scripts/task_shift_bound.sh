@@ -6,6 +6,9 @@
 # which the reached goals are not below the idealised user's.
 #
 #   scripts/task_shift_bound.sh     ($ERRP, default target/release/errp)
+case "${1:-}" in
+  -h | --help) awk 'NR > 1 && /^#SBATCH/ { exit } NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
+esac
 set -euo pipefail
 cd "$(dirname "$0")/.."
 errp=${ERRP:-target/release/errp}

@@ -23,6 +23,15 @@ pub(crate) const EXIT_INTERRUPTED: u8 = 130;
 
 /// Installs the handler (once, at start-up).
 pub(crate) fn install() {
+    // Under a file-size limit (`ulimit -f`) a write that passes it kills
+    // the process with SIGXFSZ, leaving its temporaries. With a handler the
+    // write fails with EFBIG instead: an error, after which the temporaries
+    // go, as for a full disk.
+    #[cfg(unix)]
+    let _ = signal_hook::flag::register(
+        signal_hook::consts::SIGXFSZ,
+        std::sync::Arc::new(AtomicBool::new(false)),
+    );
     // Without a handler (an unusual platform) the default action stays:
     // the process ends, and the next run removes what it left.
     let _ = ctrlc::set_handler(|| {

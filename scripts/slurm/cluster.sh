@@ -11,6 +11,9 @@
 #
 # Then: export SLURM_CONF=$ERRP_SLURM_DIR/etc/slurm.conf (default dir
 # /tmp/errp-slurm) before sbatch, squeue, scancel.
+case "${1:-}" in
+  -h | --help) awk 'NR > 1 && /^#SBATCH/ { exit } NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
+esac
 set -euo pipefail
 D=${ERRP_SLURM_DIR:-/tmp/errp-slurm}
 export SLURM_CONF=$D/etc/slurm.conf

@@ -9,9 +9,16 @@
 # --wait returns when the merge has ended, with its exit code (a failed
 # shard cancels the merge: resubmit that shard, then the merge, as printed).
 # Prints the three job ids on one line ("prepare array merge") on stdout.
+case "${1:-}" in
+  -h | --help) awk 'NR > 1 && /^#SBATCH/ { exit } NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
+esac
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
-shards=${1:?"usage: submit.sh N [--wait] [sbatch options...]"}
+if [ $# -lt 1 ]; then
+  echo "usage: scripts/slurm/submit.sh N [--wait] [sbatch options...] (N: the number of shards)" >&2
+  exit 2
+fi
+shards=$1
 shift
 [[ "$shards" =~ ^[1-9][0-9]*$ ]] || { echo "submit.sh: N must be a number of shards >= 1, not $shards" >&2; exit 2; }
 wait=()

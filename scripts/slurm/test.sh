@@ -5,10 +5,22 @@
 # unsharded; no shard may search the targeting again; and an e-puck shard
 # cancelled mid-way and resubmitted alone must change nothing.
 #
-#   scripts/slurm/test.sh ERRP       (as root; starts and stops the cluster)
+#   scripts/slurm/test.sh [--install] ERRP   (as root; starts and stops the cluster)
+#
+# --install first installs Slurm 22.05 and munge with apt-get
+# (scripts/slurm/cluster.sh install); without it, Slurm must be installed.
+case "${1:-}" in
+  -h | --help) awk 'NR > 1 && /^#SBATCH/ { exit } NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
+esac
 set -euo pipefail
 cd "$(dirname "$0")/../.."
-errp=$(realpath "${1:?usage: test.sh ERRP}")
+install=false
+if [ "${1:-}" = --install ]; then install=true; shift; fi
+if [ $# -ne 1 ] || [ ! -x "$1" ]; then
+  echo "usage: scripts/slurm/test.sh [--install] ERRP (ERRP: an executable errp program; got ${1:-nothing})" >&2
+  exit 2
+fi
+errp=$(realpath "$1")
 here=scripts/slurm
 work=$(mktemp -d /tmp/errp-slurm-test.XXXXXX)
 export ERRP_SLURM_DIR=$work/cluster SLURM_CONF=$work/cluster/etc/slurm.conf
@@ -17,7 +29,12 @@ cleanup() {
   "$here/cluster.sh" down || true
   rm -rf "$work"
 }
-"$here/cluster.sh" install
+if $install; then
+  "$here/cluster.sh" install
+elif ! command -v slurmctld >/dev/null || ! command -v sbatch >/dev/null; then
+  echo "test.sh: Slurm is not installed: pass --install to install it with apt-get (as root)" >&2
+  exit 2
+fi
 "$here/cluster.sh" up
 trap cleanup EXIT
 

@@ -59,6 +59,10 @@ pub(crate) fn opening_view(blueprint: Blueprint, timeline: &str) -> Blueprint {
         )
 }
 
+/// How long a recording's flush may go without its file growing before
+/// the writer is taken to have stopped ([`RrdFile::finish`]).
+pub const FLUSH_STEP: std::time::Duration = std::time::Duration::from_secs(3);
+
 /// An `.rrd` file being recorded. Log to [`RrdFile::stream`]; call
 /// [`RrdFile::finish`] to flush it and move it into place.
 pub struct RrdFile {
@@ -97,14 +101,39 @@ impl RrdFile {
     }
 
     /// Flushes everything to disk and renames the file into place.
+    ///
+    /// When the SDK's file writer stops on an error (a full disk, a
+    /// file-size limit), a flush can wait for it forever; the flush is
+    /// therefore waited for in steps of [`FLUSH_STEP`], and a step in which
+    /// the file did not grow is the writer's end: an error, and the
+    /// temporary is removed. The stream, whose threads may still wait, is
+    /// then left to the process's end rather than dropped (which would
+    /// wait too).
     pub fn finish(self) -> Result<std::path::PathBuf> {
-        let path = self.pending.path().to_path_buf();
-        self.stream
-            .flush_blocking()
-            .map_err(|e| recording_failed(&path, e.to_string()))?;
-        self.stream.disconnect();
-        drop(self.stream);
-        self.pending.commit()
+        let Self { stream, pending } = self;
+        let path = pending.path().to_path_buf();
+        let size = || std::fs::metadata(pending.temp_path()).map_or(0, |m| m.len());
+        let mut last = size();
+        loop {
+            match stream.flush_with_timeout(FLUSH_STEP) {
+                Ok(()) => break,
+                Err(rerun::sink::SinkFlushError::Timeout) if size() != last => last = size(),
+                Err(e) => {
+                    std::mem::forget(stream);
+                    let message = match e {
+                        rerun::sink::SinkFlushError::Timeout => format!(
+                            "the file writer stopped with the file at {last} bytes (a full disk \
+                             or a file-size limit?)"
+                        ),
+                        other => other.to_string(),
+                    };
+                    return Err(recording_failed(&path, message));
+                }
+            }
+        }
+        stream.disconnect();
+        drop(stream);
+        pending.commit()
     }
 }
 

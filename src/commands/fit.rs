@@ -358,7 +358,7 @@ fn start(
 /// The command line, version and commit, for a fit's result file.
 fn provenance() -> Provenance {
     Provenance {
-        command: std::env::args().collect::<Vec<_>>().join(" "),
+        command: crate::commands::command_line().join(" "),
         errp_version: env!("CARGO_PKG_VERSION").to_string(),
         commit: COMMIT.to_string(),
     }

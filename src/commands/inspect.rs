@@ -45,6 +45,22 @@ pub(crate) fn inspect(args: &InspectArgs) -> Result<()> {
         }),
         None => None,
     };
+    if let Some(figure) = &args.figure {
+        let same = |dir: &Path| {
+            std::path::absolute(dir)
+                .ok()
+                .is_some_and(|d| std::path::absolute(figure).ok().is_some_and(|f| f == d))
+        };
+        for (flag, dir) in [("--csv", &args.csv), ("--parquet", &args.parquet)] {
+            if let Some(dir) = dir.as_deref().filter(|d| same(d)) {
+                bail!(
+                    "--figure {} is also the {flag} directory {}: give the figure another path",
+                    figure.display(),
+                    dir.display()
+                );
+            }
+        }
+    }
     if let (Some(path), Some(kind)) = (&args.figure, figure_kind) {
         let (magic, what): (&[u8], &str) = match kind {
             FigureKind::Png => (b"\x89PNG", "a PNG image"),

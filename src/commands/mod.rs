@@ -18,3 +18,12 @@ pub(crate) fn user_realism(path: Option<&std::path::Path>) -> anyhow::Result<err
         None => errp_bci::Realism::published(),
     })
 }
+
+/// The command line as it was given, for a result's provenance: an
+/// argument that is not UTF-8 (a file name, say) is kept with U+FFFD in
+/// place of its bad bytes, never a panic.
+pub(crate) fn command_line() -> Vec<String> {
+    std::env::args_os()
+        .map(|a| a.to_string_lossy().into_owned())
+        .collect()
+}

@@ -147,7 +147,7 @@ fn provenance(
 ) -> errp_sim::record::data::Provenance {
     let mut p = errp_sim::record::data::Provenance::new(task, name, text, seed);
     p.commit = crate::commands::fit::COMMIT.to_string();
-    p.command = std::env::args().collect();
+    p.command = crate::commands::command_line();
     p.decoder_summary = decoder_summary;
     p
 }

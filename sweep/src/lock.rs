@@ -60,7 +60,9 @@ pub struct Holder {
 impl Holder {
     fn me() -> Self {
         let pid = std::process::id();
-        let command: Vec<String> = std::env::args().collect();
+        let command: Vec<String> = std::env::args_os()
+            .map(|a| a.to_string_lossy().into_owned())
+            .collect();
         let mut command = command.join(" ");
         if command.len() > 300 {
             let cut = (0..=300)

@@ -3,10 +3,12 @@
 //! interrupted, run twice at once or given damaged files (`reliability`).
 
 mod commands;
+mod edges;
 mod hostile;
 mod inspect;
 mod realism;
 mod reliability;
+mod scripts;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

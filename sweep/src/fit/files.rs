@@ -42,6 +42,22 @@ pub(crate) fn write_fit_files(
 /// and the entries `ours` accepts (a fit's sweeps); `what` names the fit in
 /// the message ("a fit's", "a grid fit's").
 pub(crate) fn check_out(out: &Path, ours: impl Fn(&Path) -> bool, what: &str) -> Result<()> {
+    // A fit inside another fit's directory would make that one's rerun
+    // refuse its own directory.
+    if let Some(outer) = std::path::absolute(out).ok().and_then(|abs| {
+        abs.ancestors()
+            .skip(1)
+            .find(|a| is_fit_json(&a.join(FIT_FILES[0])))
+            .map(Path::to_path_buf)
+    }) {
+        return Err(SimError::Sweep(format!(
+            "--out {} is inside the directory of another fit, {} (its {}); give a directory \
+             outside it",
+            out.display(),
+            outer.display(),
+            FIT_FILES[0]
+        )));
+    }
     if !out.exists() {
         return check_writable(out);
     }

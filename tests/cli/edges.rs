@@ -1,0 +1,164 @@
+//! Edges a hostile user finds: file names that are not UTF-8, a file-size
+//! limit, outputs that collide, a fit inside another fit.
+
+use std::ffi::OsStr;
+use std::os::unix::ffi::OsStrExt;
+use std::path::Path;
+use std::process::{Command, Output};
+
+use crate::{files_in, stderr, temp_dir};
+
+fn errp_os(dir: &Path, args: &[&OsStr]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_errp"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .expect("errp runs")
+}
+
+fn scenario(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenarios")
+        .join(name)
+        .display()
+        .to_string()
+}
+
+/// A file name with a byte that is not UTF-8 is a file name like any
+/// other: the command runs and writes it (its provenance keeps the name
+/// with U+FFFD), never exit 101.
+#[cfg(feature = "rerun")]
+#[test]
+fn names_that_are_not_utf8_are_written_not_a_panic() {
+    let dir = temp_dir("non-utf8");
+    let grid = scenario("grid_fixed_goals.toml");
+    let name = OsStr::from_bytes(b"\xff.rrd");
+    let o = errp_os(
+        &dir,
+        &[
+            "run".as_ref(),
+            grid.as_ref(),
+            "--decoder".as_ref(),
+            "oracle".as_ref(),
+            "-q".as_ref(),
+            "--save".as_ref(),
+            name,
+        ],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(dir.join(name).is_file());
+    let out = OsStr::from_bytes(b"d\xff");
+    let o = errp_os(
+        &dir,
+        &[
+            "sweep".as_ref(),
+            "--task".as_ref(),
+            "grid".as_ref(),
+            "--accuracy".as_ref(),
+            "0.8".as_ref(),
+            "--param".as_ref(),
+            "decoder=oracle".as_ref(),
+            "--episodes".as_ref(),
+            "2".as_ref(),
+            "--quiet".as_ref(),
+            "--out".as_ref(),
+            out,
+        ],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let files = files_in(&dir.join(out));
+    assert!(files.contains(&"summary.csv".to_string()), "{files:?}");
+    assert!(!files.iter().any(|f| f.contains("lock")), "{files:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Under a file-size limit a recording that passes it is an error (exit
+/// 2, EFBIG), and nothing is left: not a death by SIGXFSZ that leaves its
+/// temporary.
+#[cfg(feature = "rerun")]
+#[test]
+fn a_file_size_limit_is_an_error_that_leaves_nothing() {
+    let dir = temp_dir("ulimit");
+    let o = Command::new("sh")
+        .current_dir(&dir)
+        .arg("-c")
+        .arg(format!(
+            "ulimit -f 200 && exec '{}' run '{}' --decoder oracle -q --save x.rrd",
+            env!("CARGO_BIN_EXE_errp"),
+            scenario("grid_fixed_goals.toml")
+        ))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("x.rrd"), "{}", stderr(&o));
+    assert!(files_in(&dir).is_empty(), "{:?}", files_in(&dir));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `--figure` and `--csv` (or `--parquet`) naming the same path are
+/// refused before anything is written.
+#[cfg(feature = "rerun")]
+#[test]
+fn a_figure_and_a_table_directory_of_one_path_are_refused_first() {
+    let dir = temp_dir("same-out");
+    let grid = scenario("grid_fixed_goals.toml");
+    let o = errp_os(
+        &dir,
+        &[
+            "run".as_ref(),
+            grid.as_ref(),
+            "--decoder".as_ref(),
+            "oracle".as_ref(),
+            "-q".as_ref(),
+            "--save".as_ref(),
+            "x.rrd".as_ref(),
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    for flag in ["--csv", "--parquet"] {
+        let o = errp_os(
+            &dir,
+            &[
+                "inspect".as_ref(),
+                "x.rrd".as_ref(),
+                flag.as_ref(),
+                "f.png".as_ref(),
+                "--figure".as_ref(),
+                "./f.png".as_ref(),
+            ],
+        );
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(stderr(&o).contains(flag), "{}", stderr(&o));
+        assert_eq!(files_in(&dir), ["x.rrd"]);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A fit's directory inside another fit's is refused (a rerun of the outer
+/// one would refuse its own directory), before any work.
+#[test]
+fn a_fit_inside_another_fit_is_refused() {
+    let dir = temp_dir("fit-in-fit");
+    std::fs::write(
+        dir.join("fit.json"),
+        r#"{"format": 1, "parameter": "accuracy", "provenance": {"errp_version": "0.1.0"}}"#,
+    )
+    .unwrap();
+    for kind in ["epuck", "grid"] {
+        let o = errp_os(
+            &dir,
+            &[
+                "fit".as_ref(),
+                kind.as_ref(),
+                "--out".as_ref(),
+                "inner".as_ref(),
+                "--no-cache".as_ref(),
+            ],
+        );
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        let e = stderr(&o);
+        assert!(e.contains("inner") && e.contains("another fit"), "{e}");
+        assert_eq!(files_in(&dir), ["fit.json"]);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
