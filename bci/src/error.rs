@@ -60,7 +60,7 @@ pub(crate) fn check(
     } else {
         Err(BciError::InvalidParameter {
             name,
-            value: value.to_string(),
+            value: errp_valid::shown(value),
             expected: expected.to_string(),
         })
     }

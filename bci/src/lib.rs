@@ -71,7 +71,7 @@ pub use continuous::ContinuousFeatures;
 pub use edf::EdfWriter;
 pub use erp::{AssessmentKind, Component, ErpTemplates};
 pub use error::{BciError, Result};
-pub use errp_valid::{Check, Valid};
+pub use errp_valid::{Check, Valid, shown};
 pub use features::{EpochWindow, FeatureExtractor};
 pub use filter::{Biquad, FilterBank, FilterChain};
 pub use generator::{Assessment, Components, EegBlock, EegGenerator, GeneratorParams, Realism};

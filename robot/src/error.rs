@@ -37,7 +37,7 @@ pub(crate) fn check(ok: bool, name: &'static str, v: impl Display, expected: &st
     ok.then_some(())
         .ok_or_else(|| RobotError::InvalidParameter {
             name,
-            value: v.to_string(),
+            value: errp_valid::shown(v),
             expected: expected.to_string(),
         })
 }

@@ -248,8 +248,9 @@ pub fn truncate(text: &str, n: usize) -> String {
 /// The error for a bad `field` of the scenario at `path`.
 pub(crate) fn field_error(path: &Path, field: &str, value: String, expected: &str) -> SimError {
     SimError::Scenario(format!(
-        "{}: field `{field}` = {value} is invalid: expected {expected}",
-        path.display()
+        "{}: field `{field}` = {} is invalid: expected {expected}",
+        path.display(),
+        errp_bci::shown(value)
     ))
 }
 

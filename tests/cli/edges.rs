@@ -162,3 +162,45 @@ fn a_fit_inside_another_fit_is_refused() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Messages show numbers as the user wrote them and blame the field that
+/// is wrong; a size that would be ignored is refused.
+#[test]
+fn messages_show_numbers_as_written_and_blame_the_wrong_field() {
+    let dir = temp_dir("messages");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+    let read = |name: &str| std::fs::read_to_string(root.join(name)).unwrap();
+    let cases = [
+        (
+            format!(
+                "{}\n[control]\nk_turn = 1e300\n",
+                read("mexico_to_pisa.toml")
+            ),
+            "control.k_turn` = 1e300",
+        ),
+        (
+            read("grid_fixed_goals.toml").replacen(
+                "[control]\n",
+                "[control]\nwrong_goal_reward = 1e300\n",
+                1,
+            ),
+            "control.wrong_goal_reward` = 1e300",
+        ),
+        (
+            read("obstacles_havana_to_seoul.toml").replacen(
+                "shape = \"circle\"",
+                "size_cm = [10, 10]\nshape = \"circle\"",
+                1,
+            ),
+            "size_cm` = [10, 10] is invalid: expected no size_cm for a circle",
+        ),
+    ];
+    for (k, (text, want)) in cases.iter().enumerate() {
+        let file = dir.join(format!("s{k}.toml"));
+        std::fs::write(&file, text).unwrap();
+        let e = crate::refused(&["run", file.to_str().unwrap(), "-q", "--runs", "1"]);
+        assert!(e.contains(want), "{want}: {e}");
+        assert!(e.len() < 400, "{e}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -15,6 +15,22 @@ use std::ops::Deref;
 
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
+/// A value as an error message shows it: as `Display` gives it, but a
+/// number whose plain form is long (`1e300` would print 301 digits, `1e-300`
+/// three hundred zeros) in exponent form, as a user writes it. Integers
+/// with more significant digits than a float holds stay whole.
+pub fn shown(value: impl fmt::Display) -> String {
+    let text = value.to_string();
+    // A float's plain form has at most 17 significant digits; a longer
+    // integer (a seed) is shown whole.
+    let digits: String = text.chars().filter(char::is_ascii_digit).collect();
+    let significant = digits.trim_start_matches('0').trim_end_matches('0').len();
+    match text.parse::<f64>() {
+        Ok(x) if text.len() > 17 && significant <= 17 && x.is_finite() => format!("{x:e}"),
+        _ => text,
+    }
+}
+
 /// A parameter set that knows its own rules.
 pub trait Check {
     /// What a broken rule is reported as (naming the field, the value and
@@ -108,6 +124,18 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn numbers_are_shown_as_written() {
+        assert_eq!(shown(1e300), "1e300");
+        assert_eq!(shown(-2.5e-300), "-2.5e-300");
+        assert_eq!(shown(0.3), "0.3");
+        assert_eq!(shown(12345.0), "12345");
+        assert_eq!(shown(u64::MAX), "18446744073709551615");
+        assert_eq!(shown(1e20), "1e20");
+        assert_eq!(shown("box"), "box");
+        assert_eq!(shown(f64::NAN), "NaN");
+    }
 
     #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
     struct Gain {

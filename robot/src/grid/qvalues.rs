@@ -40,6 +40,9 @@ impl Check for QParams {
     }
 }
 
+/// The largest |reward|: the Q-values over tau stay far from overflow.
+const MAX_REWARD: f64 = 1000.0;
+
 impl QParams {
     /// Checks every field.
     pub(crate) fn validate(&self) -> Result<()> {
@@ -50,18 +53,20 @@ impl QParams {
             "a number in [0, 1)",
         )?;
         check(
-            self.wrong_goal_reward.is_finite(),
+            self.wrong_goal_reward.is_finite() && self.wrong_goal_reward.abs() <= MAX_REWARD,
             "wrong_goal_reward",
             self.wrong_goal_reward,
-            "a finite number",
+            &format!("a number in [-{MAX_REWARD}, {MAX_REWARD}]"),
         )?;
         check(
-            self.goal_reward.is_finite() && self.goal_reward > self.wrong_goal_reward,
+            self.goal_reward.is_finite()
+                && self.goal_reward > self.wrong_goal_reward
+                && self.goal_reward <= MAX_REWARD,
             "goal_reward",
             self.goal_reward,
             &format!(
-                "a finite number above wrong_goal_reward ({})",
-                self.wrong_goal_reward
+                "a number above wrong_goal_reward ({}) and at most {MAX_REWARD}",
+                errp_valid::shown(self.wrong_goal_reward)
             ),
         )
     }

@@ -458,6 +458,24 @@ fn obstacle(k: usize, o: &ObstacleFile, size_cm: f64, path: &Path) -> Result<Obs
             &format!("a point inside the arena, both coordinates in [0, {size_cm}]"),
         ));
     }
+    // A size of the other shape would be ignored: refused instead.
+    let foreign = match o.shape.as_str() {
+        "box" => o.radius_cm.map(|r| ("radius_cm", r.to_string(), "a box")),
+        "circle" => o
+            .size_cm
+            .map(|s| ("size_cm", format!("[{}, {}]", s.0[0], s.0[1]), "a circle")),
+        _ => None,
+    };
+    if let Some((name, value, shape)) = foreign {
+        return Err(bad(
+            &field(name),
+            value,
+            &format!(
+                "no {name} for {shape} (a box takes size_cm = [width_cm, height_cm], a circle \
+                 radius_cm)"
+            ),
+        ));
+    }
     match o.shape.as_str() {
         "box" => {
             let [w, h] = o
