@@ -60,6 +60,6 @@ pub use scenario_file::{
     MAX_KEY_PARTS, MAX_SCENARIO_BYTES, key_parts, parse_toml, read_scenario, table_into, truncate,
 };
 pub use stats::{
-    StreamingPearson, correlation_p_value, incomplete_beta, mean_sd, median, pearson,
-    percentile_of, quantile, wilson_interval,
+    StreamingPearson, correlation_p_value, fixed_or_dash, incomplete_beta, mean_sd, median,
+    pearson, percentile_of, quantile, wilson_interval,
 };

@@ -306,3 +306,14 @@ mod tests {
         assert!((quantile(&v, 0.1) - 1.3).abs() < 1e-12);
     }
 }
+
+/// `x` with `decimals` decimals, or `-` when it is undefined (NaN or
+/// infinite: a rate of no trials, the median of no runs), so that no
+/// printed figure is invented.
+pub fn fixed_or_dash(x: f64, decimals: usize) -> String {
+    if x.is_finite() {
+        format!("{x:.decimals$}")
+    } else {
+        "-".to_string()
+    }
+}

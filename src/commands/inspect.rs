@@ -279,53 +279,60 @@ fn compare(recs: &[Recording]) -> Result<()> {
     add(
         "median time (s)",
         stat(&|r| match &r.runs {
-            Runs::Epuck { results, .. } => Some(format!("{:.1}", summarise(results).median_secs)),
-            Runs::Grid { results, .. } => Some(format!(
-                "{:.1}",
-                errp_sim::median(&results.iter().map(|e| e.total_secs).collect::<Vec<_>>())
+            Runs::Epuck { results, .. } => {
+                Some(errp_sim::fixed_or_dash(summarise(results).median_secs, 1))
+            }
+            Runs::Grid { results, .. } => Some(errp_sim::fixed_or_dash(
+                errp_sim::median(&results.iter().map(|e| e.total_secs).collect::<Vec<_>>()),
+                1,
             )),
         }),
     );
     add(
         "median detections",
         stat(&|r| match &r.runs {
-            Runs::Epuck { results, .. } => {
-                Some(format!("{:.1}", summarise(results).median_detected))
-            }
+            Runs::Epuck { results, .. } => Some(errp_sim::fixed_or_dash(
+                summarise(results).median_detected,
+                1,
+            )),
             Runs::Grid { .. } => None,
         }),
     );
     add(
         "median false",
         stat(&|r| match &r.runs {
-            Runs::Epuck { results, .. } => Some(format!("{:.1}", summarise(results).median_false)),
+            Runs::Epuck { results, .. } => {
+                Some(errp_sim::fixed_or_dash(summarise(results).median_false, 1))
+            }
             Runs::Grid { .. } => None,
         }),
     );
     add(
         "hit rate (%)",
         stat(&|r| match &r.runs {
-            Runs::Epuck { results, .. } => {
-                Some(format!("{:.1}", 100.0 * summarise(results).hit_rate))
-            }
+            Runs::Epuck { results, .. } => Some(errp_sim::fixed_or_dash(
+                100.0 * summarise(results).hit_rate,
+                1,
+            )),
             Runs::Grid { .. } => None,
         }),
     );
     add(
         "false alarms/min",
         stat(&|r| match &r.runs {
-            Runs::Epuck { results, .. } => {
-                Some(format!("{:.2}", summarise(results).false_alarms_per_min))
-            }
+            Runs::Epuck { results, .. } => Some(errp_sim::fixed_or_dash(
+                summarise(results).false_alarms_per_min,
+                2,
+            )),
             Runs::Grid { .. } => None,
         }),
     );
     add(
         "median actions",
         stat(&|r| match &r.runs {
-            Runs::Grid { results, .. } => Some(format!(
-                "{:.1}",
-                errp_sim::median(&results.iter().map(|e| e.actions as f64).collect::<Vec<_>>())
+            Runs::Grid { results, .. } => Some(errp_sim::fixed_or_dash(
+                errp_sim::median(&results.iter().map(|e| e.actions as f64).collect::<Vec<_>>()),
+                1,
             )),
             Runs::Epuck { .. } => None,
         }),

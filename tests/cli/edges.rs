@@ -204,3 +204,28 @@ fn messages_show_numbers_as_written_and_blame_the_wrong_field() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// What is undefined is printed as `-`, never as NaN or an invented 0: runs
+/// too short for any ErrP window or any goal; a time-out shorter than the
+/// decoder's window is refused.
+#[test]
+fn undefined_figures_are_dashes_not_numbers() {
+    let dir = temp_dir("undefined");
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/mexico_to_pisa.toml"),
+    )
+    .unwrap();
+    let short = dir.join("short.toml");
+    std::fs::write(&short, text.replacen("max_secs = 600", "max_secs = 1", 1)).unwrap();
+    let o = crate::errp(&["run", short.to_str().unwrap(), "--runs", "2", "--quiet"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(!out.contains("NaN"), "{out}");
+    assert!(out.contains("median time (s)      -"), "{out}");
+    assert!(out.contains("- % turning"), "{out}");
+    let tiny = dir.join("tiny.toml");
+    std::fs::write(&tiny, text.replacen("max_secs = 600", "max_secs = 1e-9", 1)).unwrap();
+    let e = crate::refused(&["run", tiny.to_str().unwrap(), "--quiet"]);
+    assert!(e.contains("max_secs` = 1e-9") && e.contains("1 to"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -16,8 +16,8 @@ use std::ops::Deref;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 /// A value as an error message shows it: as `Display` gives it, but a
-/// number whose plain form is long (`1e300` would print 301 digits, `1e-300`
-/// three hundred zeros) in exponent form, as a user writes it. Integers
+/// number whose plain form is long (`1e300` would print 301 digits, `1e-9`
+/// eight zeros) in exponent form, as a user writes it. Integers
 /// with more significant digits than a float holds stay whole.
 pub fn shown(value: impl fmt::Display) -> String {
     let text = value.to_string();
@@ -26,7 +26,13 @@ pub fn shown(value: impl fmt::Display) -> String {
     let digits: String = text.chars().filter(char::is_ascii_digit).collect();
     let significant = digits.trim_start_matches('0').trim_end_matches('0').len();
     match text.parse::<f64>() {
-        Ok(x) if text.len() > 17 && significant <= 17 && x.is_finite() => format!("{x:e}"),
+        Ok(x)
+            if x.is_finite()
+                && significant <= 17
+                && (x.abs() >= 1e16 || (x != 0.0 && x.abs() < 1e-4)) =>
+        {
+            format!("{x:e}")
+        }
         _ => text,
     }
 }
@@ -130,6 +136,8 @@ mod tests {
         assert_eq!(shown(1e300), "1e300");
         assert_eq!(shown(-2.5e-300), "-2.5e-300");
         assert_eq!(shown(0.3), "0.3");
+        assert_eq!(shown(1e-9), "1e-9");
+        assert_eq!(shown(0.001), "0.001");
         assert_eq!(shown(12345.0), "12345");
         assert_eq!(shown(u64::MAX), "18446744073709551615");
         assert_eq!(shown(1e20), "1e20");

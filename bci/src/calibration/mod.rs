@@ -131,9 +131,11 @@ impl Accuracy {
                 en += a.n_error;
             }
         }
+        // No trial of a class: no rate (NaN), never an invented 0.
+        let rate = |hits: f64, n: usize| if n == 0 { f64::NAN } else { hits / n as f64 };
         Accuracy {
-            correct: ch / cn.max(1) as f64,
-            error: eh / en.max(1) as f64,
+            correct: rate(ch, cn),
+            error: rate(eh, en),
             n_correct: cn,
             n_error: en,
         }

@@ -373,9 +373,14 @@ impl Score {
             errps: self.errps.len(),
             errps_scored: scored.len(),
             clean_secs: self.clean_windows as f64 * WINDOW_STEP_SECS,
+            // A class with no window has no rate (NaN: `-` when printed,
+            // empty in a table), never an invented 0 or 100 %.
             online: Accuracy {
-                correct: 1.0 - self.false_alarms as f64 / self.n_clean_windows.max(1) as f64,
-                error: self.hits as f64 / self.n_err_windows.max(1) as f64,
+                correct: rate(
+                    self.n_clean_windows - self.false_alarms,
+                    self.n_clean_windows,
+                ),
+                error: rate(self.hits, self.n_err_windows),
                 n_correct: self.n_clean_windows,
                 n_error: self.n_err_windows,
             },
@@ -383,5 +388,14 @@ impl Score {
             max_lateral_m_per_s,
             detections: self.detected_at,
         }
+    }
+}
+
+/// `k` of `n` as a fraction; NaN when `n` is 0.
+fn rate(k: usize, n: usize) -> f64 {
+    if n == 0 {
+        f64::NAN
+    } else {
+        k as f64 / n as f64
     }
 }

@@ -8,7 +8,7 @@ use errp_robot::GoalLayout;
 use crate::epuck::episode::EpuckEpisodeResult;
 use crate::epuck::run::EpuckSummary;
 use crate::paper::PAPER_EPUCK;
-use crate::stats::{percentile_of, quantile};
+use crate::stats::{fixed_or_dash, percentile_of, quantile};
 use crate::task::ordinal_percent;
 
 /// The header line of the per-run table ([`EpuckRunRow`]).
@@ -56,7 +56,7 @@ impl fmt::Display for EpuckRunRow<'_> {
         };
         write!(
             f,
-            "{:>4}  {:<16} {:>8.1}  {:>8} {:>6} {:>6} {:>6}  {:>8.1} {:>8.1}  {:>5.0} {:>6.2}",
+            "{:>4}  {:<16} {:>8.1}  {:>8} {:>6} {:>6} {:>6}  {:>8} {:>8}  {:>5} {:>6}",
             self.index + 1,
             on,
             r.time_secs,
@@ -64,10 +64,10 @@ impl fmt::Display for EpuckRunRow<'_> {
             r.false_detections,
             r.missed_errors,
             r.errps,
-            100.0 * r.online.correct,
-            100.0 * r.online.error,
-            100.0 * r.hit_rate(),
-            r.false_alarms_per_min()
+            fixed_or_dash(100.0 * r.online.correct, 1),
+            fixed_or_dash(100.0 * r.online.error, 1),
+            fixed_or_dash(100.0 * r.hit_rate(), 0),
+            fixed_or_dash(r.false_alarms_per_min(), 2)
         )
     }
 }
@@ -109,14 +109,26 @@ impl fmt::Display for EpuckSummaryReport<'_> {
             ),
         ];
         for (label, value, paper) in medians {
-            writeln!(f, "  {label:<20} {value:.1}{}", note(paper))?;
+            writeln!(
+                f,
+                "  {label:<20} {}{}",
+                fixed_or_dash(value, 1),
+                note(paper)
+            )?;
         }
-        let q = |v: &[f64]| (quantile(v, 0.1), quantile(v, 0.9));
-        let (t10, t90) = q(&s.reached_secs);
-        let (d10, d90) = q(&s.reached_detected);
+        let q = |v: &[f64], d: usize| {
+            let (lo, hi) = (quantile(v, 0.1), quantile(v, 0.9));
+            if lo.is_finite() && hi.is_finite() {
+                format!("{lo:.d$}-{hi:.d$}")
+            } else {
+                "-".to_string()
+            }
+        };
         writeln!(
             f,
-            "  central 80 %         time {t10:.1}-{t90:.1} s, detected {d10:.0}-{d90:.0}"
+            "  central 80 %         time {} s, detected {}",
+            q(&s.reached_secs, 1),
+            q(&s.reached_detected, 0)
         )?;
         if let Some(&(_, secs, det)) = paper {
             writeln!(
@@ -135,32 +147,36 @@ impl fmt::Display for EpuckSummaryReport<'_> {
                 "never: fewer than half the runs reach it".to_string()
             }
         )?;
-        writeln!(f, "  median false         {:.1}", s.median_false)?;
-        let [turning, driving, on_goal] = s.phase_shares.map(|x| 100.0 * x);
         writeln!(
             f,
-            "  detections           {:.3} per second of run; {turning:.0} % turning, \
-             {driving:.0} % driving, {on_goal:.0} % on a goal   [paper: 0.18 and 0.21, mostly \
+            "  median false         {}",
+            fixed_or_dash(s.median_false, 1)
+        )?;
+        let [turning, driving, on_goal] = s.phase_shares.map(|x| fixed_or_dash(100.0 * x, 0));
+        writeln!(
+            f,
+            "  detections           {} per second of run; {turning} % turning, \
+             {driving} % driving, {on_goal} % on a goal   [paper: 0.18 and 0.21, mostly \
              during turns]",
-            s.detections_per_sec
+            fixed_or_dash(s.detections_per_sec, 3)
         )?;
-        let [turn, drive, stop] = s.judged_shares.map(|x| 100.0 * x);
+        let [turn, drive, stop] = s.judged_shares.map(|x| fixed_or_dash(100.0 * x, 0));
         writeln!(
             f,
-            "  true detections      of ErrPs judging a turn {turn:.0} %, a drive {drive:.0} %, a \
-             stop {stop:.0} %"
-        )?;
-        writeln!(
-            f,
-            "  online detector      hit rate {:.1} % per ErrP, {:.2} false alarms per error-free minute",
-            100.0 * s.hit_rate,
-            s.false_alarms_per_min
+            "  true detections      of ErrPs judging a turn {turn} %, a drive {drive} %, a \
+             stop {stop} %"
         )?;
         writeln!(
             f,
-            "  window accuracy      correct {:.2} %, error {:.2} % at T_e = {} ({} clean / {} ErrP windows)",
-            100.0 * s.online.correct,
-            100.0 * s.online.error,
+            "  online detector      hit rate {} % per ErrP, {} false alarms per error-free minute",
+            fixed_or_dash(100.0 * s.hit_rate, 1),
+            fixed_or_dash(s.false_alarms_per_min, 2)
+        )?;
+        writeln!(
+            f,
+            "  window accuracy      correct {} %, error {} % at T_e = {} ({} clean / {} ErrP windows)",
+            fixed_or_dash(100.0 * s.online.correct, 2),
+            fixed_or_dash(100.0 * s.online.error, 2),
             self.t_e,
             s.online.n_correct,
             s.online.n_error

@@ -269,12 +269,13 @@ pub fn summarise(results: &[EpuckEpisodeResult]) -> EpuckSummary {
         },
         online: Accuracy::pooled(results.iter().map(|r| &r.online)),
         detections_per_sec: sum(&|r| r.detected_errors as f64) / sum(&|r| r.time_secs),
+        // Shares of no detection are undefined (NaN), not 0 %.
         phase_shares: {
-            let total = sum(&|r| r.detected_errors as f64).max(1.0);
+            let total = sum(&|r| r.detected_errors as f64);
             [0, 1, 2].map(|k| sum(&|r| r.detected_by_phase[k] as f64) / total)
         },
         judged_shares: {
-            let total = sum(&|r| r.true_by_judged_phase.iter().sum::<usize>() as f64).max(1.0);
+            let total = sum(&|r| r.true_by_judged_phase.iter().sum::<usize>() as f64);
             [0, 1, 2].map(|k| sum(&|r| r.true_by_judged_phase[k] as f64) / total)
         },
         hit_rate: 1.0 - sum(&|r| r.missed_errors as f64) / sum(&|r| r.errps_scored as f64),

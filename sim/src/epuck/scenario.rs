@@ -170,11 +170,14 @@ impl EpuckScenario {
         if let Some(v) = file.avoidance.as_ref().and_then(|a| a.enabled) {
             params.avoidance.enabled = v;
         }
-        if !(file.max_secs.is_finite() && file.max_secs > 0.0 && file.max_secs <= MAX_RUN_SECS) {
+        // At least one second: the decoder's window is 1 s long, and a run
+        // is simulated in whole 0.1 s steps, so a shorter time-out would be
+        // reported as a run longer than itself.
+        if !(file.max_secs.is_finite() && (1.0..=MAX_RUN_SECS).contains(&file.max_secs)) {
             return Err(bad(
                 "max_secs",
                 file.max_secs.to_string(),
-                &format!("a time-out > 0 s and at most {MAX_RUN_SECS} s (default 600)"),
+                &format!("a time-out of 1 to {MAX_RUN_SECS} s (default 600)"),
             ));
         }
         params.max_secs = file.max_secs;

@@ -89,10 +89,10 @@ impl fmt::Display for GridRunReport {
         writeln!(f, "  total time (s)   {tm:.2} +- {tsd:.2}")?;
         writeln!(
             f,
-            "  online accuracy  correct {:.2} %, error {:.2} %, mean {:.2} % over {} actions",
-            100.0 * online.correct,
-            100.0 * online.error,
-            100.0 * online.mean(),
+            "  online accuracy  correct {} %, error {} %, mean {} % over {} actions",
+            crate::fixed_or_dash(100.0 * online.correct, 2),
+            crate::fixed_or_dash(100.0 * online.error, 2),
+            crate::fixed_or_dash(100.0 * online.mean(), 2),
             online.n_correct + online.n_error
         )
     }
