@@ -7,13 +7,22 @@ of the wrong type, not finite."""
 import math
 import re
 
+import gymnasium as gym
 import numpy as np
 import pytest
 
 import errp
+import errp.gym  # noqa: F401  (registers the environments)
 
-WHOLE = [-1, -(2**70), 2**64, 2**200, 1.5, 2.0, "3", True, None, float("nan"), [1], np.float64(1.0)]
-REAL = [float("nan"), float("inf"), -float("inf"), "0.8", True, [0.8], object()]
+WHOLE = [-1, -(2**70), 2**64, 2**200, 1.5, 2.0, "3", True, None, float("nan"), [1], np.float64(1.0),
+         1 + 0j]
+REAL = [float("nan"), float("inf"), -float("inf"), "0.8", True, [0.8], object(), 10**400, 1 + 0j,
+        b"0.8"]
+#: Bad actions of an environment: fractions, non-finite, out of range,
+#: arrays of several, complex, None.
+ACTIONS = [3.7, float("nan"), float("inf"), -1, 7, 2**70, np.array([1, 2]), 1 + 0j, None, True,
+           "1"]
+CELLS = [(3.9, 1.2), (float("inf"), 1), (5, 0), (1,), (1, 2, 3), "ab", 7, (1 + 0j, 0)]
 SWEEP_TEXT = ["2.0", "0.4:0.9:0.1", "abc", "0.9:0.6:0.1", ""]
 
 
@@ -53,6 +62,27 @@ def calls():
     add("EegGenerator.generate", "n_samples", WHOLE + [10**9], gen.generate)
     add("EegGenerator.schedule", "onset_secs", REAL + [-1.0, None],
         lambda v: gen.schedule(v, "error"))
+    # Paths: bytes and other types are refused, naming the argument.
+    for bad in [b"x.toml", 3, 2.5]:
+        cases.append(("run", "scenario", bad, lambda v: errp.run(v)))
+        cases.append(("read_recording", "path", bad, lambda v: errp.read_recording(v)))
+    cases.append(("sweep", "out", b"d", lambda v: errp.sweep(v, task="grid", accuracy=0.7)))
+    # A sweep's values may not hold the list separators.
+    for bad in ["0.3,0.5", "0.3:0.5:0.1"]:
+        cases.append(("sweep", "params", bad,
+                      lambda v: errp.sweep(task="grid", accuracy=0.7, params={"tau": [v]})))
+    # The environments: actions, goals and starts.
+    grid = gym.make("errp/Grid-v0")
+    grid.reset(seed=0)
+    add("Grid-v0.step", "action", ACTIONS, lambda v: grid.step(v))
+    add("Grid-v0.reset", "goal", CELLS, lambda v: grid.reset(options={"goal": v}))
+    add("Grid-v0.reset", "start", CELLS, lambda v: grid.reset(options={"start": v}))
+    add("Grid-v0", "goal", CELLS, lambda v: gym.make("errp/Grid-v0", goal=v))
+    epuck = gym.make("errp/Epuck-v0")
+    epuck.reset(seed=0)
+    add("Epuck-v0.step", "action", ACTIONS, lambda v: epuck.step(v))
+    add("Epuck-v0", "goal", [2.5, float("inf"), 25, -1, "Atlantis", 1 + 0j],
+        lambda v: gym.make("errp/Epuck-v0", goal=v))
     # errp.decoders: scikit-learn's habit, parameters checked at fit.
     try:
         from errp import decoders as d
@@ -78,6 +108,18 @@ def calls():
     for cls in (d.TemporalFeatures, d.ContinuousFeatures):
         add(cls.__name__, "sfreq", REAL + [0.0, 250.0, 2.0**70, None],
             lambda v, cls=cls: cls(sfreq=v).fit_transform(epochs))
+    # Input that is not finite, overflows the features or is complex: X.
+    def spoilt(a, v):
+        a = a.astype(complex) if isinstance(v, complex) else a.copy()
+        a.flat[3] = v
+        return a
+
+    bad_x = [float("nan"), float("inf"), 1e300, 1j]
+    for cls in (d.TemporalFeatures, d.ContinuousFeatures):
+        add(cls.__name__, "X", bad_x,
+            lambda v, cls=cls: cls().fit_transform(spoilt(rng.normal(size=(4, 8, 256)), v)))
+    for cls in (d.ShrinkageLDA, d.RbfSVC):
+        add(cls.__name__, "X", bad_x, lambda v, cls=cls: cls().fit(spoilt(x, v), y))
     return cases
 
 

@@ -73,8 +73,8 @@ def _frame(csv: str):
     return pd.read_csv(io.StringIO(csv))
 
 
-def _path(p: Optional[PathLike]) -> Optional[str]:
-    return None if p is None else os.fspath(p)
+def _path(p: Optional[PathLike], name: str) -> Optional[str]:
+    return _args.path(name, p)
 
 
 def episode_columns(task: str) -> list:
@@ -363,10 +363,10 @@ def run(
         runs=_args.whole("runs", runs, 1, _core.MAX_RUNS, optional=True),
         accuracy=_args.accuracy("accuracy", accuracy, optional=True),
         overrides=None if overrides is None else dict(overrides),
-        save=_path(save),
+        save=_path(save, "save"),
     )
     with _progress.shown(progress, "errp.run") as report:
-        d = _core.run(_path(scenario), progress=report, **keywords)
+        d = _core.run(_path(scenario, "scenario"), progress=report, **keywords)
     df = _frame(d["csv"])
     df.attrs["task"] = d["task"]
     df.attrs["decoder"] = dict(d["decoder"])
@@ -511,7 +511,7 @@ def read_recording(path: PathLike) -> Recording:
 
     if not HAS_RERUN:
         raise RuntimeError("this errp was built without Rerun; read_recording needs it")
-    d = _core.read_recording(_path(path))
+    d = _core.read_recording(_path(path, "path"))
     tables = {
         name: pd.DataFrame({c: cols[c] for c in d["order"][name]})
         for name, cols in d["tables"].items()
@@ -616,13 +616,19 @@ def sweep(
         for name, values in params.items():
             if isinstance(values, (str, bytes)) or not hasattr(values, "__iter__"):
                 values = [values]
-            axes.append(f"{name}=" + ",".join(_value_text(v) for v in values))
+            texts = [_value_text(v) for v in values]
+            for i, t in enumerate(texts):
+                if "," in t or ":" in t:
+                    raise ValueError(
+                        f"params[{name!r}][{i}] = {t!r} is invalid: one value may not hold ',' "
+                        "or ':', which separate values and ranges; give the values as a list")
+            axes.append(f"{name}=" + ",".join(texts))
     tmp = None
     if out is None:
         tmp = tempfile.mkdtemp(prefix="errp-sweep-")
         target = os.path.join(tmp, "sweep")
     else:
-        target = os.fspath(out)
+        target = _args.path("out", out)
     try:
         with _progress.shown(progress, "errp.sweep") as report:
             d = _core.sweep(
@@ -630,12 +636,12 @@ def sweep(
                 dict(
                     accuracy=acc,
                     task=task,
-                    scenario=_path(scenario),
+                    scenario=_path(scenario, "scenario"),
                     episodes=episodes,
                     seed=seed,
                     params=axes,
                     stream=stream,
-                    cache=_path(cache),
+                    cache=_path(cache, "cache"),
                     threads=threads,
                 ),
                 progress=report,
@@ -754,7 +760,7 @@ class GridTask(_Task):
             overrides=None if overrides is None else dict(overrides),
         )
         with _progress.shown(progress, "errp.GridTask") as report:
-            self._core = _core.GridTask(_path(scenario), progress=report, **keywords)
+            self._core = _core.GridTask(_path(scenario, "scenario"), progress=report, **keywords)
 
     def run(
         self, *, save: Optional[PathLike] = None, progress: Optional[bool] = None
@@ -765,7 +771,7 @@ class GridTask(_Task):
         --save`` records them, with the decoder in the loop (yours, if
         given). ``progress`` as for :func:`run`."""
         with _progress.shown(progress, "GridTask.run") as report:
-            csv = self._core.run(_path(save), progress=report)
+            csv = self._core.run(_path(save, "save"), progress=report)
         df = _frame(csv)
         df.attrs["task"] = "grid"
         df.attrs["decoder"] = self.calibration
@@ -810,7 +816,7 @@ class EpuckTask(_Task):
             overrides=None if overrides is None else dict(overrides),
         )
         with _progress.shown(progress, "errp.EpuckTask") as report:
-            self._core = _core.EpuckTask(_path(scenario), progress=report, **keywords)
+            self._core = _core.EpuckTask(_path(scenario, "scenario"), progress=report, **keywords)
 
     def run(
         self,
@@ -826,7 +832,7 @@ class EpuckTask(_Task):
         ``progress`` as for :func:`run`."""
         runs = _args.whole("runs", runs, 1, _core.MAX_RUNS, optional=True)
         with _progress.shown(progress, "EpuckTask.run") as report:
-            csv = self._core.run(runs, save=_path(save), progress=report)
+            csv = self._core.run(runs, save=_path(save, "save"), progress=report)
         df = _frame(csv)
         df.attrs["task"] = "epuck"
         df.attrs["decoder"] = self.calibration

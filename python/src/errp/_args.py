@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
 from typing import Optional
 
 #: The largest seed: what a scenario file (TOML, a signed 64-bit integer)
@@ -51,7 +52,14 @@ def real(
         raise TypeError(f"{name} must be {what}, not None")
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise TypeError(f"{name} must be {what}, not {type(value).__name__} {value!r}")
-    v = float(value)
+    try:
+        v = float(value)
+    except OverflowError:
+        # An integer too large for a float (10**400).
+        size = int(int(value).bit_length() * math.log10(2))
+        raise ValueError(
+            f"{name} = an integer of about 10^{size} is invalid: it is too large for a float; "
+            f"expected {what}") from None
     if not math.isfinite(v):
         raise ValueError(f"{name} = {v!r} is invalid: expected {what}")
     return v
@@ -66,3 +74,22 @@ def accuracy(
     what = ("a mean accuracy in (0.5, 1), or 1 for the oracle" if oracle
             else "a mean accuracy strictly between 0.5 and 1")
     return real(name, value, optional=optional, what=what)
+
+
+def path(name: str, value) -> Optional[str]:
+    """A file or directory path: a ``str`` or an ``os.PathLike`` of one
+    (``None`` passes). Bytes are refused, naming the argument (a name that
+    is not UTF-8 is given as ``os.fsdecode(raw)``)."""
+    if value is None:
+        return None
+    try:
+        v = os.fspath(value)
+    except TypeError:
+        raise TypeError(
+            f"{name} must be a path (str or os.PathLike), not {type(value).__name__} {value!r}"
+        ) from None
+    if isinstance(v, bytes):
+        raise TypeError(
+            f"{name} must be a path as str, not bytes {value!r} (use os.fsdecode for a raw name)"
+        )
+    return v

@@ -73,15 +73,42 @@ __all__ = [
 ]
 
 
+#: The largest magnitude of an input value: beyond it a power or a squared
+#: distance would overflow a float and the result would be invented.
+MAX_MAGNITUDE = 1e100
+
+
+def _bounded(name: str, X: np.ndarray) -> np.ndarray:
+    """Refuses an ``X`` that holds NaN, infinities or values beyond
+    :data:`MAX_MAGNITUDE`, naming where."""
+    bad = ~np.isfinite(X) | (np.abs(np.nan_to_num(X)) > MAX_MAGNITUDE)
+    if bad.any():
+        at = tuple(int(i) for i in np.argwhere(bad)[0])
+        raise ValueError(
+            f"{name}: X[{', '.join(map(str, at))}] = {float(X[at])!r} is invalid: expected finite "
+            f"values (no NaN or inf) of magnitude at most {MAX_MAGNITUDE:g} "
+            f"({int(bad.sum())} value(s) are not)"
+        )
+    return X
+
+
+def _real(name: str, X) -> None:
+    """Refuses complex input, naming ``X`` (NumPy would drop the imaginary
+    part with only a warning)."""
+    if np.iscomplexobj(X):
+        raise TypeError(f"{name}: X must be real, not complex")
+
+
 def _epochs(name: str, X) -> np.ndarray:
     """``X`` as a C-ordered float64 array of shape (n_epochs, n_channels,
-    n_samples)."""
+    n_samples), finite and bounded."""
+    _real(name, X)
     X = np.ascontiguousarray(X, dtype=np.float64)
     if X.ndim != 3:
         raise ValueError(
             f"{name}: X must be 3-D (n_epochs, n_channels, n_samples), got shape {X.shape}"
         )
-    return X
+    return _bounded(name, X)
 
 
 def _sfreq(value) -> float:
@@ -182,7 +209,9 @@ class _Binary(ClassifierMixin, BaseEstimator):
     """Common part of the two classifiers: binary labels, 2-D features."""
 
     def _classes(self, X, y):
+        _real(type(self).__name__, X)
         X, y = _validate_data(self, X, y, dtype=np.float64, order="C")
+        _bounded(type(self).__name__, X)
         check_classification_targets(y)
         self.classes_, index = np.unique(y, return_inverse=True)
         k = len(self.classes_)
@@ -196,7 +225,9 @@ class _Binary(ClassifierMixin, BaseEstimator):
 
     def _features(self, X):
         check_is_fitted(self)
-        return _validate_data(self, X, dtype=np.float64, order="C", reset=False)
+        _real(type(self).__name__, X)
+        X = _validate_data(self, X, dtype=np.float64, order="C", reset=False)
+        return _bounded(type(self).__name__, X)
 
     def predict(self, X) -> np.ndarray:
         """The class of each row: the error class where the decision is

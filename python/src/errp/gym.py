@@ -38,6 +38,7 @@ here).
 
 from __future__ import annotations
 
+import numbers
 import os
 import warnings
 import weakref
@@ -119,10 +120,10 @@ class GridEnv(gym.Env):
         accuracy = _args.accuracy("accuracy", accuracy, optional=True)
         with _progress.shown(progress, "errp/Grid-v0") as report:
             self._core = _core.GridEnvCore(
-                None if scenario is None else os.fspath(scenario),
+                _args.path("scenario", scenario),
                 accuracy=accuracy,
                 overrides=fields,
-                save=None if save is None else os.fspath(save),
+                save=_args.path("save", save),
                 progress=report,
             )
         self.save = save
@@ -206,12 +207,7 @@ class GridEnv(gym.Env):
         (the time limit is the wrapper's), and info: ``success``, the
         user's true judgement ``error``, the decoder's ``decoded_error``,
         ``p_error``, ``interval_secs`` and the goal."""
-        a = int(action)
-        if not self.action_space.contains(a):
-            raise ValueError(
-                f"action = {action!r} is invalid: expected 0 (up), 1 (down), "
-                "2 (left), 3 (right) or 4 (goal reached)"
-            )
+        a = _action(action, "0 (up), 1 (down), 2 (left), 3 (right) or 4 (goal reached)", 5)
         d = self._core.step(a, self.observe_epoch)
         self._cursor = tuple(d["cursor"])
         self._visits[self._cursor] += 1
@@ -329,10 +325,10 @@ class EpuckEnv(gym.Env):
         accuracy = _args.accuracy("accuracy", accuracy, optional=True)
         with _progress.shown(progress, "errp/Epuck-v0") as report:
             self._core = _core.EpuckEnvCore(
-                None if scenario is None else os.fspath(scenario),
+                _args.path("scenario", scenario),
                 accuracy=accuracy,
                 overrides=None if overrides is None else dict(overrides),
-                save=None if save is None else os.fspath(save),
+                save=_args.path("save", save),
                 progress=report,
             )
         self.save = save
@@ -399,7 +395,11 @@ class EpuckEnv(gym.Env):
                     f"({', '.join(self.goal_names)}) or an index 0-24"
                 )
             return self.goal_names.index(goal)
-        g = int(goal)
+        g = _whole(goal)
+        if g is None:
+            raise TypeError(
+                f"goal must be a city name or a whole index from 0 to "
+                f"{len(self.goal_names) - 1}, not {type(goal).__name__} {goal!r}")
         if not 0 <= g < len(self.goal_names):
             raise ValueError(
                 f"goal = {goal!r} is invalid: expected an index from 0 to "
@@ -455,12 +455,7 @@ class EpuckEnv(gym.Env):
         False, and info: ``success``, ``committed`` (the city stopped on),
         ``errps`` (the user's ErrPs during the action, for scoring),
         ``time_secs`` and the goal."""
-        a = int(action)
-        if not self.action_space.contains(a):
-            raise ValueError(
-                f"action = {action!r} is invalid: expected 0 (forward), 1 (turn left), "
-                "2 (turn right) or 3 (stop)"
-            )
+        a = _action(action, "0 (forward), 1 (turn left), 2 (turn right) or 3 (stop)", 4)
         d = self._core.step(a, self.windows_per_action, self.observe_window)
         self._pose = tuple(d["pose"])
         self._time = float(d["time_secs"])
@@ -599,16 +594,40 @@ def _arena_frame(env) -> np.ndarray:
     return c.img
 
 
+def _whole(v) -> Optional[int]:
+    """``v`` as an ``int`` if it is a Python or NumPy integer (a 0-d
+    integer array too), else ``None``: no float, fraction, bool, complex,
+    string or None is taken for one."""
+    if isinstance(v, np.ndarray) and v.ndim == 0 and v.dtype.kind in "iu":
+        v = v.item()
+    if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Integral):
+        return None
+    return int(v)
+
+
+def _action(action, expected: str, n: int) -> int:
+    """An environment's action: a whole number from 0 to ``n - 1``."""
+    a = _whole(action)
+    if a is None:
+        raise TypeError(
+            f"action must be a whole number: {expected}, not {type(action).__name__} {action!r}")
+    if not 0 <= a < n:
+        raise ValueError(f"action = {a} is invalid: expected {expected}")
+    return a
+
+
 def _cell(name: str, c) -> Optional[Tuple[int, int]]:
     if c is None:
         return None
+    expected = "a cell (x, y) of the 5x5 grid, x and y whole numbers from 0 to 4"
     try:
-        x, y = (int(v) for v in c)
-    except (TypeError, ValueError):
-        raise ValueError(
-            f"{name} = {c!r} is invalid: expected a cell (x, y) of the 5x5 grid, "
-            "x and y from 0 to 4"
-        ) from None
+        parts = list(c)
+    except TypeError:
+        raise TypeError(f"{name} must be {expected}, not {type(c).__name__} {c!r}") from None
+    whole = [_whole(v) for v in parts]
+    if len(parts) != 2 or any(v is None for v in whole):
+        raise TypeError(f"{name} must be {expected}, not {c!r}")
+    x, y = whole
     if not (0 <= x < 5 and 0 <= y < 5):
         raise ValueError(
             f"{name} = ({x}, {y}) is invalid: expected a cell (x, y) of the 5x5 grid, "
