@@ -39,6 +39,8 @@ Example: the session's own cross-validation, by scikit-learn::
 
 from __future__ import annotations
 
+import contextlib
+
 import numpy as np
 
 try:
@@ -96,7 +98,20 @@ def _real(name: str, X) -> None:
     """Refuses complex input, naming ``X`` (NumPy would drop the imaginary
     part with only a warning)."""
     if np.iscomplexobj(X):
-        raise TypeError(f"{name}: X must be real, not complex")
+        raise ValueError(f"{name}: X must be real, not complex (Complex data not supported)")
+
+
+@contextlib.contextmanager
+def _naming_complex(name: str):
+    """scikit-learn's refusal of complex input, with the estimator and ``X``
+    named."""
+    try:
+        yield
+    except ValueError as e:
+        if "Complex data not supported" in str(e):
+            raise ValueError(
+                f"{name}: X must be real, not complex (Complex data not supported)") from None
+        raise
 
 
 def _epochs(name: str, X) -> np.ndarray:
@@ -209,8 +224,8 @@ class _Binary(ClassifierMixin, BaseEstimator):
     """Common part of the two classifiers: binary labels, 2-D features."""
 
     def _classes(self, X, y):
-        _real(type(self).__name__, X)
-        X, y = _validate_data(self, X, y, dtype=np.float64, order="C")
+        with _naming_complex(type(self).__name__):
+            X, y = _validate_data(self, X, y, dtype=np.float64, order="C")
         _bounded(type(self).__name__, X)
         check_classification_targets(y)
         self.classes_, index = np.unique(y, return_inverse=True)
@@ -225,8 +240,8 @@ class _Binary(ClassifierMixin, BaseEstimator):
 
     def _features(self, X):
         check_is_fitted(self)
-        _real(type(self).__name__, X)
-        X = _validate_data(self, X, dtype=np.float64, order="C", reset=False)
+        with _naming_complex(type(self).__name__):
+            X = _validate_data(self, X, dtype=np.float64, order="C", reset=False)
         return _bounded(type(self).__name__, X)
 
     def predict(self, X) -> np.ndarray:
