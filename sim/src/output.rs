@@ -194,6 +194,38 @@ fn remove_stale_partials(dest: &Path) {
     }
 }
 
+/// The process of this host (this one included) that writes the same file
+/// as our temporary `temp` under another temporary of its own, if any:
+/// two writers of one path would have the last one win, silently. Those of
+/// other hosts cannot be seen to be alive and are left alone.
+fn other_writer(temp: &Path, host: &str) -> Option<u32> {
+    let ours = temp.file_name()?.to_str()?;
+    let (prefix, _) = ours.split_once(".partial-")?;
+    let dir = match temp.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    std::fs::read_dir(dir)
+        .ok()?
+        .flatten()
+        .take(100_000)
+        .find_map(|entry| {
+            let file = entry.file_name();
+            let name = file.to_str()?;
+            if name == ours {
+                return None;
+            }
+            let (p, rest) = name.split_once(".partial-")?;
+            if p != prefix {
+                return None;
+            }
+            let mut parts = rest.rsplitn(3, '-');
+            let (_, pid, owner) = (parts.next()?, parts.next()?, parts.next()?);
+            let pid = pid.parse::<u32>().ok()?;
+            (owner == host && !process_gone(pid, None)).then_some(pid)
+        })
+}
+
 /// A file being written under a temporary name next to its destination. It
 /// is renamed into place by [`PendingFile::commit`]; dropped uncommitted (an
 /// error, a panic, Ctrl-C unwinding), the temporary is removed, so a failed
@@ -279,6 +311,23 @@ impl PendingFile {
                 Err(e) => return Err(fail(e)),
             }
         };
+        if let Some(pid) = other_writer(&temp, &host) {
+            drop(file);
+            let _ = std::fs::remove_file(&temp);
+            return Err(fail(std::io::Error::new(
+                std::io::ErrorKind::AlreadyExists,
+                if pid == std::process::id() {
+                    "this process is writing the same file already (another recording or \
+                     environment with this path): give each its own path"
+                        .to_string()
+                } else {
+                    format!(
+                        "process {pid} is writing the same file now: wait for it to finish, or \
+                         give another path"
+                    )
+                },
+            )));
+        }
         remove_if_interrupted(&temp);
         Ok((
             Self {

@@ -132,8 +132,38 @@ impl RrdFile {
             }
         }
         stream.disconnect();
+        // Dropping the stream ends the writer, which writes the file's end
+        // then; an error there is only logged by the SDK, so the end is
+        // checked on disk.
         drop(stream);
+        if let Err(message) = check_stream_footer(pending.temp_path()) {
+            return Err(recording_failed(&path, message));
+        }
         pending.commit()
+    }
+}
+
+/// Checks that the `.rrd` file at `path` ends with Rerun's stream footer
+/// (32 bytes: the span of the footer message, its checksum, `RRF2FOOT` and
+/// the count 1) and that the span ends where the footer begins: a file whose
+/// last writes failed does not.
+fn check_stream_footer(path: &Path) -> std::result::Result<(), String> {
+    use std::io::{Read, Seek, SeekFrom};
+    const FOOTER: u64 = 32;
+    let mut file = crate::open_regular(path).map_err(|e| e.to_string())?;
+    let len = file.metadata().map_err(|e| e.to_string())?.len();
+    let mut tail = [0u8; FOOTER as usize];
+    let read = len >= FOOTER
+        && file.seek(SeekFrom::Start(len - FOOTER)).is_ok()
+        && file.read_exact(&mut tail).is_ok();
+    let word = |at: usize| u64::from_le_bytes(tail[at..at + 8].try_into().expect("8 bytes"));
+    if read && &tail[20..28] == b"RRF2FOOT" && word(0).checked_add(word(8)) == Some(len - FOOTER) {
+        Ok(())
+    } else {
+        Err(format!(
+            "the recording's end was not written: the file stops at {len} bytes (a full disk or \
+             a file-size limit?)"
+        ))
     }
 }
 
@@ -170,7 +200,7 @@ pub(crate) fn record_error(path: &Path) -> impl Fn(rerun::RecordingStreamError) 
 /// file finds the usual cause (a full disk, a quota), which leads.
 fn recording_failed(path: &Path, message: String) -> SimError {
     let message = match probe_space(path) {
-        Err(e) => format!("{e} (the Rerun SDK: {message})"),
+        Err(e) => format!("{e} ({message})"),
         Ok(()) => message,
     };
     SimError::Record {

@@ -225,8 +225,10 @@ class GridEnv(gym.Env):
         return self._obs(p, d.get("epoch")), 1.0 - 2.0 * p, terminated, False, info
 
     def close(self) -> None:
-        """Writes the recording (``save=``); the environment records no more."""
-        self._finalizer()
+        """Writes the recording (``save=``); the environment records no more.
+        With ``save=`` and no episode that took an action, nothing is
+        written, and a warning says so."""
+        _close_recording(self)
         super().close()
 
     def render(self):
@@ -477,8 +479,10 @@ class EpuckEnv(gym.Env):
 
     def close(self) -> None:
         """Writes the recording (``save=``); the episode in progress ends
-        without a commitment, and the environment records no more."""
-        self._finalizer()
+        without a commitment, and the environment records no more. With
+        ``save=`` and no episode that took an action, nothing is written,
+        and a warning says so."""
+        _close_recording(self)
         super().close()
 
     def render(self):
@@ -592,6 +596,22 @@ def _arena_frame(env) -> np.ndarray:
     c.img[[0, -1], :] = (60, 60, 60)
     c.img[:, [0, -1]] = (60, 60, 60)
     return c.img
+
+
+def _close_recording(env) -> None:
+    """Closes ``env``'s core once (writing its recording); warns when
+    ``save=`` was given and no episode was recorded, so nothing was
+    written."""
+    if not env._finalizer.alive:
+        return
+    written = env._finalizer()
+    if env.save is not None and written is None:
+        warnings.warn(
+            f"save={os.fspath(env.save)!r}: no episode took an action, so nothing was recorded "
+            "and no file was written",
+            UserWarning,
+            stacklevel=3,
+        )
 
 
 def _whole(v) -> Optional[int]:
