@@ -238,6 +238,17 @@ fn ln_gamma(x: f64) -> f64 {
     0.5 * (2.0 * std::f64::consts::PI).ln() + (x + 0.5) * t.ln() - t + a.ln()
 }
 
+/// `x` with `decimals` decimals, or `-` when it is undefined (NaN or
+/// infinite: a rate of no trials, the median of no runs), so that no
+/// printed figure is invented.
+pub fn fixed_or_dash(x: f64, decimals: usize) -> String {
+    if x.is_finite() {
+        format!("{x:.decimals$}")
+    } else {
+        "-".to_string()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -304,16 +315,5 @@ mod tests {
         assert_eq!(quantile(&v, 0.0), 1.0);
         assert_eq!(quantile(&v, 1.0), 4.0);
         assert!((quantile(&v, 0.1) - 1.3).abs() < 1e-12);
-    }
-}
-
-/// `x` with `decimals` decimals, or `-` when it is undefined (NaN or
-/// infinite: a rate of no trials, the median of no runs), so that no
-/// printed figure is invented.
-pub fn fixed_or_dash(x: f64, decimals: usize) -> String {
-    if x.is_finite() {
-        format!("{x:.decimals$}")
-    } else {
-        "-".to_string()
     }
 }
