@@ -2,6 +2,7 @@
 //! limit, outputs that collide, a fit inside another fit.
 
 use std::ffi::OsStr;
+#[cfg(feature = "rerun")]
 use std::os::unix::ffi::OsStrExt;
 use std::path::Path;
 use std::process::{Command, Output};
@@ -16,6 +17,7 @@ fn errp_os(dir: &Path, args: &[&OsStr]) -> Output {
         .expect("errp runs")
 }
 
+#[cfg(feature = "rerun")]
 fn scenario(name: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("scenarios")
