@@ -311,23 +311,6 @@ impl PendingFile {
                 Err(e) => return Err(fail(e)),
             }
         };
-        if let Some(pid) = other_writer(&temp, &host) {
-            drop(file);
-            let _ = std::fs::remove_file(&temp);
-            return Err(fail(std::io::Error::new(
-                std::io::ErrorKind::AlreadyExists,
-                if pid == std::process::id() {
-                    "this process is writing the same file already (another recording or \
-                     environment with this path): give each its own path"
-                        .to_string()
-                } else {
-                    format!(
-                        "process {pid} is writing the same file now: wait for it to finish, or \
-                         give another path"
-                    )
-                },
-            )));
-        }
         remove_if_interrupted(&temp);
         Ok((
             Self {
@@ -338,6 +321,33 @@ impl PendingFile {
             },
             file,
         ))
+    }
+
+    /// As [`PendingFile::create`], for an output that one writer at a time
+    /// may hold (a recording): refused, naming the path, while another
+    /// writer of this host (this process included) is writing the same
+    /// file, where two would silently have the last one win.
+    pub fn create_exclusive(dest: impl AsRef<Path>) -> Result<(Self, File)> {
+        let (pending, file) = Self::create(dest)?;
+        if let Some(pid) = other_writer(&pending.temp, &host_name()) {
+            return Err(SimError::Output {
+                path: pending.dest.clone(),
+                source: std::io::Error::new(
+                    std::io::ErrorKind::AlreadyExists,
+                    if pid == std::process::id() {
+                        "this process is writing the same file already (another recording or \
+                         environment with this path): give each its own path"
+                            .to_string()
+                    } else {
+                        format!(
+                            "process {pid} is writing the same file now: wait for it to finish, \
+                             or give another path"
+                        )
+                    },
+                ),
+            });
+        }
+        Ok((pending, file))
     }
 
     /// Where the data goes while it is written.
@@ -451,6 +461,26 @@ mod tests {
         assert!(!dead.exists() && !dead_other_file.exists());
         assert!(live.exists() && elsewhere.exists() && not_ours.exists());
         assert_eq!(std::fs::read(dir.join("a.txt")).unwrap(), b"whole");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn an_exclusive_output_refuses_a_second_writer_while_the_first_writes() {
+        let dir = std::env::temp_dir().join(format!("errp-exclusive-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let (first, _f) = PendingFile::create_exclusive(dir.join("r.rrd")).unwrap();
+        let e = PendingFile::create_exclusive(dir.join("r.rrd"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("r.rrd") && e.contains("writing the same file"),
+            "{e}"
+        );
+        // The refused one left nothing; the first still writes, then commits.
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+        first.commit().unwrap();
+        let (again, _g) = PendingFile::create_exclusive(dir.join("r.rrd")).unwrap();
+        drop(again);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

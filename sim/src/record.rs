@@ -78,7 +78,7 @@ impl RrdFile {
         path: impl AsRef<Path>,
         blueprint: Blueprint,
     ) -> Result<Self> {
-        let (pending, file) = PendingFile::create(path)?;
+        let (pending, file) = PendingFile::create_exclusive(path)?;
         drop(file);
         let stream = RecordingStreamBuilder::new(app_id)
             .with_default_blueprint(blueprint)

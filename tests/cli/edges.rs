@@ -231,3 +231,60 @@ fn undefined_figures_are_dashes_not_numbers() {
     assert!(e.contains("max_secs` = 1e-9") && e.contains("1 to"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A second process recording to the path another is recording to is
+/// refused (exit 2, naming the path); the first finishes its file.
+#[cfg(feature = "rerun")]
+#[test]
+fn a_second_process_recording_one_path_is_refused() {
+    let dir = temp_dir("two-writers");
+    let epuck = scenario("mexico_to_pisa.toml");
+    let mut first = Command::new(env!("CARGO_BIN_EXE_errp"))
+        .current_dir(&dir)
+        .args([
+            "run",
+            epuck.as_str(),
+            "--runs",
+            "20",
+            "-q",
+            "--save",
+            "x.rrd",
+        ])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("errp runs");
+    // Wait (up to a minute) for the first one's temporary.
+    let mut waited = 0;
+    while !files_in(&dir)
+        .iter()
+        .any(|f| f.starts_with(".x.rrd.partial-"))
+    {
+        assert!(waited < 600, "the first run never started its recording");
+        std::thread::sleep(std::time::Duration::from_millis(100));
+        waited += 1;
+    }
+    let o = errp_os(
+        &dir,
+        &[
+            "run".as_ref(),
+            epuck.as_ref(),
+            "--runs".as_ref(),
+            "1".as_ref(),
+            "-q".as_ref(),
+            "--save".as_ref(),
+            "x.rrd".as_ref(),
+        ],
+    );
+    let still_running = first.try_wait().unwrap().is_none();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("x.rrd") && stderr(&o).contains("writing the same file"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(still_running, "the first run ended before the check");
+    assert!(first.wait().unwrap().success());
+    assert_eq!(files_in(&dir), ["x.rrd"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
