@@ -149,7 +149,8 @@ impl fmt::Display for SweepReport {
             };
             writeln!(
                 f,
-                "{name}: online accuracy vs {cost} over {n} successful episodes: r = {r:.3}, p = {}",
+                "{name}: online accuracy vs {cost} over {n} successful episodes: r = {}, p = {}",
+                errp_sim::fixed_or_dash(*r, 3),
                 if p.is_finite() {
                     format!("{p:.3e}")
                 } else {
