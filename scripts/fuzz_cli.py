@@ -20,6 +20,12 @@ Grid scenarios run with the oracle decoder and e-puck scenarios with
 order (seeded) until --seconds have passed (default: all of them); the
 counts are printed at the end and any failure makes the exit code 1.
 
+A family of damaged recordings (`recording_cases`, about 190, in
+fuzz_recordings.py): a grid run's, an e-puck run's and a calibration's
+recording cut short at seeded offsets, with bits flipped, doubled, followed
+by garbage, reduced to its header or zeroed, each read by `errp inspect
+--csv`, which must exit 0 or 2 (naming the file) and leave nothing on 2.
+
 A second family (`hostile_cases`, about 200) changes the program's
 surroundings instead of its input: standard output or error closed early
 (`| head -1`) or on a full disk (`/dev/full`); FIFOs, sockets, devices
@@ -46,6 +52,7 @@ import tomllib
 from pathlib import Path
 
 from fuzz_hostile import build_base, hostile_cases, run_case, signal_cases
+from fuzz_recordings import make_bases, recording_cases, run_damage
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENARIOS = sorted((ROOT / "scenarios").glob("*.toml"))
@@ -239,7 +246,7 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--memory-gib", type=int, default=4)
     ap.add_argument("--list", action="store_true")
-    ap.add_argument("--only", choices=["input", "hostile", "signal"],
+    ap.add_argument("--only", choices=["input", "hostile", "signal", "recordings"],
                     help="run one family of cases")
     a = ap.parse_args()
     errp = str(Path(a.errp).resolve())
@@ -247,10 +254,17 @@ def main():
     cases += [("input", " ".join(f), None, f) for f in FLAG_CASES]
     cases += [("hostile", c.label, None, c) for c in hostile_cases()]
     cases += [("signal", c.label, at, c) for at, c in signal_cases(20, a.seed)]
+    base_dir = tempfile.mkdtemp(prefix="errp-fuzz-base-")
+    bases = None
+    if a.only in (None, "recordings"):
+        bases = make_bases(errp, base_dir)
+        sizes = {kind: len(b) for kind, b in bases.items()}
+        cases += [("recordings", c.label, None, c) for c in recording_cases(a.seed, sizes)]
     random.Random(a.seed).shuffle(cases)
     if a.list:
         for kind, label, _, args in cases:
             print(kind, "|", label, "|", " ".join(args) if kind == "input" else args.command())
+        shutil.rmtree(base_dir, ignore_errors=True)
         return
     grid_file = ROOT / "scenarios" / "grid_fixed_goals.toml"
     epuck_file = ROOT / "scenarios" / "mexico_to_pisa.toml"
@@ -258,13 +272,14 @@ def main():
         cases = [c for c in cases if c[0] == a.only]
     started = time.monotonic()
     ran, ran_ok, refused, stopped, failures = 0, 0, 0, 0, []
-    base_dir = tempfile.mkdtemp(prefix="errp-fuzz-base-")
     base = None
     for kind, label, text, args in cases:
         if time.monotonic() - started > a.seconds:
             break
         if kind == "input":
             code, failure = check(errp, label, text, args, a.memory_gib, grid_file, epuck_file)
+        elif kind == "recordings":
+            failure, code = run_damage(errp, bases, args, a.memory_gib, limit_memory)
         else:
             if base is None:
                 base = build_base(errp, base_dir)
