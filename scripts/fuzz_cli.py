@@ -2,6 +2,7 @@
 """Hostile-but-fair use of the `errp` program, case after case.
 
 Usage: fuzz_cli.py ERRP [--seconds N] [--seed S] [--memory-gib G] [--only FAMILY] [--list]
+                   [--python PYTHON]
 
 Cases are made by a structured generator: every shipped scenario with one
 field (any it has or could have) set to an edge value of every TOML type,
@@ -25,6 +26,11 @@ fuzz_recordings.py): a grid run's, an e-puck run's and a calibration's
 recording cut short at seeded offsets, with bits flipped, doubled, followed
 by garbage, reduced to its header or zeroed, each read by `errp inspect
 --csv`, which must exit 0 or 2 (naming the file) and leave nothing on 2.
+
+A family of Python calls (`python_cases`, 215, in fuzz_python.py): the
+package's public calls, each given a bad value for one argument in a
+process of its own (`--python`, the interpreter with the package), which
+must succeed or raise TypeError, ValueError or OSError naming the argument.
 
 A second family (`hostile_cases`, about 200) changes the program's
 surroundings instead of its input: standard output or error closed early
@@ -52,6 +58,7 @@ import tomllib
 from pathlib import Path
 
 from fuzz_hostile import build_base, hostile_cases, run_case, signal_cases
+from fuzz_python import python_cases, run_python_case
 from fuzz_recordings import make_bases, recording_cases, run_damage
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -246,7 +253,9 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--memory-gib", type=int, default=4)
     ap.add_argument("--list", action="store_true")
-    ap.add_argument("--only", choices=["input", "hostile", "signal", "recordings"],
+    ap.add_argument("--python", default=sys.executable,
+                    help="the Python with the errp package, for the python family")
+    ap.add_argument("--only", choices=["input", "hostile", "signal", "recordings", "python"],
                     help="run one family of cases")
     a = ap.parse_args()
     errp = str(Path(a.errp).resolve())
@@ -260,6 +269,7 @@ def main():
         bases = make_bases(errp, base_dir)
         sizes = {kind: len(b) for kind, b in bases.items()}
         cases += [("recordings", c.label, None, c) for c in recording_cases(a.seed, sizes)]
+    cases += [("python", c.label, None, c) for c in python_cases()]
     random.Random(a.seed).shuffle(cases)
     if a.list:
         for kind, label, _, args in cases:
@@ -278,6 +288,9 @@ def main():
             break
         if kind == "input":
             code, failure = check(errp, label, text, args, a.memory_gib, grid_file, epuck_file)
+        elif kind == "python":
+            failure, code = run_python_case(os.path.abspath(a.python), args, a.memory_gib,
+                                            limit_memory)
         elif kind == "recordings":
             failure, code = run_damage(errp, bases, args, a.memory_gib, limit_memory)
         else:
