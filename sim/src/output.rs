@@ -156,6 +156,18 @@ fn partial_name(name: &std::ffi::OsStr, host: &str, random: u64) -> String {
     format!(".{}{tail}", &name[..cut])
 }
 
+/// A temporary's name `.NAME.partial-HOST-PID-RANDOM` as (`.NAME`, HOST,
+/// PID); `None` for any other name. The host may hold dashes itself.
+fn parse_partial(name: &str) -> Option<(&str, &str, u32)> {
+    let (prefix, rest) = name
+        .starts_with('.')
+        .then(|| name.split_once(".partial-"))??;
+    let mut parts = rest.rsplitn(3, '-');
+    let (random, pid, owner) = (parts.next()?, parts.next()?, parts.next()?);
+    let random_ok = random.len() == 16 && random.bytes().all(|b| b.is_ascii_hexdigit());
+    Some((prefix, owner, pid.parse().ok().filter(|_| random_ok)?))
+}
+
 /// Removes the temporaries in `dest`'s directory (of any file) left by
 /// processes of this host that are gone (killed, or out of memory). Those
 /// of other hosts, whose processes cannot be seen from here, and of live
@@ -171,21 +183,7 @@ fn remove_stale_partials(dest: &Path) {
     let host = host_name();
     for entry in entries.flatten().take(100_000) {
         let file = entry.file_name();
-        let Some(rest) = file
-            .to_str()
-            .filter(|f| f.starts_with('.'))
-            .and_then(|f| f.split_once(".partial-"))
-            .map(|(_, rest)| rest)
-        else {
-            continue;
-        };
-        // HOST-PID-RANDOM, the host possibly holding dashes itself.
-        let mut parts = rest.rsplitn(3, '-');
-        let (random, pid, owner) = (parts.next(), parts.next(), parts.next());
-        let random_ok =
-            random.is_some_and(|r| r.len() == 16 && r.bytes().all(|b| b.is_ascii_hexdigit()));
-        if let (true, Some(pid), Some(owner)) =
-            (random_ok, pid.and_then(|p| p.parse::<u32>().ok()), owner)
+        if let Some((_, owner, pid)) = file.to_str().and_then(parse_partial)
             && owner == host
             && process_gone(pid, None)
         {
@@ -211,18 +209,9 @@ fn other_writer(temp: &Path, host: &str) -> Option<u32> {
         .take(100_000)
         .find_map(|entry| {
             let file = entry.file_name();
-            let name = file.to_str()?;
-            if name == ours {
-                return None;
-            }
-            let (p, rest) = name.split_once(".partial-")?;
-            if p != prefix {
-                return None;
-            }
-            let mut parts = rest.rsplitn(3, '-');
-            let (_, pid, owner) = (parts.next()?, parts.next()?, parts.next()?);
-            let pid = pid.parse::<u32>().ok()?;
-            (owner == host && !process_gone(pid, None)).then_some(pid)
+            let name = file.to_str().filter(|&n| n != ours)?;
+            let (p, owner, pid) = parse_partial(name)?;
+            (p == prefix && owner == host && !process_gone(pid, None)).then_some(pid)
         })
 }
 

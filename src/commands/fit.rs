@@ -570,6 +570,14 @@ fn print_grid_fit(fit: &GridFit) -> Result<()> {
     Ok(())
 }
 
+/// Per-subject z values in one column each (`+2.1 -0.4 ...`).
+fn z_row(z: &[f64]) -> String {
+    z.iter()
+        .map(|v| format!("{v:+5.1}"))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
 /// The single-trial latency SD, profiled over the rest.
 fn print_trial_latency_fit(t: &errp_sweep::fit::TrialLatencyFit) -> Result<()> {
     let num = errp_sim::task::format_number;
@@ -581,12 +589,6 @@ fn print_trial_latency_fit(t: &errp_sweep::fit::TrialLatencyFit) -> Result<()> {
         " SD ms  log L (profile)  40/40 log L  length  reward  P(all 40)  fixed z S1..S4        \
          free z S1..S4 (held out)"
     )?;
-    let zs = |z: &[f64]| -> String {
-        z.iter()
-            .map(|v| format!("{v:+5.1}"))
-            .collect::<Vec<_>>()
-            .join(" ")
-    };
     for k in 0..t.sds.len() {
         let (length, reward) = t.point[k];
         outln!(
@@ -598,8 +600,8 @@ fn print_trial_latency_fit(t: &errp_sweep::fit::TrialLatencyFit) -> Result<()> {
             length.map_or("-".to_string(), |l| l.to_string()),
             num(reward),
             t.p_all_reached[k],
-            zs(&t.fixed_z[k]),
-            zs(&t.free_z[k])
+            z_row(&t.fixed_z[k]),
+            z_row(&t.free_z[k])
         )?;
     }
     outln!(
@@ -625,12 +627,6 @@ fn print_pairs_fit(p: &errp_sweep::fit::PairsFit) -> Result<()> {
         "length  best reward  log L (profile)  P(all 40)  40/40 reward (log L)  fixed z S1..S4 \
          at best            free z S1..S4 (held out)"
     )?;
-    let zs = |z: &[f64]| -> String {
-        z.iter()
-            .map(|v| format!("{v:+5.1}"))
-            .collect::<Vec<_>>()
-            .join(" ")
-    };
     for k in 0..p.lengths.len() {
         let reached = p.reached[k].map_or("none".to_string(), |(g, l)| {
             format!("{} ({:.2})", num(g), l)
@@ -643,8 +639,8 @@ fn print_pairs_fit(p: &errp_sweep::fit::PairsFit) -> Result<()> {
             p.profile[k],
             p.p_all_reached[k],
             reached,
-            zs(&p.fixed_z[k]),
-            zs(&p.free_z[k])
+            z_row(&p.fixed_z[k]),
+            z_row(&p.free_z[k])
         )?;
     }
     let (lo, hi) = p.interval_95;

@@ -417,6 +417,17 @@ fn the_shipped_grid_q_scale_is_the_committed_fit() {
     );
 }
 
+/// Runs the grid fit of `spec` into `out` to its end.
+fn complete_grid_fit(spec: &GridFitSpec, out: &std::path::Path) -> Box<errp_sweep::fit::GridFit> {
+    let cancel = AtomicBool::new(false);
+    let GridFitOutcome::Complete(fit, _) =
+        run_grid_fit(spec, out, &cache(), provenance(), &cancel, &()).unwrap()
+    else {
+        panic!("not interrupted")
+    };
+    fit
+}
+
 /// A grid fit small enough for a test: two goal rewards, one calibration
 /// per subject and goal set, two groups, the shipped pairs.
 fn small_grid_spec() -> GridFitSpec {
@@ -543,12 +554,7 @@ fn a_grid_fit_over_pair_lengths_profiles_each_length() {
         pair_lengths: vec![8, 28],
         ..small_grid_spec()
     };
-    let cancel = AtomicBool::new(false);
-    let GridFitOutcome::Complete(fit, _) =
-        run_grid_fit(&spec, &out, &cache(), provenance(), &cancel, &()).unwrap()
-    else {
-        panic!("not interrupted")
-    };
+    let fit = complete_grid_fit(&spec, &out);
     let pairs = fit.pairs.as_ref().expect("fitted over lengths");
     assert_eq!(pairs.lengths, vec![8, 28]);
     assert!(pairs.profile.iter().all(|l| !l.is_nan()), "{pairs:?}");
@@ -581,12 +587,7 @@ fn a_grid_fit_over_trial_latency_sds_runs_each_users() {
         trial_latency_sds: vec![5.0, 60.0],
         ..small_grid_spec()
     };
-    let cancel = AtomicBool::new(false);
-    let GridFitOutcome::Complete(fit, _) =
-        run_grid_fit(&spec, &out, &cache(), provenance(), &cancel, &()).unwrap()
-    else {
-        panic!("not interrupted")
-    };
+    let fit = complete_grid_fit(&spec, &out);
     let trial = fit.trial_latency.as_ref().expect("fitted over SDs");
     assert_eq!(trial.sds, vec![5.0, 60.0]);
     assert!(trial.profile.iter().all(|l| !l.is_nan()), "{trial:?}");
