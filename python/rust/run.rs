@@ -315,7 +315,7 @@ fn run_grid(
     })?;
     let mut lines = vec![header(&GridTask::INFO)];
     for (k, r) in episodes.iter().enumerate() {
-        let seed = derive_seed(s.seed, "grid/episode", k as u64);
+        let seed = errp_sim::grid::grid_episode_seed(s.seed, k);
         lines.push(line(s.accuracy, k, seed, grid_row(r)));
     }
     let info = grid_summary(s, calibration.as_ref());

@@ -161,7 +161,7 @@ impl GridTask {
         let meter = Meter::default();
         let n = s.episodes.len();
         let mut push = |k: usize, r: &errp_sim::grid::GridEpisodeResult| {
-            let seed = derive_seed(s.seed, "grid/episode", k as u64);
+            let seed = errp_sim::grid::grid_episode_seed(s.seed, k);
             lines.push(line(s.accuracy, k, seed, grid_row(r)));
             meter.set(EPISODES, k + 1, n);
         };

@@ -8,14 +8,12 @@ use std::sync::Arc;
 use errp_bci::{EegBlock, rng::stream};
 use errp_robot::{Cell, Grid, GridAction};
 use rand::Rng;
-use rand_chacha::ChaCha8Rng;
 
 use crate::error::{Result, SimError};
 use crate::grid::decoder::AssessmentDecoder;
-use crate::grid::episode::{
-    ActionDecoder, Decoded, GridDecoding, GridEpisodeResult, GridStep, GridTally,
-};
+use crate::grid::episode::{GridDecoding, GridEpisodeResult};
 use crate::grid::params::GridTaskParams;
+use crate::grid::plant::GridPlant;
 
 /// What one action gave the agent.
 #[derive(Debug, Clone, PartialEq)]
@@ -38,27 +36,21 @@ pub struct GridFeedback {
     pub epoch: Option<EegBlock>,
 }
 
-/// One episode of the grid with the actions chosen from outside.
+/// One episode of the grid with the actions chosen from outside: the
+/// [`GridPlant`] the episode's shared control drives, driven by an agent.
 pub struct GridEnvironment {
     decoder: Arc<AssessmentDecoder>,
-    actions_decoder: ActionDecoder,
+    plant: GridPlant,
     params: GridTaskParams,
-    grid: Grid,
-    cell: Cell,
-    goal: Cell,
-    rng_user: ChaCha8Rng,
-    tally: GridTally,
-    total_secs: f64,
     committed: Option<Cell>,
     ended: bool,
-    /// Every action, kept for a recording ([`GridEnvironment::keep_steps`]).
-    steps: Option<Vec<GridStep>>,
 }
 
 impl GridEnvironment {
     /// An episode from `start` (or a random cell) towards the user's `goal`
     /// (or a random cell), everything random from `seed`: the same seed and
-    /// actions give the same feedback.
+    /// actions give the same feedback, and with the start and goal given,
+    /// the same as the episode of that seed ([`crate::grid::run_grid_episode`]).
     pub fn new(
         decoder: Arc<AssessmentDecoder>,
         params: GridTaskParams,
@@ -85,62 +77,58 @@ impl GridEnvironment {
         };
         let goal = draw(goal, "goal")?;
         let start = draw(start, "start")?;
-        let actions_decoder = ActionDecoder::start(&GridDecoding::Builtin(&decoder), seed)?;
+        let plant = GridPlant::new(grid, start, goal, &GridDecoding::Builtin(&decoder), seed)?;
         Ok(Self {
             decoder,
-            actions_decoder,
+            plant,
             params,
-            grid,
-            cell: start,
-            goal,
-            rng_user: stream(seed, "grid/user"),
-            tally: GridTally::new(&grid, start),
-            total_secs: 0.0,
             committed: None,
             ended: false,
-            steps: None,
         })
     }
 
     /// The cursor.
     pub fn cell(&self) -> Cell {
-        self.cell
+        self.plant.cell()
     }
 
     /// The user's goal.
     pub fn goal(&self) -> Cell {
-        self.goal
+        self.plant.goal()
     }
 
     /// Actions taken so far.
     pub fn actions(&self) -> usize {
-        self.tally.actions()
+        self.plant.actions()
     }
 
     /// Keeps every action from now on, for [`GridEnvironment::result`].
     pub fn keep_steps(&mut self) {
-        self.steps.get_or_insert_with(Vec::new);
+        self.plant.keep_steps();
     }
 
-    /// True once the agent said "goal reached".
+    /// True once the agent said "goal reached" or committed to a goal.
     pub fn ended(&self) -> bool {
         self.ended
     }
 
+    /// Ends the episode on `goal`, in place of any "goal reached" before:
+    /// the decision of an agent that commits to a goal of its belief, as
+    /// the shared control does when its belief converges (its "goal
+    /// reached" actions are actions like the others, which the user
+    /// judges).
+    pub fn commit(&mut self, goal: Cell) {
+        self.ended = true;
+        self.committed = Some(goal);
+    }
+
     /// The episode so far as the task scores one: the cell where the agent
-    /// said "goal reached" is the committed goal, the time is the sum of
-    /// the inter-action intervals, and the steps (kept since
-    /// [`GridEnvironment::keep_steps`]) hold no belief (NaN): the agent's
-    /// is its own.
+    /// said "goal reached" (or the goal it committed to) is the committed
+    /// goal, the time is the sum of the inter-action intervals, and the
+    /// steps (kept since [`GridEnvironment::keep_steps`]) hold no belief
+    /// (NaN): the agent's is its own.
     pub fn result(&self) -> GridEpisodeResult {
-        let steps = self.steps.clone().unwrap_or_default();
-        self.tally.clone().result(
-            self.goal,
-            self.committed,
-            self.params.epoch_secs,
-            self.total_secs,
-            steps,
-        )
+        self.plant.result(self.committed, self.params.epoch_secs)
     }
 
     /// True if the decoder streams EEG, so that epochs can be returned.
@@ -161,52 +149,28 @@ impl GridEnvironment {
                     .into(),
             ));
         }
-        let error = !self.grid.is_correct(self.cell, action, self.goal);
-        let interval = self
-            .rng_user
-            .random_range(self.params.interval_min_secs..=self.params.interval_max_secs);
-        let Decoded {
-            p_error,
-            says_error,
-            epoch,
-            ..
-        } = self.actions_decoder.decode(
+        let goal = self.plant.goal();
+        let mut judged = self.plant.act(
             &mut GridDecoding::Builtin(&self.decoder),
-            error,
-            interval,
+            action,
+            &self.params,
             false,
             keep_epoch,
         )?;
-        let reached = action == GridAction::GoalReached && self.cell == self.goal;
-        let from = self.cell;
-        self.cell = self.grid.step(self.cell, action);
-        self.tally.action(&self.grid, self.cell, error, says_error);
-        if let Some(steps) = self.steps.as_mut() {
-            steps.push(GridStep {
-                onset_secs: self.total_secs,
-                from,
-                action,
-                to: self.cell,
-                error,
-                p_error,
-                decoded_error: says_error,
-                belief: vec![f64::NAN; self.grid.n_cells()],
-                fcz: Vec::new(),
-            });
-        }
-        self.total_secs += interval;
+        let n_cells = self.plant.grid().n_cells();
+        self.plant.keep(&mut judged, || vec![f64::NAN; n_cells]);
         if action == GridAction::GoalReached && !self.ended {
             self.ended = true;
-            self.committed = Some(from);
+            self.committed = Some(judged.from);
         }
         Ok(GridFeedback {
-            cell: self.cell,
-            p_error,
-            decoded_error: says_error,
-            error,
-            reached,
-            interval_secs: interval,
-            epoch,
+            cell: judged.to,
+            p_error: judged.decoded.p_error,
+            decoded_error: judged.decoded.says_error,
+            error: judged.error,
+            reached: action == GridAction::GoalReached && judged.from == goal,
+            interval_secs: judged.interval_secs,
+            epoch: judged.decoded.epoch,
         })
     }
 }

@@ -6,6 +6,7 @@ pub(crate) mod environment;
 pub(crate) mod episode;
 pub(crate) mod pairs;
 pub(crate) mod params;
+pub(crate) mod plant;
 pub(crate) mod report;
 pub(crate) mod run;
 pub(crate) mod scenario;
@@ -28,6 +29,7 @@ pub use pairs::{
     total_length,
 };
 pub use params::GridTaskParams;
+pub use plant::grid_episode_seed;
 pub use report::{GridEpisodeHeader, GridEpisodeRow, Table1Report};
 pub use run::{
     GridRunReport, GridShared, HELD_OUT_PER_CLASS, PreparedGrid, eeg_decoder, pooled_accuracy,

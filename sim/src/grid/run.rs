@@ -435,7 +435,7 @@ pub fn run_grid_scenario_with(
     let mut out = Vec::with_capacity(scenario.episodes.len());
     for (k, &(start, goal)) in scenario.episodes.iter().enumerate() {
         errp_bci::stop::check()?;
-        let seed = derive_seed(scenario.seed, "grid/episode", k as u64);
+        let seed = crate::grid::grid_episode_seed(scenario.seed, k);
         let r = run_grid_episode_with(
             start,
             goal,

@@ -76,7 +76,7 @@ pub fn record_grid_run(
     let s = &report.scenario;
     let mut recorder = GridRecorder::new(file)?;
     for (k, ep) in report.episodes.iter().enumerate() {
-        let seed = errp_bci::rng::derive_seed(s.seed, "grid/episode", k as u64);
+        let seed = crate::grid::grid_episode_seed(s.seed, k);
         recorder.episode(seed, s.params.epoch_secs, ep)?;
     }
     recorder.finish(provenance)

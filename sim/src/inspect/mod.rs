@@ -11,7 +11,7 @@ use errp_robot::{Cell, Grid, GridAction, Pose};
 use crate::epuck::episode::Score;
 use crate::epuck::plant::step_motion;
 use crate::epuck::{EpuckEpisodeResult, EpuckScenario};
-use crate::grid::episode::GridTally;
+use crate::grid::plant::GridTally;
 use crate::grid::{GridEpisodeResult, GridScenario, GridStep};
 use crate::record::data::{Column, Provenance};
 use crate::record::paths;

@@ -6,6 +6,7 @@
 use std::sync::Arc;
 
 use errp_bci::{EegBlock, EpochWindow, ErrorModel};
+use errp_robot::GridController;
 use errp_robot::{Cell, Grid, GridAction, StepKind};
 use errp_sim::epuck::{
     EpuckAction, EpuckEnvironment, EpuckObserver, PhysicsFrame, WindowFrame,
@@ -230,6 +231,62 @@ fn a_window_decoder_reads_the_windows_the_svm_reads() {
         .unwrap();
     assert!(on_start.ended());
     assert_eq!(seen.end, Some((0.125, Some(start_city(&s)))));
+}
+
+/// A grid episode is the environment driven by the shared control: the
+/// same actions, EEG, p(error) and scoring, bit for bit, whatever the
+/// decoder (oracle, streamed EEG, an epoch bank). The two share one
+/// [`GridPlant`](errp_sim::grid); this holds the episode's own parts (the
+/// controller's use of each p(error), its convergence) to it.
+#[test]
+fn a_grid_episode_is_the_environment_driven_by_the_shared_control() {
+    let params = GridTaskParams::default();
+    let t = grid::table(&params);
+    let streamed = sigmoid_decoder();
+    let AssessmentDecoder::Eeg(eeg) = grid::eeg_decoder(0.75, 5) else {
+        unreachable!("eeg_decoder streams")
+    };
+    let bank = errp_sim::grid::EpochBank::build(*eeg, &params, 100, 7).unwrap();
+    let banked = AssessmentDecoder::EegBank(Box::new(bank));
+    let decoders = [
+        AssessmentDecoder::Oracle { accuracy: 0.7 },
+        streamed,
+        banked,
+    ];
+    let pairs = [
+        (Cell::new(0, 0), Cell::new(4, 4)),
+        (Cell::new(2, 1), Cell::new(2, 3)),
+    ];
+    let mut episodes = 0;
+    for decoder in decoders {
+        let decoder = Arc::new(decoder);
+        for (k, &(start, goal)) in pairs.iter().enumerate() {
+            let seed = errp_sim::grid::grid_episode_seed(21, k);
+            let want = run_grid_episode(start, goal, &t, &params, &decoder, seed, false).unwrap();
+            let mut env =
+                GridEnvironment::new(decoder.clone(), params, Some(start), Some(goal), seed)
+                    .unwrap();
+            let mut controller = GridController::with_table(t.clone(), params.control);
+            let mut rng_policy = errp_bci::rng::stream(seed, "grid/policy");
+            for _ in 0..params.max_actions {
+                let from = env.cell();
+                let action = controller.choose(from, &mut rng_policy);
+                let fb = env.step(action, false).unwrap();
+                controller.observe(from, action, fb.p_error).unwrap();
+                if let Some(found) = controller.converged() {
+                    env.commit(found);
+                    break;
+                }
+            }
+            assert!(
+                want.actions >= 3,
+                "the episode exercises the loop: {want:?}"
+            );
+            assert_eq!(format!("{:?}", env.result()), format!("{want:?}"));
+            episodes += usize::from(want.committed.is_some());
+        }
+    }
+    assert!(episodes >= 4, "most episodes converge: {episodes} of 6");
 }
 
 /// An episode of the shared control is the environment driven by the

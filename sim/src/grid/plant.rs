@@ -1,0 +1,377 @@
+//! The grid's one closed loop below the decision maker: the user judges
+//! an action against the goal, waits the inter-action interval, the EEG of
+//! that judgement is decoded, the cursor moves and the action is scored.
+//! The episode ([`crate::grid::run_grid_episode_with`], the shared control
+//! choosing) and the environment ([`crate::grid::GridEnvironment`], an
+//! agent choosing) both drive a [`GridPlant`], so that an environment
+//! driven by the shared control is the episode, bit for bit
+//! (`sim/tests/it/grid_identity.rs`).
+
+use errp_bci::{Accuracy, Components, EegBlock, rng::derive_seed, rng::stream};
+use errp_robot::{Cell, Grid, GridAction};
+use rand::Rng;
+use rand_chacha::ChaCha8Rng;
+
+use crate::error::{Result, SimError, check_p_error};
+use crate::grid::decoder::{AssessmentDecoder, OnlineEeg, decide, oracle_report};
+use crate::grid::episode::{GridDecoding, GridEpisodeResult, GridStep};
+use crate::grid::params::GridTaskParams;
+
+/// The seed of episode `k` of a grid scenario with base seed `seed`.
+pub fn grid_episode_seed(seed: u64, k: usize) -> u64 {
+    derive_seed(seed, "grid/episode", k as u64)
+}
+
+/// One episode's world: the cursor, the user's goal and clock, the decoder
+/// of the user's EEG, and the tally that scores the episode.
+pub(crate) struct GridPlant {
+    grid: Grid,
+    cell: Cell,
+    goal: Cell,
+    rng_user: ChaCha8Rng,
+    decoder: ActionDecoder,
+    tally: GridTally,
+    total_secs: f64,
+    /// Every action, when kept.
+    steps: Option<Vec<GridStep>>,
+}
+
+/// One action as the plant took it.
+pub(crate) struct Judged {
+    /// The cursor before the action.
+    pub(crate) from: Cell,
+    /// The action.
+    pub(crate) action: GridAction,
+    /// The cursor after it.
+    pub(crate) to: Cell,
+    /// The user's verdict: true if the action was an error.
+    pub(crate) error: bool,
+    /// The action's onset (s since the episode started).
+    pub(crate) onset_secs: f64,
+    /// The inter-action interval that followed it (s).
+    pub(crate) interval_secs: f64,
+    /// What the decoder made of the user's EEG.
+    pub(crate) decoded: Decoded,
+}
+
+impl GridPlant {
+    /// An episode on `grid` from `start` towards the user's `goal` (both on
+    /// the grid: the callers check them), decoded by `decoding`, every
+    /// random draw from `seed`.
+    pub(crate) fn new(
+        grid: Grid,
+        start: Cell,
+        goal: Cell,
+        decoding: &GridDecoding<'_>,
+        seed: u64,
+    ) -> Result<Self> {
+        Ok(Self {
+            grid,
+            cell: start,
+            goal,
+            rng_user: stream(seed, "grid/user"),
+            decoder: ActionDecoder::start(decoding, seed)?,
+            tally: GridTally::new(&grid, start),
+            total_secs: 0.0,
+            steps: None,
+        })
+    }
+
+    /// The grid.
+    pub(crate) fn grid(&self) -> &Grid {
+        &self.grid
+    }
+
+    /// The cursor.
+    pub(crate) fn cell(&self) -> Cell {
+        self.cell
+    }
+
+    /// The user's goal.
+    pub(crate) fn goal(&self) -> Cell {
+        self.goal
+    }
+
+    /// Actions so far.
+    pub(crate) fn actions(&self) -> usize {
+        self.tally.actions()
+    }
+
+    /// Keeps every action from now on (see [`GridPlant::keep`]).
+    pub(crate) fn keep_steps(&mut self) {
+        self.steps.get_or_insert_with(Vec::new);
+    }
+
+    /// Takes `action`: the user judges it against the goal (an error when
+    /// it does not bring the cursor closer, or says "goal reached" off the
+    /// goal), the interval to the next action is drawn, the EEG of the
+    /// judgement is decoded with `decoding` (the one the plant started
+    /// with; `keep_fcz` returns the FCz trace, `keep_epoch` the
+    /// preprocessed epoch), the cursor moves (a move against a border
+    /// leaves it in place) and the action is scored.
+    pub(crate) fn act(
+        &mut self,
+        decoding: &mut GridDecoding<'_>,
+        action: GridAction,
+        params: &GridTaskParams,
+        keep_fcz: bool,
+        keep_epoch: bool,
+    ) -> Result<Judged> {
+        let from = self.cell;
+        let error = !self.grid.is_correct(from, action, self.goal);
+        let interval_secs = self
+            .rng_user
+            .random_range(params.interval_min_secs..=params.interval_max_secs);
+        let decoded = self
+            .decoder
+            .decode(decoding, error, interval_secs, keep_fcz, keep_epoch)?;
+        let to = self.grid.step(from, action);
+        self.cell = to;
+        self.tally.action(&self.grid, to, error, decoded.says_error);
+        let onset_secs = self.total_secs;
+        self.total_secs += interval_secs;
+        Ok(Judged {
+            from,
+            action,
+            to,
+            error,
+            onset_secs,
+            interval_secs,
+            decoded,
+        })
+    }
+
+    /// Keeps `judged` (the last action) with the decision maker's
+    /// `belief` over the goals after it, when steps are kept; its FCz
+    /// trace moves into the step.
+    pub(crate) fn keep(&mut self, judged: &mut Judged, belief: impl FnOnce() -> Vec<f64>) {
+        if let Some(steps) = self.steps.as_mut() {
+            steps.push(GridStep {
+                onset_secs: judged.onset_secs,
+                from: judged.from,
+                action: judged.action,
+                to: judged.to,
+                error: judged.error,
+                p_error: judged.decoded.p_error,
+                decoded_error: judged.decoded.says_error,
+                belief: belief(),
+                fcz: std::mem::take(&mut judged.decoded.fcz),
+            });
+        }
+    }
+
+    /// The episode so far as the task scores one, ended `committed` (or
+    /// not), with `epoch_secs` of EEG per action.
+    pub(crate) fn result(&self, committed: Option<Cell>, epoch_secs: f64) -> GridEpisodeResult {
+        self.tally.clone().result(
+            self.goal,
+            committed,
+            epoch_secs,
+            self.total_secs,
+            self.steps.clone().unwrap_or_default(),
+        )
+    }
+
+    /// [`GridPlant::result`], the plant spent.
+    pub(crate) fn into_result(self, committed: Option<Cell>, epoch_secs: f64) -> GridEpisodeResult {
+        self.tally.result(
+            self.goal,
+            committed,
+            epoch_secs,
+            self.total_secs,
+            self.steps.unwrap_or_default(),
+        )
+    }
+}
+
+/// What a grid episode counts as it goes, the one scoring of the episode,
+/// the environment an agent steps and `errp inspect`: the cells visited
+/// and, per action, the user's verdict and the decoder's.
+#[derive(Debug, Clone)]
+pub(crate) struct GridTally {
+    start: Cell,
+    visits: Vec<u32>,
+    labels: Vec<bool>,
+    decoded: Vec<bool>,
+}
+
+impl GridTally {
+    /// An episode starting on `start` of `grid`.
+    pub(crate) fn new(grid: &Grid, start: Cell) -> Self {
+        let mut visits = vec![0u32; grid.n_cells()];
+        visits[grid.index(start)] += 1;
+        Self {
+            start,
+            visits,
+            labels: Vec::new(),
+            decoded: Vec::new(),
+        }
+    }
+
+    /// An action that moved the cursor `to`, an error to the user
+    /// (`error`), decoded as one (`decoded`) or not.
+    pub(crate) fn action(&mut self, grid: &Grid, to: Cell, error: bool, decoded: bool) {
+        self.visits[grid.index(to)] += 1;
+        self.labels.push(error);
+        self.decoded.push(decoded);
+    }
+
+    /// Actions so far.
+    pub(crate) fn actions(&self) -> usize {
+        self.labels.len()
+    }
+
+    /// The result of the episode towards `goal` that ended `committed` (or
+    /// not) after `total_secs`, with `epoch_secs` of EEG per action and the
+    /// `steps` kept.
+    pub(crate) fn result(
+        self,
+        goal: Cell,
+        committed: Option<Cell>,
+        epoch_secs: f64,
+        total_secs: f64,
+        steps: Vec<GridStep>,
+    ) -> GridEpisodeResult {
+        let actions = self.actions();
+        GridEpisodeResult {
+            start: self.start,
+            goal,
+            committed,
+            actions,
+            net_secs: actions as f64 * epoch_secs,
+            total_secs,
+            online: Accuracy::score(&self.labels, &self.decoded),
+            visits: self.visits,
+            steps,
+        }
+    }
+}
+
+/// What a decoded action gives: p(error), the decoder's class, the FCz
+/// trace (when asked) and the preprocessed epoch (when asked, and the EEG
+/// is streamed).
+pub(crate) struct Decoded {
+    pub(crate) p_error: f64,
+    pub(crate) says_error: bool,
+    pub(crate) fcz: Vec<f64>,
+    pub(crate) epoch: Option<EegBlock>,
+}
+
+/// A [`GridDecoding`] with its EEG stream and random draws, decoding one
+/// action after another.
+pub(crate) struct ActionDecoder {
+    online: Option<OnlineEeg>,
+    rng_oracle: ChaCha8Rng,
+    rng_bank: ChaCha8Rng,
+}
+
+impl ActionDecoder {
+    /// Checks `decoding` and starts its EEG stream (if it streams), with
+    /// every random draw from `seed`.
+    pub(crate) fn start(decoding: &GridDecoding<'_>, seed: u64) -> Result<Self> {
+        if let GridDecoding::Scores { error, correct } = decoding {
+            if error.is_empty() || correct.is_empty() {
+                return Err(SimError::Scenario(
+                    "decoder: the bank needs at least one scored epoch of each class".into(),
+                ));
+            }
+            for &p in error.iter().chain(correct.iter()) {
+                check_p_error(p)?;
+            }
+        }
+        let source = match decoding {
+            GridDecoding::Builtin(AssessmentDecoder::Eeg(d)) => Some(d.source()),
+            GridDecoding::Epochs { source, .. } => Some(*source),
+            _ => None,
+        };
+        let online = match source {
+            Some(source) => Some(OnlineEeg::start(
+                source,
+                derive_seed(seed, "grid/eeg", 0),
+                Components::default(),
+            )?),
+            None => None,
+        };
+        Ok(Self {
+            online,
+            rng_oracle: stream(seed, "grid/oracle"),
+            rng_bank: stream(seed, "grid/bank/draw"),
+        })
+    }
+
+    /// Decodes with `decoding` (the one it started with) an action the
+    /// user judged erroneous (`error`) or correct, streaming `interval` s of
+    /// EEG when the EEG is streamed.
+    pub(crate) fn decode(
+        &mut self,
+        decoding: &mut GridDecoding<'_>,
+        error: bool,
+        interval: f64,
+        record_steps: bool,
+        keep_epoch: bool,
+    ) -> Result<Decoded> {
+        let mut epoch = None;
+        let (p_error, says_error, fcz) = match (decoding, self.online.as_mut()) {
+            (GridDecoding::Builtin(AssessmentDecoder::Oracle { accuracy }), _) => {
+                let (p, says_error) = oracle_report(*accuracy, error, &mut self.rng_oracle);
+                (p, says_error, Vec::new())
+            }
+            (GridDecoding::Builtin(AssessmentDecoder::Eeg(d)), Some(eeg)) if keep_epoch => {
+                let (block, fcz) = eeg.epoch_block(error, interval);
+                let (p, says) = decide(d, &eeg.features(&block));
+                epoch = Some(block);
+                (p, says, if record_steps { fcz } else { Vec::new() })
+            }
+            (GridDecoding::Builtin(AssessmentDecoder::Eeg(d)), Some(eeg)) => {
+                let (x, fcz) = eeg.epoch(error, interval, record_steps);
+                let (p, says) = decide(d, &x);
+                (p, says, fcz)
+            }
+            (GridDecoding::Epochs { decode, .. }, Some(eeg)) => {
+                let (block, fcz) = eeg.epoch_block(error, interval);
+                let p = check_p_error(decode(&block)?)?;
+                if keep_epoch {
+                    epoch = Some(block);
+                }
+                (p, p >= 0.5, if record_steps { fcz } else { Vec::new() })
+            }
+            (
+                GridDecoding::Builtin(AssessmentDecoder::Eeg(_)) | GridDecoding::Epochs { .. },
+                None,
+            ) => {
+                unreachable!("EEG decoder without a stream")
+            }
+            (
+                GridDecoding::Scores {
+                    error: e,
+                    correct: c,
+                },
+                _,
+            ) => {
+                let pool = if error { e } else { c };
+                let p = pool[self.rng_bank.random_range(0..pool.len())];
+                (p, p >= 0.5, Vec::new())
+            }
+            (GridDecoding::Builtin(AssessmentDecoder::EegBank(bank)), _) => {
+                let pool = if error { &bank.error } else { &bank.correct };
+                let (x, fcz) = &pool[self.rng_bank.random_range(0..pool.len())];
+                let (p, says) = decide(&bank.decoder, x);
+                (
+                    p,
+                    says,
+                    if record_steps {
+                        fcz.clone()
+                    } else {
+                        Vec::new()
+                    },
+                )
+            }
+        };
+        Ok(Decoded {
+            p_error,
+            says_error,
+            fcz,
+            epoch,
+        })
+    }
+}
