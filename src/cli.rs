@@ -5,10 +5,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
 use clap::ValueEnum;
-use errp_bci::{MeanAccuracy, RequestedAccuracy, TargetingStep};
+use errp_bci::{MeanAccuracy, RequestedAccuracy};
 use errp_sim::grid::EegMode;
-
-use crate::out::errln;
 
 #[derive(Clone, Copy, ValueEnum)]
 pub(crate) enum Goals {
@@ -191,19 +189,6 @@ pub(crate) fn check_extension(path: &Path, ext: &str, flag: &str) -> Result<()> 
         );
     }
     Ok(())
-}
-
-/// Prints each accuracy-targeting step to stderr, unless `quiet`.
-pub(crate) fn calibration_progress(quiet: bool) -> impl FnMut(&TargetingStep) {
-    move |s| {
-        if !quiet {
-            errln!(
-                "  calibrating: ErrP-to-noise {:.4} -> mean {:.2} %",
-                s.ratio,
-                100.0 * s.accuracy.mean()
-            );
-        }
-    }
 }
 
 /// Arguments of `errp inspect`.

@@ -2,12 +2,12 @@
 //! overrides, EEG blocks as numpy arrays, and a decoder of the caller's own
 //! called from inside the Rust loop.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use errp_bci::{EegBlock, Montage};
+use errp_bci::{EegBlock, Montage, RequestedAccuracy};
 use errp_sim::epuck::EpuckScenario;
 use errp_sim::grid::GridScenario;
-use errp_sim::{AnyScenario, SimError};
+use errp_sim::{AnyScenario, LoadedScenario, ScenarioInput, ScenarioSource, SetterNames, SimError};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::exceptions::{PyFileNotFoundError, PyKeyboardInterrupt, PyOSError, PyValueError};
@@ -48,90 +48,14 @@ pub(crate) fn value_error(field: &str, value: impl std::fmt::Display, expected: 
     PyValueError::new_err(format!("{field} = {value} is invalid: expected {expected}"))
 }
 
-/// The scenario keyword: a path to a TOML file, or `None` for the built-in
-/// scenario of the task (`grid_fixed_goals.toml`, `mexico_to_pisa.toml`).
-pub(crate) enum ScenarioSource {
-    /// A file.
-    File(PathBuf),
-    /// Built-in text, named by the path it has in the repository.
-    BuiltIn(&'static str, &'static str),
-}
-
-impl ScenarioSource {
-    /// `scenario` as given, or the built-in of `default_epuck`'s task.
-    pub(crate) fn new(scenario: Option<PathBuf>, default_epuck: bool) -> Self {
-        match scenario {
-            Some(p) => ScenarioSource::File(p),
-            None if default_epuck => {
-                ScenarioSource::BuiltIn(errp_sweep::BUILT_IN_EPUCK, "scenarios/mexico_to_pisa.toml")
-            }
-            None => ScenarioSource::BuiltIn(
-                errp_sweep::BUILT_IN_GRID,
-                "scenarios/grid_fixed_goals.toml",
-            ),
-        }
-    }
-
-    /// Loads and validates it with `overrides` set first.
-    pub(crate) fn load(&self, overrides: &[(String, toml::Value)]) -> PyResult<AnyScenario> {
-        let pairs: Vec<(&str, toml::Value)> = overrides
-            .iter()
-            .map(|(k, v)| (k.as_str(), v.clone()))
-            .collect();
-        if let ScenarioSource::File(p) = self
-            && !p.exists()
-        {
-            return Err(PyFileNotFoundError::new_err(format!(
-                "scenario: {} does not exist",
-                p.display()
-            )));
-        }
-        match self {
-            ScenarioSource::File(p) => errp_sim::load_scenario_with(p, &pairs),
-            ScenarioSource::BuiltIn(text, name) => {
-                errp_sim::parse_scenario_with(text, Path::new(name), &pairs)
-            }
-        }
-        .map_err(py_err)
-    }
-}
-
-impl ScenarioSource {
-    /// The scenario's text as run: with `overrides` set (for recordings).
-    pub(crate) fn text_as_run(&self, overrides: &[(String, toml::Value)]) -> PyResult<String> {
-        let pairs: Vec<(&str, toml::Value)> = overrides
-            .iter()
-            .map(|(k, v)| (k.as_str(), v.clone()))
-            .collect();
-        match self {
-            ScenarioSource::File(p) => errp_sim::read_scenario(p)
-                .and_then(|text| errp_sim::scenario_text_with(&text, p, &pairs)),
-            ScenarioSource::BuiltIn(text, name) => {
-                errp_sim::scenario_text_with(text, Path::new(name), &pairs)
-            }
-        }
-        .map_err(py_err)
-    }
-}
-
-/// The text as run of the scenario [`load_any`] loads with the same
-/// arguments.
-pub(crate) fn load_any_text(
-    scenario: Option<PathBuf>,
-    default_epuck: bool,
-    keys: Keys,
-    given: Option<&Bound<'_, PyDict>>,
-) -> PyResult<String> {
-    ScenarioSource::new(scenario, default_epuck).text_as_run(&overrides(keys.pairs()?, given)?)
-}
-
 /// `overrides={"control.tau": 0.5, ...}` as scenario keys and TOML values,
-/// in the dictionary's order; `extra` (from the keyword arguments) first.
-pub(crate) fn overrides(
-    extra: Vec<(String, toml::Value)>,
+/// in the dictionary's order; `set` are the keys the keyword arguments set,
+/// which the dictionary may not set again.
+fn overrides(
+    set: &[&str],
     given: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Vec<(String, toml::Value)>> {
-    let mut out = extra;
+    let mut out: Vec<(String, toml::Value)> = Vec::new();
     if let Some(d) = given {
         for (k, v) in d.iter() {
             let key: String = k.extract().map_err(|_| {
@@ -140,7 +64,7 @@ pub(crate) fn overrides(
                      fields, e.g. \"control.tau\""
                 ))
             })?;
-            if out.iter().any(|(have, _)| *have == key) {
+            if set.contains(&key.as_str()) || out.iter().any(|(have, _)| *have == key) {
                 return Err(PyValueError::new_err(format!(
                     "overrides: `{key}` is set twice (once by a keyword argument)"
                 )));
@@ -292,9 +216,19 @@ pub(crate) fn check_callable(py: Python<'_>, name: &str, f: Option<&Py<PyAny>>) 
     }
 }
 
+/// How errors name the keyword arguments that set a scenario's values.
+pub(crate) const KEYWORDS: SetterNames = SetterNames {
+    accuracy: "accuracy",
+    seed: "seed",
+    runs: "runs",
+    decoder: "overrides[\"decoder\"]",
+    eeg: "overrides[\"eeg\"]",
+    save: "save",
+};
+
 /// The keyword arguments that set a scenario's keys, set before
 /// `overrides=` and as `errp run`'s flags set them
-/// ([`errp_sim::apply_overrides`]).
+/// ([`errp_sim::ScenarioInput`]).
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Keys {
     /// `accuracy=`: `user.accuracy`.
@@ -314,76 +248,114 @@ impl Keys {
         }
     }
 
-    /// The keys and their values, in order.
-    fn pairs(self) -> PyResult<Vec<(String, toml::Value)>> {
-        let mut out = Vec::new();
-        if let Some(a) = self.accuracy {
-            out.push(("user.accuracy".to_string(), toml::Value::Float(a)));
+    /// The scenario `source` with these keys and `given` (`overrides=`)
+    /// set, each checked here, where it enters.
+    fn input(
+        self,
+        source: ScenarioSource,
+        given: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<ScenarioInput> {
+        let accuracy = self
+            .accuracy
+            .map(|a| {
+                RequestedAccuracy::new(a).map_err(|_| {
+                    value_error(
+                        "accuracy",
+                        a,
+                        "a mean accuracy strictly between 0.5 and 1 (1 for the grid's oracle \
+                         decoder)",
+                    )
+                })
+            })
+            .transpose()?;
+        if let Some(seed) = self.seed
+            && i64::try_from(seed).is_err()
+        {
+            return Err(value_error(
+                "seed",
+                seed,
+                &format!("a whole number from 0 to {}", i64::MAX),
+            ));
         }
-        if let Some(seed) = self.seed {
-            let seed = i64::try_from(seed).map_err(|_| {
-                value_error(
-                    "seed",
-                    seed,
-                    &format!("a whole number from 0 to {}", i64::MAX),
-                )
-            })?;
-            out.push(("seed".to_string(), toml::Value::Integer(seed)));
-        }
-        if let Some(runs) = self.runs {
-            let max = errp_sim::epuck::MAX_RUNS;
-            let n = u64::try_from(runs).ok().filter(|n| (1..=max).contains(n));
-            let Some(n) = n else {
-                return Err(value_error(
-                    "runs",
-                    runs,
-                    &format!("a whole number from 1 to {max}"),
-                ));
-            };
-            out.push(("runs".to_string(), toml::Value::Integer(n as i64)));
-        }
-        Ok(out)
+        let runs = match self.runs {
+            None => None,
+            Some(runs) => {
+                let max = errp_sim::epuck::MAX_RUNS;
+                let n = u64::try_from(runs).ok().filter(|n| (1..=max).contains(n));
+                Some(n.ok_or_else(|| {
+                    value_error("runs", runs, &format!("a whole number from 1 to {max}"))
+                })?)
+            }
+        };
+        let set: Vec<&str> = [
+            (accuracy.is_some(), "user.accuracy"),
+            (self.seed.is_some(), "seed"),
+            (runs.is_some(), "runs"),
+        ]
+        .into_iter()
+        .filter_map(|(on, key)| on.then_some(key))
+        .collect();
+        Ok(ScenarioInput {
+            accuracy,
+            seed: self.seed,
+            runs,
+            keys: overrides(&set, given)?,
+            ..ScenarioInput::new(source)
+        })
     }
 }
 
-/// The scenario keyword with `keys` and `overrides=` set: the file given,
-/// or the built-in scenario of the e-puck (`default_epuck`) or of the grid.
-pub(crate) fn load_any(
+/// The scenario keyword (the file given, or the built-in scenario of the
+/// e-puck (`default_epuck`) or of the grid) with `keys` and `overrides=`
+/// set, loaded once.
+pub(crate) fn load(
     scenario: Option<PathBuf>,
     default_epuck: bool,
     keys: Keys,
     given: Option<&Bound<'_, PyDict>>,
-) -> PyResult<AnyScenario> {
-    ScenarioSource::new(scenario, default_epuck).load(&overrides(keys.pairs()?, given)?)
+) -> PyResult<LoadedScenario> {
+    if let Some(p) = &scenario
+        && !p.exists()
+    {
+        return Err(PyFileNotFoundError::new_err(format!(
+            "scenario: {} does not exist",
+            p.display()
+        )));
+    }
+    let source = ScenarioSource::file_or_built_in(scenario, default_epuck);
+    keys.input(source, given)?.load(&KEYWORDS).map_err(py_err)
 }
 
-/// A grid scenario (the built-in one by default); `who` names what needs
-/// it in the error for an e-puck scenario.
+/// A grid scenario (the built-in one by default) and its text as run;
+/// `who` names what needs it in the error for an e-puck scenario.
 pub(crate) fn load_grid(
     scenario: Option<PathBuf>,
     keys: Keys,
     given: Option<&Bound<'_, PyDict>>,
     who: &str,
-) -> PyResult<GridScenario> {
+) -> PyResult<(GridScenario, String)> {
     let shown = shown(&scenario);
-    match load_any(scenario, false, keys, given)? {
-        AnyScenario::Grid(s) => Ok(*s),
+    let loaded = load(scenario, false, keys, given)?;
+    match loaded.scenario {
+        AnyScenario::Grid(s) => Ok((*s, loaded.text)),
         AnyScenario::Epuck(_) => Err(PyValueError::new_err(format!(
             "scenario: {shown} is an e-puck scenario; {who} needs a grid scenario"
         ))),
     }
 }
 
-/// An e-puck scenario (the built-in Mexico-to-Pisa one by default).
+/// An e-puck scenario (the built-in Mexico-to-Pisa one by default) and its
+/// text as run.
 pub(crate) fn load_epuck(
     scenario: Option<PathBuf>,
     keys: Keys,
     given: Option<&Bound<'_, PyDict>>,
     who: &str,
-) -> PyResult<EpuckScenario> {
+) -> PyResult<(EpuckScenario, String)> {
     let shown = shown(&scenario);
-    match load_any(scenario, true, keys, given)? {
-        AnyScenario::Epuck(s) => Ok(*s),
+    let loaded = load(scenario, true, keys, given)?;
+    match loaded.scenario {
+        AnyScenario::Epuck(s) => Ok((*s, loaded.text)),
         AnyScenario::Grid(_) => Err(PyValueError::new_err(format!(
             "scenario: {shown} is a grid scenario; {who} needs an e-puck scenario"
         ))),

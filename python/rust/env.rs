@@ -18,9 +18,7 @@ use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{
-    Keys, block_to_numpy, load_any_text, load_epuck, load_grid, py_err, value_error,
-};
+use crate::convert::{Keys, block_to_numpy, load_epuck, load_grid, py_err, value_error};
 use crate::interrupt::{CALIBRATING, Meter, long_shown};
 use crate::run::check_save;
 
@@ -149,11 +147,7 @@ impl GridEnvCore {
         progress: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         check_save(save.as_ref())?;
-        let text = match &save {
-            Some(_) => load_any_text(scenario.clone(), false, Keys::accuracy(accuracy), overrides)?,
-            None => String::new(),
-        };
-        let s = load_grid(
+        let (s, text) = load_grid(
             scenario,
             Keys::accuracy(accuracy),
             overrides,
@@ -397,11 +391,7 @@ impl EpuckEnvCore {
         progress: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         check_save(save.as_ref())?;
-        let text = match &save {
-            Some(_) => load_any_text(scenario.clone(), true, Keys::accuracy(accuracy), overrides)?,
-            None => String::new(),
-        };
-        let s = load_epuck(
+        let (s, text) = load_epuck(
             scenario,
             Keys::accuracy(accuracy),
             overrides,

@@ -5,14 +5,13 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, PoisonError};
 
-use errp_bci::rng::derive_seed;
-use errp_sim::AnyScenario;
 use errp_sim::calibration::CalibrationReport;
 use errp_sim::epuck::{
     ContinuousDecoder, ContinuousReport, EpuckScenario, EpuckTask, epuck_row, epuck_run_seed,
 };
-use errp_sim::grid::{GridScenario, GridTask, grid_row, prepare_decoder, run_grid_scenario};
+use errp_sim::grid::{GridScenario, GridTask, grid_row};
 use errp_sim::task::{EpisodeRow, Task, TaskInfo, format_number};
+use errp_sim::{AnyScenario, RunOutcome};
 use errp_sweep::{
     InputNames, Shard, SweepOptions, SweepOutcome, SweepSpec, SweepTask, TargetCache,
     parse_accuracies, parse_axis, sweep_fixed, sweep_scenario,
@@ -21,7 +20,7 @@ use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{Keys, load_any, load_any_text, py_err, value_error};
+use crate::convert::{KEYWORDS, Keys, load, py_err, value_error};
 use crate::interrupt::{CALIBRATING, EPISODES, Meter, RUNS, long_or, long_shown};
 
 /// What a sweep reports from Python: its progress (its decoders
@@ -144,9 +143,35 @@ fn check_ours(path: &std::path::Path) -> PyResult<()> {
     Ok(())
 }
 
+/// What `errp.run` reports as it goes: the calibration, then the
+/// episodes or runs, on the meter.
+struct RunMeter<'a> {
+    meter: &'a Meter,
+    /// Grid episodes, or e-puck runs.
+    total: usize,
+}
+
+impl errp_sim::RunObserver for RunMeter<'_> {
+    fn targeting(&self, _step: &errp_bci::TargetingStep) {
+        self.meter.step(CALIBRATING, 0);
+    }
+
+    fn online_step(&self, _step: &errp_bci::OnlineStep) {
+        self.meter.step(CALIBRATING, 0);
+    }
+
+    fn grid_episode(&self, k: usize, _result: &errp_sim::grid::GridEpisodeResult) {
+        self.meter.set(EPISODES, k + 1, self.total);
+    }
+
+    fn epuck_run_done(&self) {
+        self.meter.step(RUNS, self.total);
+    }
+}
+
 /// Runs a scenario as `errp run` does (the same decoder, seeds and
-/// results) and returns its episodes as CSV text, one row per episode, and
-/// what was calibrated.
+/// results, on the same path: [`errp_sim::run_scenario`]) and returns its
+/// episodes as CSV text, one row per episode, and what was calibrated.
 #[pyfunction]
 #[pyo3(signature = (scenario=None, *, seed=None, runs=None, accuracy=None, overrides=None, save=None, progress=None))]
 #[allow(clippy::too_many_arguments)] // Python's keywords, one each
@@ -166,58 +191,58 @@ pub(crate) fn run<'py>(
         seed,
         runs,
     };
-    // The file as given first (the task decides whether runs= applies),
-    // then with runs= set as a key as well.
-    let mut any = load_any(
-        scenario.clone(),
-        true,
-        Keys { runs: None, ..keys },
-        overrides,
-    )?;
-    match (&any, runs) {
-        (AnyScenario::Grid(_), Some(_)) => {
-            return Err(PyValueError::new_err(
-                "runs: applies to e-puck scenarios; a grid scenario lists its episodes \
-                 (set `repeats`, or give overrides)",
-            ));
-        }
-        (AnyScenario::Epuck(_), Some(_)) => {
-            any = load_any(scenario.clone(), true, keys, overrides)?
-        }
-        _ => {}
-    }
-    let text = match &save {
-        Some(_) => load_any_text(scenario, true, keys, overrides)?,
-        None => String::new(),
+    let loaded = load(scenario, true, keys, overrides)?;
+    let total = match &loaded.scenario {
+        AnyScenario::Grid(s) => s.episodes.len(),
+        AnyScenario::Epuck(s) => s.runs,
     };
+    let provenance = errp_sim::RunProvenance {
+        command: vec!["python: errp.run".into()],
+        commit: None,
+    };
+    let options = errp_sim::RunOptions {
+        save: save.as_deref(),
+        provenance: &provenance,
+        names: &KEYWORDS,
+    };
+    let meter = Meter::default();
+    let watch = RunMeter {
+        meter: &meter,
+        total,
+    };
+    let done = long_shown(py, &meter, progress, || {
+        errp_sim::run_scenario(loaded, options, &watch)
+    })?
+    .map_err(|e| py_err(e.error))?;
     let out = PyDict::new(py);
-    match any {
-        AnyScenario::Grid(s) => {
-            let meter = Meter::default();
-            let (csv, info) = long_shown(py, &meter, progress, || {
-                run_grid(&s, save.as_ref(), text, &meter)
-            })?
-            .map_err(py_err)?;
+    match &done.outcome {
+        RunOutcome::Grid(report) => {
+            let s = &report.scenario;
+            let mut lines = vec![header(&GridTask::INFO)];
+            for (k, r) in report.episodes.iter().enumerate() {
+                let seed = errp_sim::grid::grid_episode_seed(s.seed, k);
+                lines.push(line(s.accuracy, k, seed, grid_row(r)));
+            }
             out.set_item("task", "grid")?;
-            out.set_item("csv", csv)?;
+            out.set_item("csv", lines.join("\n") + "\n")?;
+            let info = grid_summary(s, report.calibration.as_ref());
             out.set_item("decoder", info)?;
         }
-        AnyScenario::Epuck(s) => {
-            if save.is_some() && s.runs > 100 {
-                return Err(value_error(
-                    "runs",
-                    s.runs,
-                    "at most 100 with save= (each run adds about 2.5 MB to the recording)",
+        RunOutcome::Epuck(r) => {
+            let s = &r.scenario;
+            let mut lines = vec![header(&EpuckTask::INFO)];
+            for (k, result) in r.results.iter().enumerate() {
+                let seed = epuck_run_seed(s.seed, k);
+                lines.push(line(
+                    s.accuracy.get(),
+                    k,
+                    seed,
+                    epuck_row(&s.layout, result),
                 ));
             }
-            let meter = Meter::default();
-            let (csv, info) = long_shown(py, &meter, progress, || {
-                run_epuck(&s, save.as_ref(), text, &meter)
-            })?
-            .map_err(py_err)?;
             out.set_item("task", "epuck")?;
-            out.set_item("csv", csv)?;
-            out.set_item("decoder", info)?;
+            out.set_item("csv", lines.join("\n") + "\n")?;
+            out.set_item("decoder", epuck_summary(s, &r.decoder, &r.report))?;
         }
     }
     Ok(out)
@@ -293,93 +318,6 @@ pub(crate) fn provenance(
     let mut p = errp_sim::record::data::Provenance::new(task, name, text, seed);
     p.command = vec![format!("python: {call}")];
     p
-}
-
-fn run_grid(
-    s: &GridScenario,
-    save: Option<&PathBuf>,
-    text: String,
-    meter: &Meter,
-) -> errp_sim::Result<(String, DecoderSummary)> {
-    #[cfg(feature = "rerun")]
-    let rrd = match save {
-        Some(p) => Some(errp_sim::grid::grid_recording(p)?),
-        None => None,
-    };
-    #[cfg(not(feature = "rerun"))]
-    let _ = (save, &text);
-    let (decoder, calibration) = prepare_decoder(s, |_| meter.step(CALIBRATING, 0))?;
-    let n = s.episodes.len();
-    let episodes = run_grid_scenario(s, &decoder, save.is_some(), |k, _| {
-        meter.set(EPISODES, k + 1, n);
-    })?;
-    let mut lines = vec![header(&GridTask::INFO)];
-    for (k, r) in episodes.iter().enumerate() {
-        let seed = errp_sim::grid::grid_episode_seed(s.seed, k);
-        lines.push(line(s.accuracy, k, seed, grid_row(r)));
-    }
-    let info = grid_summary(s, calibration.as_ref());
-    #[cfg(feature = "rerun")]
-    if let Some(file) = rrd {
-        let report = errp_sim::grid::GridRunReport {
-            scenario: s.clone(),
-            calibration,
-            episodes,
-        };
-        let p = provenance("grid", &s.name, text, s.seed, "errp.run");
-        errp_sim::grid::record_grid_run(file, &report, &p)?;
-    }
-    Ok((lines.join("\n") + "\n", info))
-}
-
-fn run_epuck(
-    s: &EpuckScenario,
-    save: Option<&PathBuf>,
-    text: String,
-    meter: &Meter,
-) -> errp_sim::Result<(String, DecoderSummary)> {
-    #[cfg(feature = "rerun")]
-    let rrd = match save {
-        Some(p) => Some(errp_sim::epuck::epuck_recording(p)?),
-        None => None,
-    };
-    #[cfg(not(feature = "rerun"))]
-    let _ = (save, &text);
-    let (decoder, report) = errp_sim::epuck::prepare_continuous_decoder_with(
-        s,
-        |_| meter.step(CALIBRATING, 0),
-        |_| meter.step(CALIBRATING, 0),
-    )?;
-    let one_more = || meter.step(RUNS, s.runs);
-    #[cfg(feature = "rerun")]
-    let results = match &rrd {
-        Some(file) => {
-            let p = provenance("epuck", &s.name, text, s.seed, "errp.run");
-            errp_sim::epuck::record_epuck_runs_with(
-                file,
-                s,
-                &decoder,
-                &p,
-                s.runs,
-                None,
-                &mut |_| one_more(),
-            )?
-        }
-        None => errp_sim::epuck::run_epuck_batch_counted(s, &decoder, s.runs, &one_more)?,
-    };
-    #[cfg(not(feature = "rerun"))]
-    let results = errp_sim::epuck::run_epuck_batch_counted(s, &decoder, s.runs, &one_more)?;
-    let mut lines = vec![header(&EpuckTask::INFO)];
-    for (k, r) in results.iter().enumerate() {
-        let seed = epuck_run_seed(s.seed, k);
-        lines.push(line(s.accuracy.get(), k, seed, epuck_row(&s.layout, r)));
-    }
-    let info = epuck_summary(s, &decoder, &report);
-    #[cfg(feature = "rerun")]
-    if let Some(file) = rrd {
-        file.finish()?;
-    }
-    Ok((lines.join("\n") + "\n", info))
 }
 
 /// The keywords of `errp.sweep`, which its Python wrapper passes as one

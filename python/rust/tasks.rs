@@ -7,10 +7,9 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use errp_bci::EegBlock;
-use errp_bci::rng::derive_seed;
 use errp_sim::epuck::{
     ContinuousDecoder, EpuckScenario, EpuckTask as EpuckInfo, epuck_row, epuck_run_seed,
-    run_epuck_batch_counted, run_epuck_episode_with,
+    run_epuck_runs,
 };
 use errp_sim::grid::{
     AssessmentDecoder, EegDecoder, EpochBlocks, GridDecoding, GridScenario, GridTask as GridInfo,
@@ -23,19 +22,13 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::{
-    Keys, PyDecoder, blocks_to_array3, channel_names, check_callable, load_any_text, load_epuck,
-    load_grid, py_err, value_error,
+    Keys, PyDecoder, blocks_to_array3, channel_names, check_callable, load_epuck, load_grid,
+    py_err, value_error,
 };
 use crate::interrupt::{CALIBRATING, EPISODES, Meter, RUNS, long, long_shown};
 use crate::run::{
     DecoderSummary, check_save, epuck_summary, grid_summary, header, line, summary_dict,
 };
-
-/// The most grid episodes `GridTask.run(save=)` records (as `errp run
-/// --save`).
-const MAX_SAVED_GRID_EPISODES: usize = 5_000;
-/// The most e-puck runs `EpuckTask.run(save=)` records (as `errp.run`).
-const MAX_SAVED_EPUCK_RUNS: usize = 100;
 
 /// The command a task's recording names.
 #[cfg(feature = "rerun")]
@@ -94,8 +87,7 @@ impl GridTask {
             seed,
             runs: None,
         };
-        let text = load_any_text(scenario.clone(), false, keys, overrides)?;
-        let s = load_grid(scenario, keys, overrides, "errp.GridTask")?;
+        let (s, text) = load_grid(scenario, keys, overrides, "errp.GridTask")?;
         check_callable(py, "decoder", decoder.as_ref())?;
         check_callable(py, "batch_decoder", batch_decoder.as_ref())?;
         if decoder.is_some() && batch_decoder.is_some() {
@@ -142,11 +134,14 @@ impl GridTask {
     ) -> PyResult<String> {
         check_save(save.as_ref())?;
         let s = &self.scenario;
-        if save.is_some() && s.episodes.len() > MAX_SAVED_GRID_EPISODES {
+        if save.is_some() && s.episodes.len() > errp_sim::MAX_RECORDED_EPISODES {
             return Err(value_error(
                 "save",
                 format!("a scenario of {} episodes", s.episodes.len()),
-                &format!("at most {MAX_SAVED_GRID_EPISODES} episodes in a recording"),
+                &format!(
+                    "at most {} episodes in a recording",
+                    errp_sim::MAX_RECORDED_EPISODES
+                ),
             ));
         }
         #[cfg(feature = "rerun")]
@@ -338,8 +333,7 @@ impl EpuckTask {
             seed,
             runs: None,
         };
-        let text = load_any_text(scenario.clone(), true, keys, overrides)?;
-        let s = load_epuck(scenario, keys, overrides, "errp.EpuckTask")?;
+        let (s, text) = load_epuck(scenario, keys, overrides, "errp.EpuckTask")?;
         check_callable(py, "decoder", decoder.as_ref())?;
         let meter = Meter::default();
         let (builtin, report) = long_shown(py, &meter, progress, || {
@@ -385,89 +379,69 @@ impl EpuckTask {
                 &format!("a whole number from 1 to {max}"),
             ));
         }
-        if save.is_some() && runs > MAX_SAVED_EPUCK_RUNS {
+        if save.is_some() && runs as u64 > errp_sim::MAX_RECORDED_RUNS {
             return Err(value_error(
                 "runs",
                 runs,
                 &format!(
-                    "at most {MAX_SAVED_EPUCK_RUNS} with save= (each run adds about 2.5 MB to \
-                     the recording)"
+                    "at most {} with save= (each run adds about 2.5 MB to \
+                     the recording)",
+                    errp_sim::MAX_RECORDED_RUNS
                 ),
             ));
         }
         let s = &self.scenario;
         let d = &self.builtin;
         let meter = Meter::default();
-        let one_more = || meter.step(RUNS, runs);
+        let one_more = |_: usize| meter.step(RUNS, runs);
         #[cfg(feature = "rerun")]
-        if let Some(path) = &save {
-            let file = errp_sim::epuck::epuck_recording(path).map_err(py_err)?;
-            let call = task_call("EpuckTask", self.decoder.is_some());
-            let p = crate::run::provenance("epuck", &s.name, self.text.clone(), s.seed, &call);
-            let results = match &self.decoder {
-                None => long_shown(py, &meter, progress, || {
-                    errp_sim::epuck::record_epuck_runs_with(
-                        &file,
-                        s,
-                        d,
-                        &p,
-                        runs,
-                        None,
-                        &mut |_| one_more(),
-                    )
-                })?
-                .map_err(py_err)?,
-                Some(f) => {
-                    let mut dec = PyDecoder::new(f.clone_ref(py));
-                    let result = long_shown(py, &meter, progress, || {
-                        let mut call = |b: &EegBlock| dec.call(b);
-                        errp_sim::epuck::record_epuck_runs_with(
-                            &file,
-                            s,
-                            d,
-                            &p,
-                            runs,
-                            Some(&mut call),
-                            &mut |_| one_more(),
-                        )
-                    })?;
-                    self.calls.fetch_add(dec.calls, Ordering::Relaxed);
-                    result.map_err(|e| dec.error(e))?
-                }
-            };
-            py.detach(|| file.finish()).map_err(py_err)?;
-            return Ok(self.rows(&results));
-        }
+        let file = save
+            .as_ref()
+            .map(|p| errp_sim::epuck::epuck_recording(p))
+            .transpose()
+            .map_err(py_err)?;
         #[cfg(not(feature = "rerun"))]
         let _ = &self.text;
-        let results = match &self.decoder {
-            None => long_shown(py, &meter, progress, || {
-                run_epuck_batch_counted(s, d, runs, &one_more)
-            })?
-            .map_err(py_err)?,
-            Some(f) => {
-                let mut dec = PyDecoder::new(f.clone_ref(py));
-                let result = long_shown(py, &meter, progress, || {
-                    (0..runs)
-                        .map(|k| {
-                            errp_bci::stop::check()?;
-                            let mut call = |b: &EegBlock| dec.call(b);
-                            let r = run_epuck_episode_with(
-                                s,
-                                d,
-                                epuck_run_seed(s.seed, k),
-                                &mut (),
-                                Some(&mut call),
-                            );
-                            one_more();
-                            r
-                        })
-                        .collect::<errp_sim::Result<Vec<_>>>()
-                })?;
+        let mut dec = self
+            .decoder
+            .as_ref()
+            .map(|f| PyDecoder::new(f.clone_ref(py)));
+        let result = long_shown(py, &meter, progress, || {
+            let mut call;
+            let window_decoder = match dec.as_mut() {
+                Some(dec) => {
+                    call = |b: &EegBlock| dec.call(b);
+                    Some(&mut call as errp_sim::epuck::WindowDecoder<'_>)
+                }
+                None => None,
+            };
+            #[cfg(feature = "rerun")]
+            if let Some(file) = &file {
+                let call = task_call("EpuckTask", self.decoder.is_some());
+                let p = crate::run::provenance("epuck", &s.name, self.text.clone(), s.seed, &call);
+                return errp_sim::epuck::record_epuck_runs_with(
+                    file,
+                    s,
+                    d,
+                    &p,
+                    runs,
+                    window_decoder,
+                    &one_more,
+                );
+            }
+            run_epuck_runs(s, d, runs, window_decoder, &mut (), &one_more)
+        })?;
+        let results = match dec {
+            Some(mut dec) => {
                 self.calls.fetch_add(dec.calls, Ordering::Relaxed);
                 result.map_err(|e| dec.error(e))?
             }
+            None => result.map_err(py_err)?,
         };
+        #[cfg(feature = "rerun")]
+        if let Some(file) = file {
+            py.detach(|| file.finish()).map_err(py_err)?;
+        }
         Ok(self.rows(&results))
     }
 

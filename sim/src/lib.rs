@@ -29,6 +29,7 @@ mod error;
 mod files;
 pub mod grid;
 pub mod host;
+mod input;
 #[cfg(feature = "rerun")]
 pub mod inspect;
 mod key;
@@ -37,6 +38,7 @@ mod paper;
 pub mod realism;
 #[cfg(feature = "rerun")]
 pub mod record;
+mod runner;
 mod scenario;
 mod scenario_file;
 #[cfg(test)]
@@ -46,12 +48,20 @@ pub mod task;
 
 pub use error::{Result, SimError, check_p_error};
 pub use files::{append_regular, is_foreign, open_regular, open_regular_with, write_regular};
+pub use input::{
+    BUILT_IN_EPUCK, BUILT_IN_GRID, LoadedScenario, ScenarioInput, ScenarioSource, SetterNames,
+};
 pub use key::StableKey;
 pub use output::{
     CreatedDirs, PendingFile, create_dir, create_dirs, forget_if_interrupted,
     remove_if_interrupted, remove_unfinished, write_atomic,
 };
 pub use paper::{PAPER, PAPER_EPUCK, PAPER_POOLED};
+pub use runner::{
+    EpuckRun, MAX_RECORDED_EPISODES, MAX_RECORDED_RUNS, RunError, RunObserver, RunOptions,
+    RunOutcome, RunProvenance, ScenarioRun, epuck_decoder_summary, grid_decoder_summary,
+    run_scenario,
+};
 pub use scenario::{
     AnyScenario, apply_overrides, is_epuck, load_scenario, load_scenario_with, parse_scenario,
     parse_scenario_table, parse_scenario_with, scenario_text_with,

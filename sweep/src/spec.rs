@@ -381,10 +381,7 @@ pub fn read_task(path: &Path) -> Result<(SweepTask, String)> {
     Ok((task, text))
 }
 
-/// The built-in grid scenario a sweep runs without a scenario file.
-pub const BUILT_IN_GRID: &str = include_str!("../../scenarios/grid_fixed_goals.toml");
-/// The built-in e-puck scenario.
-pub const BUILT_IN_EPUCK: &str = include_str!("../../scenarios/mexico_to_pisa.toml");
+pub use errp_sim::{BUILT_IN_EPUCK, BUILT_IN_GRID};
 
 /// How a caller names a sweep's inputs in its errors: `--task` on the
 /// command line, `task=` in Python.

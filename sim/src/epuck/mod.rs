@@ -36,9 +36,9 @@ pub use plant::{
 };
 pub use report::{EpuckRunHeader, EpuckRunRow, EpuckSummaryReport};
 pub use run::{
-    EpuckSummary, PreparedEpuck, epuck_run_seed, finish_continuous_decoder,
+    EpuckRunsObserver, EpuckSummary, PreparedEpuck, epuck_run_seed, finish_continuous_decoder,
     prepare_continuous_decoder, prepare_continuous_decoder_with, prepare_epuck_decoder,
-    run_epuck_batch, run_epuck_batch_counted, run_epuck_once, summarise,
+    run_epuck_batch, run_epuck_batch_counted, run_epuck_once, run_epuck_runs, summarise,
 };
 pub use scenario::{
     EpuckScenario, MAX_OBSTACLES, MAX_REACTION_LATENCY_MS, MAX_REELICIT_SECS, MAX_RUN_SECS,

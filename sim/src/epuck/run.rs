@@ -10,8 +10,9 @@ use crate::epuck::decoder::{
     ContinuousDecoder, ContinuousReport, ContinuousRequest, calibrate_continuous_at,
     run_online_calibration, target_continuous,
 };
-use crate::epuck::episode::{EpuckEpisodeResult, run_epuck_episode};
+use crate::epuck::episode::{EpuckEpisodeResult, run_epuck_episode, run_epuck_episode_with};
 use crate::epuck::observer::EpuckObserver;
+use crate::epuck::plant::WindowDecoder;
 use crate::epuck::scenario::EpuckScenario;
 use crate::error::Result;
 
@@ -159,14 +160,27 @@ pub fn run_epuck_once(
     )
 }
 
-/// Runs `runs` runs of `scenario` in parallel, without recording. Results
+/// What watches a scenario's runs one after another (a recording): told
+/// when each starts, then each run's steps as an [`EpuckObserver`].
+pub trait EpuckRunsObserver: EpuckObserver {
+    /// Run `k` (from 0) starts, from `seed`.
+    fn start_run(&mut self, k: usize, seed: u64);
+}
+
+/// `()` watches nothing ([`EpuckObserver::watches`]), so the runs may go
+/// in parallel.
+impl EpuckRunsObserver for () {
+    fn start_run(&mut self, _k: usize, _seed: u64) {}
+}
+
+/// Runs `runs` runs of `scenario` without recording, in parallel. Results
 /// are in run order and do not depend on the number of threads.
 pub fn run_epuck_batch(
     scenario: &EpuckScenario,
     decoder: &ContinuousDecoder,
     runs: usize,
 ) -> Result<Vec<EpuckEpisodeResult>> {
-    run_epuck_batch_counted(scenario, decoder, runs, &|| {})
+    run_epuck_runs(scenario, decoder, runs, None, &mut (), &|_| {})
 }
 
 /// [`run_epuck_batch`], calling `on_run` after each run ends (on the
@@ -178,15 +192,50 @@ pub fn run_epuck_batch_counted(
     runs: usize,
     on_run: &(dyn Fn() + Sync),
 ) -> Result<Vec<EpuckEpisodeResult>> {
-    (0..runs)
-        .into_par_iter()
-        .map(|k| {
-            errp_bci::stop::check()?;
-            let r = run_epuck_once(scenario, decoder, k, &mut ());
-            on_run();
-            r
-        })
-        .collect()
+    run_epuck_runs(scenario, decoder, runs, None, &mut (), &|_| on_run())
+}
+
+/// The one loop over a scenario's runs: run `k` from
+/// [`epuck_run_seed`]`(scenario.seed, k)`, with `window_decoder` (a decoder
+/// of the user's own, as in [`crate::epuck::run_epuck_episode_with`]) in
+/// place of the calibrated SVM when given, `observer` watching, and
+/// `on_run(k)` called after run `k` ends. With neither a decoder of the user's
+/// own nor an observer that watches, the runs go in parallel; otherwise
+/// one after another. Either way the results are in run order and the
+/// same.
+pub fn run_epuck_runs(
+    scenario: &EpuckScenario,
+    decoder: &ContinuousDecoder,
+    runs: usize,
+    mut window_decoder: Option<WindowDecoder<'_>>,
+    observer: &mut impl EpuckRunsObserver,
+    on_run: &(dyn Fn(usize) + Sync),
+) -> Result<Vec<EpuckEpisodeResult>> {
+    if window_decoder.is_none() && !observer.watches() {
+        return (0..runs)
+            .into_par_iter()
+            .map(|k| {
+                errp_bci::stop::check()?;
+                let r = run_epuck_once(scenario, decoder, k, &mut ());
+                on_run(k);
+                r
+            })
+            .collect();
+    }
+    let mut out = Vec::with_capacity(runs);
+    for k in 0..runs {
+        errp_bci::stop::check()?;
+        let seed = epuck_run_seed(scenario.seed, k);
+        observer.start_run(k, seed);
+        let decode = window_decoder
+            .as_mut()
+            .map(|d| &mut **d as WindowDecoder<'_>);
+        out.push(run_epuck_episode_with(
+            scenario, decoder, seed, observer, decode,
+        )?);
+        on_run(k);
+    }
+    Ok(out)
 }
 
 /// Summary of many runs of one e-puck scenario.

@@ -20,7 +20,7 @@ use crate::epuck::decoder::ContinuousDecoder;
 use crate::epuck::episode::EpuckEpisodeResult;
 use crate::epuck::observer::{EpisodeStart, EpuckObserver, PhysicsFrame, WindowFrame};
 use crate::epuck::plant::WindowDecoder;
-use crate::epuck::run::run_epuck_once;
+use crate::epuck::run::{EpuckRunsObserver, run_epuck_runs};
 use crate::epuck::scenario::EpuckScenario;
 use crate::epuck::world::{ArenaSpec, Obstacle};
 use crate::error::{Result, SimError};
@@ -109,6 +109,9 @@ pub struct EpuckRecorder {
     run: usize,
     seed: u64,
     tables: RunTables,
+    /// What the log says as each run of a batch starts, after its number
+    /// (the user's goal and decoder).
+    run_title: String,
 }
 
 /// One run's rows of the data tables ([`crate::record::data`]), sent when
@@ -204,6 +207,7 @@ impl EpuckRecorder {
             run: 0,
             seed: 0,
             tables: RunTables::default(),
+            run_title: String::new(),
         })
     }
 
@@ -405,6 +409,13 @@ impl EpuckRecorder {
     }
 }
 
+impl EpuckRunsObserver for EpuckRecorder {
+    fn start_run(&mut self, k: usize, seed: u64) {
+        let title = format!("run {}: {}", k + 1, self.run_title);
+        self.next_run(&title, seed);
+    }
+}
+
 impl EpuckObserver for EpuckRecorder {
     fn on_start(&mut self, start: &EpisodeStart) {
         self.tables.start = Some(*start);
@@ -568,7 +579,7 @@ pub fn record_epuck_runs(
         provenance,
         scenario.runs,
         None,
-        &mut |_| {},
+        &|_| {},
     )
 }
 
@@ -582,35 +593,25 @@ pub fn record_epuck_runs_with(
     decoder: &ContinuousDecoder,
     provenance: &Provenance,
     runs: usize,
-    mut window_decoder: Option<WindowDecoder<'_>>,
-    on_run: &mut dyn FnMut(usize),
+    window_decoder: Option<WindowDecoder<'_>>,
+    on_run: &(dyn Fn(usize) + Sync),
 ) -> Result<Vec<EpuckEpisodeResult>> {
     provenance.write(file, runs)?;
-    let layout = &scenario.layout;
-    let goal = &layout.goals()[scenario.episode.goal].name;
-    let decoder_text = scenario.decoder_text();
     let t_e = decoder.detector_t_e(&scenario.params, window_decoder.is_some());
-    let mut recorder = EpuckRecorder::new(file, &scenario.arena, layout, t_e)?;
-    let mut out = Vec::with_capacity(runs);
-    for k in 0..runs {
-        errp_bci::stop::check()?;
-        let seed = crate::epuck::epuck_run_seed(scenario.seed, k);
-        recorder.next_run(
-            &format!("run {}: the user wants {goal} ({decoder_text})", k + 1),
-            seed,
-        );
-        out.push(match window_decoder.as_mut() {
-            None => run_epuck_once(scenario, decoder, k, &mut recorder)?,
-            Some(decode) => crate::epuck::run_epuck_episode_with(
-                scenario,
-                decoder,
-                seed,
-                &mut recorder,
-                Some(&mut **decode),
-            )?,
-        });
-        on_run(k);
-    }
+    let mut recorder = EpuckRecorder::new(file, &scenario.arena, &scenario.layout, t_e)?;
+    recorder.run_title = format!(
+        "the user wants {} ({})",
+        scenario.layout.goals()[scenario.episode.goal].name,
+        scenario.decoder_text()
+    );
+    let out = run_epuck_runs(
+        scenario,
+        decoder,
+        runs,
+        window_decoder,
+        &mut recorder,
+        on_run,
+    )?;
     recorder.finish()?;
     Ok(out)
 }

@@ -42,6 +42,16 @@ pub enum DecoderChoice {
     Oracle,
 }
 
+impl DecoderChoice {
+    /// As a scenario file spells it (`decoder = "eeg"`).
+    pub fn key(self) -> &'static str {
+        match self {
+            DecoderChoice::Eeg => "eeg",
+            DecoderChoice::Oracle => "oracle",
+        }
+    }
+}
+
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct ScenarioFile {
@@ -100,6 +110,16 @@ pub enum EegMode {
     Stream,
     /// Drawn from a bank of epochs streamed in advance (fast, for sweeps).
     Bank,
+}
+
+impl EegMode {
+    /// As a scenario file spells it (`eeg = "stream"`).
+    pub fn key(self) -> &'static str {
+        match self {
+            EegMode::Stream => "stream",
+            EegMode::Bank => "bank",
+        }
+    }
 }
 
 #[derive(Debug, Deserialize)]

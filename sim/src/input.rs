@@ -1,0 +1,239 @@
+//! One scenario input for every front end: a scenario file or a built-in
+//! scenario, and the values a command line or a Python call sets in it
+//! (the accuracy, the seed, the runs, the grid's decoder and EEG mode, any
+//! dotted key). [`ScenarioInput::load`] reads it once, sets the values as
+//! the file's own keys, validates the result and keeps the text as run, for
+//! recordings that say how they were made.
+
+use std::path::{Path, PathBuf};
+
+use errp_bci::RequestedAccuracy;
+
+use crate::error::{Result, SimError};
+use crate::grid::{DecoderChoice, EegMode};
+use crate::scenario::{AnyScenario, apply_overrides, parse_scenario, parse_scenario_table};
+use crate::scenario_file::{parse_toml, read_scenario};
+
+/// The built-in grid scenario (`scenarios/grid_fixed_goals.toml`): what a
+/// Python call or a sweep runs without a scenario file.
+pub const BUILT_IN_GRID: &str = include_str!("../../scenarios/grid_fixed_goals.toml");
+/// The built-in e-puck scenario (`scenarios/mexico_to_pisa.toml`).
+pub const BUILT_IN_EPUCK: &str = include_str!("../../scenarios/mexico_to_pisa.toml");
+
+/// Where a scenario comes from.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ScenarioSource {
+    /// A TOML file.
+    File(PathBuf),
+    /// Built-in text, named in errors by the path it has in the repository.
+    BuiltIn {
+        /// The TOML text.
+        text: &'static str,
+        /// Its path in the repository.
+        name: &'static str,
+    },
+}
+
+impl ScenarioSource {
+    /// The file `path`, or the built-in scenario of the e-puck (`epuck`) or
+    /// of the grid.
+    pub fn file_or_built_in(path: Option<PathBuf>, epuck: bool) -> Self {
+        match (path, epuck) {
+            (Some(p), _) => ScenarioSource::File(p),
+            (None, true) => ScenarioSource::BuiltIn {
+                text: BUILT_IN_EPUCK,
+                name: "scenarios/mexico_to_pisa.toml",
+            },
+            (None, false) => ScenarioSource::BuiltIn {
+                text: BUILT_IN_GRID,
+                name: "scenarios/grid_fixed_goals.toml",
+            },
+        }
+    }
+
+    /// The path that names it in errors.
+    pub fn path(&self) -> &Path {
+        match self {
+            ScenarioSource::File(p) => p,
+            ScenarioSource::BuiltIn { name, .. } => Path::new(name),
+        }
+    }
+
+    /// Its text, read once.
+    fn text(&self) -> Result<String> {
+        match self {
+            ScenarioSource::File(p) => read_scenario(p),
+            ScenarioSource::BuiltIn { text, .. } => Ok((*text).to_string()),
+        }
+    }
+}
+
+/// How a front end names the values it sets, in its errors: `--runs` on
+/// the command line, `runs:` in Python.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SetterNames {
+    /// The accuracy.
+    pub accuracy: &'static str,
+    /// The seed.
+    pub seed: &'static str,
+    /// The runs of an e-puck scenario.
+    pub runs: &'static str,
+    /// The grid's decoder.
+    pub decoder: &'static str,
+    /// The grid's EEG mode.
+    pub eeg: &'static str,
+    /// The recording to write.
+    pub save: &'static str,
+}
+
+/// A scenario and the values set in it from outside, each checked where
+/// it entered (a flag's parser, a keyword's check).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScenarioInput {
+    /// The scenario.
+    pub source: ScenarioSource,
+    /// `user.accuracy`: a new decoder accuracy, which replaces the file's
+    /// other ways of giving it.
+    pub accuracy: Option<RequestedAccuracy>,
+    /// `seed`: a new simulated user, new runs and new free goals (at most
+    /// `i64::MAX`, as a TOML integer).
+    pub seed: Option<u64>,
+    /// `runs` (e-puck scenarios).
+    pub runs: Option<u64>,
+    /// `decoder` (grid scenarios).
+    pub decoder: Option<DecoderChoice>,
+    /// `eeg` (grid scenarios).
+    pub eeg: Option<EegMode>,
+    /// Any dotted keys, set after the values above, in order.
+    pub keys: Vec<(String, toml::Value)>,
+}
+
+/// A scenario loaded from a [`ScenarioInput`].
+#[derive(Debug, Clone)]
+pub struct LoadedScenario {
+    /// The validated scenario.
+    pub scenario: AnyScenario,
+    /// Its text as run: the file's with the values set, comments and
+    /// layout kept.
+    pub text: String,
+}
+
+impl ScenarioInput {
+    /// `source` with nothing set.
+    pub fn new(source: ScenarioSource) -> Self {
+        Self {
+            source,
+            accuracy: None,
+            seed: None,
+            runs: None,
+            decoder: None,
+            eeg: None,
+            keys: Vec::new(),
+        }
+    }
+
+    /// Reads the scenario once, checks that each value set applies to its
+    /// task (`names` name them), sets them as the file's own keys
+    /// ([`apply_overrides`]) and validates the result, so that nothing
+    /// derived from a value (the accuracy the device assumes, the free
+    /// goals drawn from the seed) can be left behind. An error of the file
+    /// as written quotes its line; one that only the values set cause
+    /// names the file and the field.
+    pub fn load(&self, names: &SetterNames) -> Result<LoadedScenario> {
+        let path = self.source.path();
+        let text = self.source.text()?;
+        let table: toml::Table = parse_toml(&text, path)?;
+        let epuck = table.get("task").and_then(toml::Value::as_str) == Some("epuck");
+        self.check_task(epuck, &table, names)?;
+        let keys = self.pairs(epuck);
+        if keys.is_empty() {
+            let scenario = parse_scenario(&text, path)?;
+            return Ok(LoadedScenario { scenario, text });
+        }
+        let as_run = apply_overrides(&text, &keys)
+            .map_err(|e| SimError::Scenario(format!("{}: {e}", path.display())))?;
+        let table: toml::Table = parse_toml(&as_run, path)?;
+        match parse_scenario_table(&table, path) {
+            Ok(mut scenario) => {
+                if let (AnyScenario::Grid(s), Some(_)) = (&mut scenario, self.accuracy) {
+                    s.user.push_str(&format!(" ({})", names.accuracy));
+                }
+                Ok(LoadedScenario {
+                    scenario,
+                    text: as_run,
+                })
+            }
+            // The file's own error first, with its line.
+            Err(e) => Err(parse_scenario(&text, path).err().unwrap_or(e)),
+        }
+    }
+
+    /// Refuses values that the scenario's task does not take: runs for the
+    /// grid, a decoder or EEG mode for the e-puck, a perfect accuracy for
+    /// anything but the grid's oracle.
+    fn check_task(&self, epuck: bool, table: &toml::Table, names: &SetterNames) -> Result<()> {
+        if epuck && (self.decoder.is_some() || self.eeg.is_some()) {
+            return Err(SimError::Scenario(format!(
+                "{} and {} apply to grid scenarios; the e-puck task always runs the streamed \
+                 EEG through the sliding-window SVM",
+                names.decoder, names.eeg
+            )));
+        }
+        if !epuck && self.runs.is_some() {
+            return Err(SimError::Scenario(format!(
+                "{}: applies to e-puck scenarios; a grid scenario lists its episodes (set \
+                 `repeats` in {})",
+                names.runs,
+                self.source.path().display()
+            )));
+        }
+        if let Some(seed) = self.seed
+            && i64::try_from(seed).is_err()
+        {
+            return Err(SimError::Scenario(format!(
+                "{} {seed} is invalid: expected a whole number from 0 to {}",
+                names.seed,
+                i64::MAX
+            )));
+        }
+        if self.accuracy == Some(RequestedAccuracy::Perfect) {
+            let oracle = match self.decoder {
+                Some(d) => d == DecoderChoice::Oracle,
+                None => table.get("decoder").and_then(toml::Value::as_str) == Some("oracle"),
+            };
+            if epuck || !oracle {
+                return Err(SimError::Scenario(format!(
+                    "{} 1: only the grid's oracle decoder may be perfect (with {} oracle, or \
+                     decoder = \"oracle\" in the scenario); the EEG decoders take a mean accuracy \
+                     strictly between 0.5 and 1, e.g. 0.95",
+                    names.accuracy, names.decoder
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// The values set, as the file's dotted keys, in order.
+    fn pairs(&self, epuck: bool) -> Vec<(&str, toml::Value)> {
+        let mut out: Vec<(&str, toml::Value)> = Vec::new();
+        if let Some(a) = self.accuracy {
+            out.push(("user.accuracy", toml::Value::Float(a.get())));
+        }
+        if let Some(seed) = self.seed {
+            out.push(("seed", toml::Value::Integer(seed as i64)));
+        }
+        if epuck && let Some(runs) = self.runs {
+            out.push(("runs", toml::Value::Integer(runs as i64)));
+        }
+        if !epuck {
+            if let Some(d) = self.decoder {
+                out.push(("decoder", toml::Value::String(d.key().into())));
+            }
+            if let Some(e) = self.eeg {
+                out.push(("eeg", toml::Value::String(e.key().into())));
+            }
+        }
+        out.extend(self.keys.iter().map(|(k, v)| (k.as_str(), v.clone())));
+        out
+    }
+}

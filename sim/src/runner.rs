@@ -1,0 +1,433 @@
+//! One path from a loaded scenario to its result, for every front end
+//! (`errp run`, the Python package's `errp.run`): the decoder prepared, the
+//! episodes or runs, and the recording with its provenance. What a front
+//! end shows along the way it sees through a [`RunObserver`]; `()` shows
+//! nothing.
+
+use std::path::{Path, PathBuf};
+
+use errp_bci::{OnlineStep, TargetingStep};
+
+use crate::calibration::CalibrationReport;
+use crate::epuck::{
+    ContinuousDecoder, ContinuousReport, EpuckEpisodeResult, EpuckScenario,
+    prepare_continuous_decoder_with, run_epuck_batch_counted,
+};
+use crate::error::SimError;
+use crate::grid::{
+    GridEpisodeResult, GridRunReport, GridScenario, prepare_decoder, run_grid_scenario,
+};
+use crate::input::{LoadedScenario, SetterNames};
+use crate::scenario::AnyScenario;
+
+/// The most e-puck runs one recording holds.
+pub const MAX_RECORDED_RUNS: u64 = 100;
+
+/// The most grid episodes one recording holds (each adds about 20 kB to
+/// the file and 150 kB of memory while it is written: measured on 1000
+/// episodes of `grid_fixed_goals.toml`).
+pub const MAX_RECORDED_EPISODES: usize = 5_000;
+
+/// What a front end sees of a run as it goes. Calls may come from several
+/// threads (the e-puck's runs run in parallel when not recorded).
+pub trait RunObserver: Sync {
+    /// A step of the search for the ErrP-to-noise ratio of the accuracy.
+    fn targeting(&self, _step: &TargetingStep) {}
+    /// A step of the e-puck detector's calibration on a held-out recording.
+    fn online_step(&self, _step: &OnlineStep) {}
+    /// The decoder is ready; `summary` says what its calibration found.
+    fn decoder_ready(&self, _summary: &str) {}
+    /// Grid episode `k` ended (in order).
+    fn grid_episode(&self, _k: usize, _result: &GridEpisodeResult) {}
+    /// The e-puck's `runs` start, in parallel unless recorded.
+    fn epuck_runs_start(&self, _runs: u64, _parallel: bool) {}
+    /// One more e-puck run ended (in no set order when in parallel).
+    fn epuck_run_done(&self) {}
+}
+
+impl RunObserver for () {}
+
+/// How a recording says it was made.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct RunProvenance {
+    /// The command or call, as its words.
+    pub command: Vec<String>,
+    /// The source commit of the program, if known.
+    pub commit: Option<String>,
+}
+
+/// What [`run_scenario`] records, if anything.
+#[derive(Debug, Clone, Copy)]
+pub struct RunOptions<'a> {
+    /// The `.rrd` file to record every episode into (created before any
+    /// work, so that an unwritable path fails first).
+    pub save: Option<&'a Path>,
+    /// How the recording says it was made.
+    pub provenance: &'a RunProvenance,
+    /// How the front end names its inputs in errors.
+    pub names: &'a SetterNames,
+}
+
+/// An e-puck scenario's runs.
+#[derive(Debug, Clone)]
+pub struct EpuckRun {
+    /// The scenario as run.
+    pub scenario: EpuckScenario,
+    /// The continuous decoder, calibrated.
+    pub decoder: ContinuousDecoder,
+    /// What its calibration found.
+    pub report: ContinuousReport,
+    /// One result per run, in run order.
+    pub results: Vec<EpuckEpisodeResult>,
+}
+
+/// What a run of either task produced.
+#[derive(Debug, Clone)]
+pub enum RunOutcome {
+    /// A grid scenario's episodes.
+    Grid(Box<GridRunReport>),
+    /// An e-puck scenario's runs.
+    Epuck(Box<EpuckRun>),
+}
+
+/// A finished run.
+#[derive(Debug, Clone)]
+pub struct ScenarioRun {
+    /// Its results.
+    pub outcome: RunOutcome,
+    /// What the decoder's calibration found, as text (printed, and kept in
+    /// a recording's provenance).
+    pub decoder_summary: String,
+    /// The recording written, if one was asked for.
+    pub recording: Option<PathBuf>,
+}
+
+/// A run that failed, with what it was doing when that is worth saying
+/// (`calibrating the decoder`, the save flag).
+#[derive(Debug, thiserror::Error)]
+#[error("{}", match context { Some(c) => format!("{c}: {error}"), None => error.to_string() })]
+pub struct RunError {
+    /// What the run was doing.
+    pub context: Option<String>,
+    /// Why it failed.
+    #[source]
+    pub error: SimError,
+}
+
+fn at(context: &str) -> impl FnOnce(SimError) -> RunError + '_ {
+    move |error| RunError {
+        context: Some(context.to_string()),
+        error,
+    }
+}
+
+fn plain(error: SimError) -> RunError {
+    RunError {
+        context: None,
+        error,
+    }
+}
+
+/// Runs a loaded scenario of either task: prepares its decoder on the one
+/// path of every command, runs its episodes (grid) or runs (e-puck) from
+/// their derived seeds, and records them with their provenance when asked.
+pub fn run_scenario(
+    loaded: LoadedScenario,
+    options: RunOptions<'_>,
+    observer: &impl RunObserver,
+) -> Result<ScenarioRun, RunError> {
+    let LoadedScenario { scenario, text } = loaded;
+    check_recordable(&scenario, &options)?;
+    match scenario {
+        AnyScenario::Grid(s) => run_grid(*s, text, options, observer),
+        AnyScenario::Epuck(s) => run_epuck(*s, text, options, observer),
+    }
+}
+
+/// Refuses a recording too large to write.
+fn check_recordable(scenario: &AnyScenario, options: &RunOptions<'_>) -> Result<(), RunError> {
+    if options.save.is_none() {
+        return Ok(());
+    }
+    let save = options.names.save;
+    let error = match scenario {
+        AnyScenario::Epuck(s) if s.runs as u64 > MAX_RECORDED_RUNS => format!(
+            "{save} with {} runs: a recording holds at most {MAX_RECORDED_RUNS} runs (each adds \
+             about 2.5 MB to the file and 9 MB of memory while it is written); record at most \
+             {MAX_RECORDED_RUNS} ({}), or run them all without {save}",
+            s.runs, options.names.runs
+        ),
+        AnyScenario::Grid(s) if s.episodes.len() > MAX_RECORDED_EPISODES => format!(
+            "{save} with {} episodes: a recording holds at most {MAX_RECORDED_EPISODES} grid \
+             episodes (each adds about 20 kB to the file and 150 kB of memory while it is \
+             written, so {:.1} GB here); record fewer (lower `repeats` in {}), or run them \
+             all without {save}",
+            s.episodes.len(),
+            s.episodes.len() as f64 * 150e3 / 1e9,
+            s.path.display()
+        ),
+        _ => return Ok(()),
+    };
+    Err(plain(SimError::Scenario(error)))
+}
+
+/// What the grid decoder's calibration found, as `errp run` prints it
+/// (nothing for the oracle).
+pub fn grid_decoder_summary(calibration: Option<&CalibrationReport>) -> String {
+    match calibration {
+        Some(c) => format!(
+            "Decoder calibrated on 400 actions: mean accuracy {:.2} % on held-out epochs (the \
+             target; correct {:.2} %, error {:.2} %), {:.2} % cross-validated\n",
+            100.0 * c.targeting.accuracy.mean(),
+            100.0 * c.targeting.accuracy.correct,
+            100.0 * c.targeting.accuracy.error,
+            100.0 * c.calibrated.accuracy.mean()
+        ),
+        None => String::new(),
+    }
+}
+
+/// What the continuous decoder's calibration found, as `errp run` prints
+/// it, with its operating point on the held-out recording.
+pub fn epuck_decoder_summary(decoder: &ContinuousDecoder, report: &ContinuousReport) -> String {
+    let acc = report.calibrated.accuracy;
+    let mut text = format!(
+        "SVM decoder calibrated on {} error + {} correct button-locked examples: correct {:.2} %, \
+         error {:.2} %, mean {:.2} % (cross-validated); {} support vectors\n",
+        acc.n_error,
+        acc.n_correct,
+        100.0 * acc.correct,
+        100.0 * acc.error,
+        100.0 * acc.mean(),
+        decoder.model.n_support()
+    );
+    if let Some(online) = &decoder.online {
+        text.push_str(&online.to_string());
+    }
+    text
+}
+
+fn run_grid(
+    scenario: GridScenario,
+    text: String,
+    options: RunOptions<'_>,
+    observer: &impl RunObserver,
+) -> Result<ScenarioRun, RunError> {
+    let file = recording::open(options.save, false).map_err(at(options.names.save))?;
+    let (decoder, calibration) = prepare_decoder(&scenario, |s| observer.targeting(s))
+        .map_err(at("calibrating the decoder"))?;
+    let decoder_summary = grid_decoder_summary(calibration.as_ref());
+    observer.decoder_ready(&decoder_summary);
+    let episodes = run_grid_scenario(&scenario, &decoder, options.save.is_some(), |k, r| {
+        observer.grid_episode(k, r)
+    })
+    .map_err(plain)?;
+    let report = GridRunReport {
+        scenario,
+        calibration,
+        episodes,
+    };
+    let recording = recording::grid(file, &report, &text, &decoder_summary, &options)
+        .map_err(at(options.names.save))?;
+    Ok(ScenarioRun {
+        outcome: RunOutcome::Grid(Box::new(report)),
+        decoder_summary,
+        recording,
+    })
+}
+
+fn run_epuck(
+    scenario: EpuckScenario,
+    text: String,
+    options: RunOptions<'_>,
+    observer: &impl RunObserver,
+) -> Result<ScenarioRun, RunError> {
+    let file = recording::open(options.save, true).map_err(at(options.names.save))?;
+    let (decoder, report) = prepare_continuous_decoder_with(
+        &scenario,
+        |s| observer.targeting(s),
+        |s| observer.online_step(s),
+    )
+    .map_err(at("calibrating the continuous decoder"))?;
+    let decoder_summary = epuck_decoder_summary(&decoder, &report);
+    observer.decoder_ready(&decoder_summary);
+    let runs = scenario.runs;
+    observer.epuck_runs_start(runs as u64, file.is_none());
+    let (results, recording) = match file {
+        Some(file) => {
+            let results = recording::epuck(
+                &file,
+                &scenario,
+                &decoder,
+                &text,
+                &decoder_summary,
+                &options,
+                &|| observer.epuck_run_done(),
+            )
+            .map_err(plain)?;
+            let path = recording::finish(file).map_err(at(options.names.save))?;
+            (results, path)
+        }
+        None => {
+            let results =
+                run_epuck_batch_counted(&scenario, &decoder, runs, &|| observer.epuck_run_done())
+                    .map_err(plain)?;
+            (results, None)
+        }
+    };
+    Ok(ScenarioRun {
+        outcome: RunOutcome::Epuck(Box::new(EpuckRun {
+            scenario,
+            decoder,
+            report,
+            results,
+        })),
+        decoder_summary,
+        recording,
+    })
+}
+
+/// The recording, when the crate records (the `rerun` feature).
+#[cfg(feature = "rerun")]
+mod recording {
+    use std::path::{Path, PathBuf};
+
+    use super::RunOptions;
+    use crate::epuck::{ContinuousDecoder, EpuckEpisodeResult, EpuckScenario};
+    use crate::error::Result;
+    use crate::grid::GridRunReport;
+    use crate::record::RrdFile;
+    use crate::record::data::Provenance;
+
+    pub(super) type File = RrdFile;
+
+    /// The `.rrd` at `save`, created now.
+    pub(super) fn open(save: Option<&Path>, epuck: bool) -> Result<Option<File>> {
+        save.map(|p| {
+            if epuck {
+                crate::epuck::epuck_recording(p)
+            } else {
+                crate::grid::grid_recording(p)
+            }
+        })
+        .transpose()
+    }
+
+    fn provenance(
+        task: &str,
+        name: &str,
+        seed: u64,
+        text: &str,
+        decoder_summary: &str,
+        options: &RunOptions<'_>,
+    ) -> Provenance {
+        let mut p = Provenance::new(task, name, text.to_string(), seed);
+        if let Some(commit) = &options.provenance.commit {
+            p.commit.clone_from(commit);
+        }
+        p.command.clone_from(&options.provenance.command);
+        p.decoder_summary = decoder_summary.to_string();
+        p
+    }
+
+    /// Writes a grid run into `file` and finishes it.
+    pub(super) fn grid(
+        file: Option<File>,
+        report: &GridRunReport,
+        text: &str,
+        decoder_summary: &str,
+        options: &RunOptions<'_>,
+    ) -> Result<Option<PathBuf>> {
+        let Some(file) = file else { return Ok(None) };
+        let s = &report.scenario;
+        let p = provenance("grid", &s.name, s.seed, text, decoder_summary, options);
+        crate::grid::record_grid_run(file, report, &p).map(Some)
+    }
+
+    /// Runs and records the e-puck's runs one after another.
+    pub(super) fn epuck(
+        file: &File,
+        scenario: &EpuckScenario,
+        decoder: &ContinuousDecoder,
+        text: &str,
+        decoder_summary: &str,
+        options: &RunOptions<'_>,
+        on_run: &(dyn Fn() + Sync),
+    ) -> Result<Vec<EpuckEpisodeResult>> {
+        let p = provenance(
+            "epuck",
+            &scenario.name,
+            scenario.seed,
+            text,
+            decoder_summary,
+            options,
+        );
+        crate::epuck::record_epuck_runs_with(
+            file,
+            scenario,
+            decoder,
+            &p,
+            scenario.runs,
+            None,
+            &|_| on_run(),
+        )
+    }
+
+    /// Finishes the file.
+    pub(super) fn finish(file: File) -> Result<Option<PathBuf>> {
+        file.finish().map(Some)
+    }
+}
+
+/// Without the `rerun` feature nothing records: asking to is an error.
+#[cfg(not(feature = "rerun"))]
+mod recording {
+    use std::path::{Path, PathBuf};
+
+    use super::RunOptions;
+    use crate::epuck::{ContinuousDecoder, EpuckEpisodeResult, EpuckScenario};
+    use crate::error::{Result, SimError};
+    use crate::grid::GridRunReport;
+
+    /// No file is ever open.
+    pub(super) enum File {}
+
+    pub(super) fn open(save: Option<&Path>, _epuck: bool) -> Result<Option<File>> {
+        match save {
+            None => Ok(None),
+            Some(p) => Err(SimError::Scenario(format!(
+                "{}: this build records nothing (built without the `rerun` feature)",
+                p.display()
+            ))),
+        }
+    }
+
+    pub(super) fn grid(
+        file: Option<File>,
+        _report: &GridRunReport,
+        _text: &str,
+        _decoder_summary: &str,
+        _options: &RunOptions<'_>,
+    ) -> Result<Option<PathBuf>> {
+        match file {
+            None => Ok(None),
+            Some(f) => match f {},
+        }
+    }
+
+    pub(super) fn epuck(
+        file: &File,
+        _scenario: &EpuckScenario,
+        _decoder: &ContinuousDecoder,
+        _text: &str,
+        _decoder_summary: &str,
+        _options: &RunOptions<'_>,
+        _on_run: &(dyn Fn() + Sync),
+    ) -> Result<Vec<EpuckEpisodeResult>> {
+        match *file {}
+    }
+
+    pub(super) fn finish(file: File) -> Result<Option<PathBuf>> {
+        match file {}
+    }
+}
