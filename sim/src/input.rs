@@ -144,7 +144,10 @@ impl ScenarioInput {
         let text = self.source.text()?;
         let table: toml::Table = parse_toml(&text, path)?;
         let epuck = table.get("task").and_then(toml::Value::as_str) == Some("epuck");
-        self.check_task(epuck, &table, names)?;
+        if let Err(e) = self.check_task(epuck, &table, names) {
+            // The file's own error first, with its line.
+            return Err(parse_scenario(&text, path).err().unwrap_or(e));
+        }
         let keys = self.pairs(epuck);
         if keys.is_empty() {
             let scenario = parse_scenario(&text, path)?;

@@ -31,6 +31,14 @@ pub const MAX_RECORDED_EPISODES: usize = 5_000;
 /// What a front end sees of a run as it goes. Calls may come from several
 /// threads (the e-puck's runs run in parallel when not recorded).
 pub trait RunObserver: Sync {
+    /// The run starts: its inputs are checked and its recording created.
+    fn start(&self, _scenario: &AnyScenario) {}
+    /// True once the front end can take no more (its output failed): the
+    /// run stops before its next stage (the episodes, the recording) and
+    /// records nothing.
+    fn stopped(&self) -> bool {
+        false
+    }
     /// A step of the search for the ErrP-to-noise ratio of the accuracy.
     fn targeting(&self, _step: &TargetingStep) {}
     /// A step of the e-puck detector's calibration on a held-out recording.
@@ -138,10 +146,23 @@ pub fn run_scenario(
 ) -> Result<ScenarioRun, RunError> {
     let LoadedScenario { scenario, text } = loaded;
     check_recordable(&scenario, &options)?;
+    let epuck = matches!(scenario, AnyScenario::Epuck(_));
+    let file = recording::open(options.save, epuck).map_err(at(options.names.save))?;
+    observer.start(&scenario);
     match scenario {
-        AnyScenario::Grid(s) => run_grid(*s, text, options, observer),
-        AnyScenario::Epuck(s) => run_epuck(*s, text, options, observer),
+        AnyScenario::Grid(s) => run_grid(*s, file, text, options, observer),
+        AnyScenario::Epuck(s) => run_epuck(*s, file, text, options, observer),
     }
+}
+
+/// The error of a run its observer stopped.
+fn check_going(observer: &impl RunObserver) -> Result<(), RunError> {
+    if observer.stopped() {
+        return Err(plain(SimError::Scenario(
+            "the run was stopped: its output failed".into(),
+        )));
+    }
+    Ok(())
 }
 
 /// Refuses a recording too large to write.
@@ -209,19 +230,21 @@ pub fn epuck_decoder_summary(decoder: &ContinuousDecoder, report: &ContinuousRep
 
 fn run_grid(
     scenario: GridScenario,
+    file: Option<recording::File>,
     text: String,
     options: RunOptions<'_>,
     observer: &impl RunObserver,
 ) -> Result<ScenarioRun, RunError> {
-    let file = recording::open(options.save, false).map_err(at(options.names.save))?;
     let (decoder, calibration) = prepare_decoder(&scenario, |s| observer.targeting(s))
         .map_err(at("calibrating the decoder"))?;
     let decoder_summary = grid_decoder_summary(calibration.as_ref());
     observer.decoder_ready(&decoder_summary);
+    check_going(observer)?;
     let episodes = run_grid_scenario(&scenario, &decoder, options.save.is_some(), |k, r| {
         observer.grid_episode(k, r)
     })
     .map_err(plain)?;
+    check_going(observer)?;
     let report = GridRunReport {
         scenario,
         calibration,
@@ -238,11 +261,11 @@ fn run_grid(
 
 fn run_epuck(
     scenario: EpuckScenario,
+    file: Option<recording::File>,
     text: String,
     options: RunOptions<'_>,
     observer: &impl RunObserver,
 ) -> Result<ScenarioRun, RunError> {
-    let file = recording::open(options.save, true).map_err(at(options.names.save))?;
     let (decoder, report) = prepare_continuous_decoder_with(
         &scenario,
         |s| observer.targeting(s),
@@ -251,6 +274,7 @@ fn run_epuck(
     .map_err(at("calibrating the continuous decoder"))?;
     let decoder_summary = epuck_decoder_summary(&decoder, &report);
     observer.decoder_ready(&decoder_summary);
+    check_going(observer)?;
     let runs = scenario.runs;
     observer.epuck_runs_start(runs as u64, file.is_none());
     let (results, recording) = match file {

@@ -41,9 +41,6 @@ pub(crate) fn run(args: &RunArgs) -> Result<()> {
     };
     let loaded = input.load(&FLAGS)?;
     check_save(args.save.as_deref())?;
-    if !args.quiet {
-        errln!("{}", announce(&loaded.scenario));
-    }
     let provenance = RunProvenance {
         command: crate::commands::command_line(),
         commit: Some(crate::commands::fit::COMMIT.to_string()),
@@ -62,13 +59,13 @@ pub(crate) fn run(args: &RunArgs) -> Result<()> {
         Some(c) => anyhow::Error::new(e.error).context(c),
         None => e.error.into(),
     });
-    // A standard output that fails stops nothing (the episodes run on);
-    // its first failure is the command's, after the run's own.
-    let run = run?;
+    // A standard output that fails stops the run before its next stage
+    // (grid episodes run on); its first failure is the command's.
     printer
         .printed
         .into_inner()
         .unwrap_or_else(std::sync::PoisonError::into_inner)?;
+    let run = run?;
     match &run.outcome {
         RunOutcome::Grid(report) => out!("{report}")?,
         RunOutcome::Epuck(r) => {
@@ -151,6 +148,19 @@ impl Printer {
 }
 
 impl RunObserver for Printer {
+    fn start(&self, scenario: &AnyScenario) {
+        if !self.quiet {
+            errln!("{}", announce(scenario));
+        }
+    }
+
+    fn stopped(&self) -> bool {
+        self.printed
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .is_err()
+    }
+
     fn targeting(&self, s: &TargetingStep) {
         if !self.quiet {
             errln!(
