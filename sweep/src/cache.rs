@@ -9,8 +9,8 @@
 //! rewritten.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
 
 use errp_bci::TargetingResult;
 use serde::{Deserialize, Serialize};
@@ -25,8 +25,6 @@ pub struct TargetCache {
     dir: Option<PathBuf>,
     /// No directory because none could be found (not by choice).
     unset: bool,
-    /// Entries found wrong since the last [`TargetCache::take_warnings`].
-    warnings: Arc<Mutex<Vec<String>>>,
     /// [`TargetCache::unwritable`] found the directory unwritable, and the
     /// user was told once: each entry's store failing is not told again.
     told_unwritable: Arc<AtomicBool>,
@@ -111,17 +109,12 @@ impl TargetCache {
         ))
     }
 
-    /// What was found wrong in the cache since the last call (each an
-    /// entry that did not verify, and was searched again): for the user.
-    pub fn take_warnings(&self) -> Vec<String> {
-        std::mem::take(&mut *self.warnings.lock().unwrap_or_else(|e| e.into_inner()))
-    }
-
-    fn warn(&self, text: String) {
-        self.warnings
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .push(text);
+    /// The cache as a decoder's preparation uses it, each warning (an
+    /// entry that did not verify and was searched again, an entry that
+    /// could not be stored) told to `warn` as it happens, on the thread
+    /// that found it.
+    pub fn reporting<'a>(&'a self, warn: &'a (dyn Fn(&str) + Sync)) -> Reporting<'a> {
+        Reporting { cache: self, warn }
     }
 
     /// The cache directory, if any.
@@ -138,14 +131,21 @@ impl TargetCache {
     }
 }
 
-impl TargetingCache for TargetCache {
+/// A [`TargetCache`] that tells its warnings as they happen
+/// ([`TargetCache::reporting`]).
+#[derive(Clone, Copy)]
+pub struct Reporting<'a> {
+    cache: &'a TargetCache,
+    warn: &'a (dyn Fn(&str) + Sync),
+}
+
+impl TargetingCache for Reporting<'_> {
     /// Looks `request` up in `kind-HASH.json` under the cache directory
     /// (the request text is kept in the file and must match), and has
     /// `verify` evaluate the entry's ratio again: an entry whose figures do
-    /// not come back is a miss, with a warning naming it (see
-    /// [`TargetCache::take_warnings`]). A miss searches and stores the
-    /// result atomically, and a store that fails (with a warning) only
-    /// costs the next run a search.
+    /// not come back is a miss, with a warning naming it. A miss searches
+    /// and stores the result atomically, and a store that fails (with a
+    /// warning) only costs the next run a search.
     fn get_or_search(
         &self,
         kind: &str,
@@ -153,7 +153,8 @@ impl TargetingCache for TargetCache {
         search: &mut dyn FnMut() -> Result<TargetingResult>,
         verify: &mut dyn FnMut(&TargetingResult) -> Result<Option<String>>,
     ) -> Result<(TargetingResult, bool)> {
-        let Some(dir) = &self.dir else {
+        let cache = self.cache;
+        let Some(dir) = &cache.dir else {
             return Ok((search()?, false));
         };
         let request = format!("{kind} v1 {request}");
@@ -173,7 +174,7 @@ impl TargetingCache for TargetCache {
                     errp_bci::ratio_text(entry.result.ratio)
                 ),
             };
-            self.warn(format!(
+            (self.warn)(&format!(
                 "the cached targeting {} is not what its search finds: {why}; searching again \
                  and replacing it",
                 path.display()
@@ -184,10 +185,10 @@ impl TargetingCache for TargetCache {
         // with a warning. (serde_json's `float_roundtrip` makes a stored
         // ratio read back bit for bit, so a hit gives what this miss gives.)
         let entry = Entry { request, result };
-        if let Err(e) = Self::store(&path, &entry)
-            && !self.told_unwritable.load(Ordering::Relaxed)
+        if let Err(e) = TargetCache::store(&path, &entry)
+            && !cache.told_unwritable.load(Ordering::Relaxed)
         {
-            self.warn(format!(
+            (self.warn)(&format!(
                 "the targeting {} could not be stored in the cache ({e}); the results are \
                  the same, and the next sweep searches it again",
                 path.display()
@@ -223,6 +224,38 @@ fn read_entry(path: &Path) -> std::io::Result<String> {
 mod tests {
     use super::*;
     use errp_bci::Accuracy;
+
+    /// A cache whose warnings are kept, to be taken.
+    struct Watched {
+        cache: TargetCache,
+        warnings: std::sync::Mutex<Vec<String>>,
+    }
+
+    impl Watched {
+        fn new(dir: impl Into<PathBuf>) -> Self {
+            Self {
+                cache: TargetCache::new(dir),
+                warnings: Default::default(),
+            }
+        }
+
+        fn get_or_search(
+            &self,
+            kind: &str,
+            request: &str,
+            search: &mut dyn FnMut() -> Result<TargetingResult>,
+            verify: &mut dyn FnMut(&TargetingResult) -> Result<Option<String>>,
+        ) -> Result<(TargetingResult, bool)> {
+            let keep = |w: &str| self.warnings.lock().unwrap().push(w.to_string());
+            self.cache
+                .reporting(&keep)
+                .get_or_search(kind, request, search, verify)
+        }
+
+        fn take_warnings(&self) -> Vec<String> {
+            std::mem::take(&mut *self.warnings.lock().unwrap())
+        }
+    }
 
     fn result(ratio: f64) -> TargetingResult {
         let accuracy = Accuracy {
@@ -263,7 +296,7 @@ mod tests {
     #[test]
     fn a_hit_reads_back_bit_for_bit_and_a_damaged_entry_is_a_miss() {
         let dir = scratch("hit");
-        let cache = TargetCache::new(&dir);
+        let cache = Watched::new(&dir);
         let ratio = 0.1 + 0.2; // not a short decimal
         let (r, hit) = cache
             .get_or_search("k", "a", &mut || Ok(result(ratio)), &mut ok)
@@ -317,7 +350,7 @@ mod tests {
     #[test]
     fn an_entry_that_cannot_be_stored_is_a_warning() {
         let dir = scratch("store");
-        let cache = TargetCache::new(&dir);
+        let cache = Watched::new(&dir);
         let _ = cache
             .get_or_search("k", "a", &mut || Ok(result(0.25)), &mut ok)
             .unwrap();
@@ -348,7 +381,7 @@ mod tests {
     #[test]
     fn writers_of_one_entry_at_once_leave_it_whole() {
         let dir = scratch("writers");
-        let cache = TargetCache::new(&dir);
+        let cache = Watched::new(&dir);
         std::thread::scope(|s| {
             for _ in 0..8 {
                 s.spawn(|| {
@@ -385,15 +418,15 @@ mod tests {
             entries(&writable).is_empty(),
             "the write test leaves nothing"
         );
-        let unwritable = TargetCache::new("/proc/errp-no-cache");
-        let e = unwritable.problem().unwrap();
+        let unwritable = Watched::new("/proc/errp-no-cache");
+        let e = unwritable.cache.problem().unwrap();
         assert!(
             e.contains("/proc/errp-no-cache") && e.contains("--no-cache"),
             "{e}"
         );
         // Told once: its entries' stores failing are not warned of again,
         // while a store failing unannounced is.
-        let search = |cache: &TargetCache| {
+        let search = |cache: &Watched| {
             let (r, hit) = cache
                 .get_or_search("k", "a", &mut || Ok(result(0.5)), &mut ok)
                 .unwrap();
@@ -401,7 +434,7 @@ mod tests {
             cache.take_warnings()
         };
         assert_eq!(search(&unwritable), Vec::<String>::new());
-        let unannounced = search(&TargetCache::new("/proc/errp-no-cache"));
+        let unannounced = search(&Watched::new("/proc/errp-no-cache"));
         assert!(
             unannounced.len() == 1 && unannounced[0].contains("could not be stored"),
             "{unannounced:?}"
@@ -421,7 +454,7 @@ mod tests {
     #[test]
     fn an_entry_that_does_not_verify_is_a_miss_with_a_warning() {
         let dir = scratch("verify");
-        let cache = TargetCache::new(&dir);
+        let cache = Watched::new(&dir);
         let search = errp_bci::TargetingParams::default();
         // The "decoder": accuracy rises with the ratio; the true ratio of
         // the request is 0.3, which gives 75 %.

@@ -33,7 +33,7 @@ mod summary;
 mod table;
 mod writer;
 
-pub use cache::TargetCache;
+pub use cache::{Reporting, TargetCache};
 pub use errp_sim::task::DecoderInfo;
 pub use figure::sweep_plot;
 pub use finish::finish_dir;

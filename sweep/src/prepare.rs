@@ -33,10 +33,8 @@ pub(crate) fn prepare_all<T: Task>(
                 loop {
                     let i = next.fetch_add(1, Ordering::SeqCst);
                     let Some(&k) = order.get(i) else { break };
-                    let result = T::prepare(scenarios[k], shared, cache);
-                    for w in cache.take_warnings() {
-                        observer.warning(&w);
-                    }
+                    let warn = |w: &str| observer.warning(w);
+                    let result = T::prepare(scenarios[k], shared, &cache.reporting(&warn));
                     if let Ok((_, info)) = &result {
                         let done = ready.fetch_add(1, Ordering::SeqCst) + 1;
                         observer.decoder_ready(info, done, n);

@@ -241,11 +241,6 @@ impl EegGenerator {
         self.sample as f64 / self.params.sfreq_hz
     }
 
-    /// Index of the next sample to be generated.
-    pub fn sample_index(&self) -> u64 {
-        self.sample
-    }
-
     /// Schedules the ERP of an assessment. Its single-trial latency jitter and
     /// amplitude are drawn now, from the ERP stream, in scheduling order;
     /// then what the user makes of the action ([`Realism`](super::Realism):

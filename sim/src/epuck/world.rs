@@ -346,11 +346,6 @@ impl World {
         &self.arena
     }
 
-    /// The e-puck's body radius (m).
-    pub fn robot_radius_m(&self) -> f64 {
-        self.radius_m
-    }
-
     /// The physics time step (s).
     pub fn dt_secs(&self) -> f64 {
         f64::from(self.integration.dt)

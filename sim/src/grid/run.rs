@@ -17,6 +17,7 @@ use crate::grid::decoder::{
 };
 use crate::grid::episode::{GridDecoding, GridEpisodeResult, run_grid_episode_with};
 use crate::grid::scenario::{DecoderChoice, EegMode, GridScenario};
+use crate::key::StableKey;
 use crate::task::DecoderInfo;
 
 /// Everything a grid run produced.
@@ -116,33 +117,27 @@ pub const HELD_OUT_PER_CLASS: usize = 2000;
 
 /// The key of a grid scenario's calibration session: its user.
 fn session_key(s: &GridScenario) -> String {
-    format!("{}{}", s.seed, realism_key(s))
+    StableKey::new("grid-session", 1)
+        .int("seed", s.seed)
+        .realism(&s.realism)
+        .finish()
 }
 
-/// The user's realism in a key: nothing for the ideal user, so that the
-/// keys of an ideal user are what they were before realism existed.
-fn realism_key(s: &GridScenario) -> String {
-    if s.realism.is_ideal() {
-        String::new()
-    } else {
-        crate::key::StableKey::new("user", 1)
-            .realism(&s.realism)
-            .finish()
-    }
+/// The key of a bank of `per_class` epochs of each class streamed for `s`
+/// under `kind` (what they depend on).
+fn epochs_key(kind: &str, s: &GridScenario, per_class: usize) -> String {
+    StableKey::new(kind, 1)
+        .int("seed", s.seed)
+        .int("per_class", per_class as u64)
+        .float("interval_min_secs", s.params.interval_min_secs)
+        .float("interval_max_secs", s.params.interval_max_secs)
+        .realism(&s.realism)
+        .finish()
 }
 
-/// The key of a grid scenario's held-out epochs (what they depend on).
+/// The key of a grid scenario's held-out epochs.
 fn held_out_key(s: &GridScenario) -> String {
-    format!(
-        "{:?}{}",
-        (
-            s.seed,
-            HELD_OUT_PER_CLASS,
-            s.params.interval_min_secs,
-            s.params.interval_max_secs
-        ),
-        realism_key(s)
-    )
+    epochs_key("grid-held-out", s, HELD_OUT_PER_CLASS)
 }
 
 /// The epochs on which the targeting of `s` scores its decoder: streamed as
@@ -164,16 +159,7 @@ fn build_held_out(
 
 /// The key of a grid scenario's epoch bank: what its epochs depend on.
 fn bank_key(s: &GridScenario) -> String {
-    format!(
-        "{:?}{}",
-        (
-            s.seed,
-            s.bank_per_class,
-            s.params.interval_min_secs,
-            s.params.interval_max_secs
-        ),
-        realism_key(s)
-    )
+    epochs_key("grid-bank", s, s.bank_per_class)
 }
 
 /// The calibration session of `setup` and `seed`, streamed as its noise and
@@ -449,4 +435,32 @@ pub fn run_grid_scenario_with(
         out.push(r);
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The keys of what grid decoders share are stable, versioned keys:
+    /// written field by field, floats by their bits, pinned here so that a
+    /// change of what they hold is made on purpose (with a new version).
+    #[test]
+    fn the_shared_parts_have_stable_keys() {
+        let text = include_str!("../../../scenarios/variants/grid_fixed_goals_ideal.toml");
+        let s = GridScenario::parse(text, std::path::Path::new("ideal.toml")).unwrap();
+        assert_eq!(session_key(&s), "grid-session/v1;seed=1");
+        let intervals = "interval_min_secs=f:4008000000000000;interval_max_secs=f:400c000000000000";
+        assert_eq!(
+            held_out_key(&s),
+            format!("grid-held-out/v1;seed=1;per_class=2000;{intervals}")
+        );
+        assert_eq!(
+            bank_key(&s),
+            format!("grid-bank/v1;seed=1;per_class=1000;{intervals}")
+        );
+        let mut real = s.clone();
+        real.realism.background_drift = 0.3;
+        assert!(session_key(&real).starts_with("grid-session/v1;seed=1;realism="));
+        assert_ne!(held_out_key(&real), held_out_key(&s));
+    }
 }

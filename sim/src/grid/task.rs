@@ -109,24 +109,16 @@ impl Task for GridTask {
     type Runner = GridRunner;
 
     fn decoder_key(s: &GridScenario) -> String {
-        let decoder = match s.decoder {
-            DecoderChoice::Eeg => "eeg",
-            DecoderChoice::Oracle => "oracle",
-        };
         let p_error = match s.p_error {
             PErrorChoice::Sigmoid => "sigmoid",
             PErrorChoice::Platt => "platt",
         };
-        let eeg = match s.eeg {
-            EegMode::Stream => "stream",
-            EegMode::Bank => "bank",
-        };
         StableKey::new("grid-decoder", 1)
             .float("accuracy", s.accuracy)
             .int("seed", s.seed)
-            .text("decoder", decoder)
+            .text("decoder", s.decoder.key())
             .text("p_error", p_error)
-            .text("eeg", eeg)
+            .text("eeg", s.eeg.key())
             .int("bank_per_class", s.bank_per_class as u64)
             .float("interval_min_secs", s.params.interval_min_secs)
             .float("interval_max_secs", s.params.interval_max_secs)

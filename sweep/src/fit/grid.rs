@@ -517,7 +517,9 @@ fn fit_users(
             };
             let row = &rows[subject];
             let s = scenario(row.accuracy, seed, &row.subject, base, &spec.realism);
-            let prepared = prepare_grid_decoder(&s, &GridShared::default(), cache, |_| {})?;
+            let warn = |w: &str| observer.warning(w);
+            let cache = cache.reporting(&warn);
+            let prepared = prepare_grid_decoder(&s, &GridShared::default(), &cache, |_| {})?;
             observer.decoder_ready(
                 &prepared.info(&s),
                 done.fetch_add(1, Ordering::Relaxed) + 1,
