@@ -23,6 +23,19 @@
 //! * the information one decoded action carries about the user's verdict
 //!   ([`ActionInformation`]);
 //! * the subjects of Table 1 ([`subject`]) and EDF+ export ([`EdfWriter`]).
+//!
+//! ```
+//! use errp_bci::{MeanAccuracy, RequestedAccuracy, subject};
+//!
+//! // An accuracy is checked where it enters: the mean of the two classes'
+//! // rates, strictly between chance and 1 (1 only for the grid's oracle).
+//! assert!(MeanAccuracy::new(0.7438).is_ok());
+//! assert!(MeanAccuracy::new(0.5).is_err());
+//! assert!(matches!(RequestedAccuracy::new(1.0), Ok(RequestedAccuracy::Perfect)));
+//! // Table 1's subjects, with the accuracies the paper reports.
+//! let s1 = subject("S1").unwrap();
+//! assert_eq!(s1.fixed_goals_pct, 83.14);
+//! ```
 
 #![warn(clippy::unwrap_used, clippy::print_stdout, clippy::iter_over_hash_type)]
 // No function over 120 lines of code (clippy.toml) outside the tests.

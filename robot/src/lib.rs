@@ -20,6 +20,18 @@
 //! assessment; the grid controller also by Thompson sampling (greedy towards
 //! a goal drawn from the belief, kept until the user objects or the belief
 //! moves away from it).
+//!
+//! ```
+//! use errp_robot::Belief;
+//!
+//! // Two goals; the device's last action was an error for the first goal
+//! // and correct for the second, and the decoder said "error" with p = 0.8:
+//! // the likelihood of each goal is what the decoder's output makes of it.
+//! let mut belief = Belief::uniform(2);
+//! belief.update(&[0.8, 0.2]).unwrap();
+//! let p = belief.probabilities();
+//! assert!((p[0] - 0.8).abs() < 1e-12 && (p[1] - 0.2).abs() < 1e-12);
+//! ```
 
 #![warn(clippy::unwrap_used, clippy::print_stdout, clippy::iter_over_hash_type)]
 // No function over 120 lines of code (clippy.toml) outside the tests.

@@ -18,6 +18,43 @@
 //! - at the top: scenario files of either task, the paper's numbers,
 //!   statistics, atomic output files, the host and process behind files
 //!   (`host`) and the error type.
+//!
+//! One path from a scenario to its result, as `errp run` and the Python
+//! package take it: the built-in grid scenario, with the oracle decoder at
+//! 90 %, run with nothing watching and nothing recorded.
+//!
+//! ```
+//! use errp_bci::RequestedAccuracy;
+//! use errp_sim::grid::DecoderChoice;
+//! use errp_sim::{
+//!     RunOptions, RunOutcome, RunProvenance, ScenarioInput, ScenarioSource, SetterNames,
+//!     run_scenario,
+//! };
+//!
+//! const NAMES: SetterNames = SetterNames {
+//!     accuracy: "accuracy",
+//!     seed: "seed",
+//!     runs: "runs",
+//!     decoder: "decoder",
+//!     eeg: "eeg",
+//!     save: "save",
+//! };
+//! let input = ScenarioInput {
+//!     accuracy: Some(RequestedAccuracy::new(0.9).unwrap()),
+//!     decoder: Some(DecoderChoice::Oracle),
+//!     ..ScenarioInput::new(ScenarioSource::file_or_built_in(None, false))
+//! };
+//! let loaded = input.load(&NAMES).unwrap();
+//! let options = RunOptions {
+//!     save: None,
+//!     provenance: &RunProvenance::default(),
+//!     names: &NAMES,
+//! };
+//! let run = run_scenario(loaded, options, &()).unwrap();
+//! let RunOutcome::Grid(report) = run.outcome else { unreachable!() };
+//! assert_eq!(report.episodes.len(), 5);
+//! assert!(report.episodes.iter().filter(|e| e.reached()).count() >= 3);
+//! ```
 
 #![warn(clippy::unwrap_used, clippy::print_stdout, clippy::iter_over_hash_type)]
 // No function over 120 lines of code (clippy.toml) outside the tests.

@@ -11,6 +11,15 @@
 //! Episodes are run by [`errp_sim`]'s task modules; this crate adds the
 //! levels, the ordered and resumable `episodes.csv`, the target cache,
 //! sharding and merging, the summaries and the plots.
+//!
+//! ```
+//! use errp_sweep::{InputNames, parse_accuracies};
+//!
+//! // A sweep's accuracy levels, as `--accuracy` and `accuracy=` give them.
+//! let levels = parse_accuracies("0.6:0.9:0.1", &InputNames::CLI).unwrap();
+//! assert_eq!(levels.len(), 4);
+//! assert!(parse_accuracies("0.4", &InputNames::CLI).is_err());
+//! ```
 
 #![warn(clippy::unwrap_used, clippy::print_stdout, clippy::iter_over_hash_type)]
 // No function over 120 lines of code (clippy.toml) outside the tests.

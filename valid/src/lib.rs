@@ -8,6 +8,31 @@
 //! The parameter structs keep their public fields and their `Default`, for
 //! building them; [`Check`] is what makes them valid.
 
+//!
+//! ```
+//! use errp_valid::{Check, Valid};
+//!
+//! /// A probability, checked once.
+//! #[derive(Debug, Clone, Copy, PartialEq)]
+//! struct Rate(f64);
+//!
+//! impl Check for Rate {
+//!     type Error = String;
+//!     fn check(&self) -> Result<(), String> {
+//!         if (0.0..=1.0).contains(&self.0) {
+//!             Ok(())
+//!         } else {
+//!             Err(format!("rate = {} is invalid: expected 0 to 1", self.0))
+//!         }
+//!     }
+//! }
+//!
+//! let rate = Valid::new(Rate(0.25)).unwrap();
+//! assert_eq!(rate.0, 0.25);
+//! assert!(Valid::new(Rate(1.5)).is_err());
+//! // A changed copy is checked again.
+//! assert!(rate.with(|r| r.0 = -1.0).is_err());
+//! ```
 #![cfg_attr(not(test), warn(clippy::too_many_lines))]
 
 use std::fmt;
