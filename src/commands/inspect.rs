@@ -4,9 +4,9 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use errp_sim::epuck::{EpuckSummaryReport, summarise};
-use errp_sim::grid::{GridEpisodeHeader, GridEpisodeRow, GridRunReport};
-use errp_sim::inspect::{CsvTable, Recording, Runs, csv_tables, phase_secs};
+use errp_sim::inspect::{
+    Comparison, CsvTable, Recording, RecordingHeadline, RecordingReport, Runs, csv_tables,
+};
 use errp_sim::{PendingFile, create_dirs};
 use errp_sweep::{ArenaPlot, GridPlot, RunPath};
 
@@ -108,13 +108,13 @@ pub(crate) fn inspect(args: &InspectArgs) -> Result<()> {
         pending.commit().context("--figure")?;
     }
     if recs.len() == 1 {
-        describe(&recs[0])?;
+        out!("{}", RecordingReport(&recs[0]))?;
     } else {
         for r in &recs {
-            outln!("{}", headline(r))?;
+            outln!("{}", RecordingHeadline(r))?;
         }
         outln!()?;
-        compare(&recs)?;
+        out!("{}", Comparison(&recs))?;
     }
     for (dir, format) in &outputs {
         outln!("Wrote the tables to {} ({})", dir.display(), format.name())?;
@@ -134,233 +134,6 @@ pub(crate) fn inspect(args: &InspectArgs) -> Result<()> {
 enum FigureKind {
     Png,
     Svg,
-}
-
-/// One line on a recording: its file, task, scenario, runs and maker.
-fn headline(r: &Recording) -> String {
-    let p = &r.provenance;
-    format!(
-        "{}: {} recording of `{}`, {} run(s), seed {}, by errp {} (commit {})",
-        r.path.display(),
-        if p.task == "epuck" { "e-puck" } else { "grid" },
-        p.scenario_name,
-        p.runs,
-        p.seed,
-        p.errp_version,
-        p.commit
-    )
-}
-
-/// The full description of one recording: provenance, how to run it again,
-/// and what `errp run` printed, recomputed from the recording.
-fn describe(r: &Recording) -> Result<()> {
-    let p = &r.provenance;
-    outln!("{}", headline(r))?;
-    outln!("  made by:  {}", p.command.join(" "))?;
-    let runs = if p.task == "epuck" {
-        format!(" --runs {}", p.runs)
-    } else {
-        String::new()
-    };
-    match &p.agent {
-        Some(agent) => outln!(
-            "  driven by: {agent}; each episode's seed is in the runs table \
-             (--csv), the actions in the trajectory"
-        )?,
-        None => outln!(
-            "  run again: errp inspect {} --scenario > scenario.toml && errp run scenario.toml \
-             --seed {}{runs}",
-            r.path.display(),
-            p.seed
-        )?,
-    }
-    outln!("Recomputed from the recording:")?;
-    out!("{}", p.decoder_summary)?;
-    match &r.runs {
-        Runs::Epuck { scenario, results } => {
-            let layout = &scenario.layout;
-            crate::commands::run::print_epuck_runs(results, layout)?;
-            let summary = summarise(results);
-            let t_e = r
-                .tables
-                .get(errp_sim::record::paths::RUNS)
-                .and_then(|t| match t.column("t_e") {
-                    Some(errp_sim::record::data::Column::F64(v)) => v.first().copied(),
-                    _ => None,
-                })
-                .unwrap_or(f64::NAN);
-            out!(
-                "{}",
-                EpuckSummaryReport {
-                    summary: &summary,
-                    scenario: &scenario.name,
-                    goal: &layout.goals()[scenario.episode.goal].name,
-                    t_e,
-                }
-            )?;
-            outln!()?;
-            outln!(
-                "{:>4}  {:>8}  {:>11} {:>11} {:>11}",
-                "run",
-                "path (m)",
-                "turning (s)",
-                "driving (s)",
-                "stopped (s)"
-            )?;
-            for (k, (result, [turning, driving, stopped])) in
-                results.iter().zip(phase_secs(r)).enumerate()
-            {
-                outln!(
-                    "{:>4}  {:>8.2}  {:>11.1} {:>11.1} {:>11.1}",
-                    k + 1,
-                    result.path_m,
-                    turning,
-                    driving,
-                    stopped
-                )?;
-            }
-        }
-        Runs::Grid { scenario, results } => {
-            outln!("{GridEpisodeHeader}")?;
-            for (k, e) in results.iter().enumerate() {
-                outln!("{}", GridEpisodeRow(k, e))?;
-            }
-            let report = GridRunReport {
-                scenario: (**scenario).clone(),
-                calibration: None,
-                episodes: results.clone(),
-            };
-            out!("{report}")?;
-        }
-    }
-    Ok(())
-}
-
-/// The recordings' summaries side by side.
-fn compare(recs: &[Recording]) -> Result<()> {
-    let name = |r: &Recording| {
-        r.path.file_name().map_or_else(
-            || r.path.display().to_string(),
-            |n| n.to_string_lossy().into_owned(),
-        )
-    };
-    let mut rows: Vec<(String, Vec<String>)> = Vec::new();
-    let mut add = |label: &str, values: Vec<String>| rows.push((label.to_string(), values));
-    add(
-        "scenario",
-        recs.iter()
-            .map(|r| r.provenance.scenario_name.clone())
-            .collect(),
-    );
-    add(
-        "runs",
-        recs.iter().map(|r| r.n_runs().to_string()).collect(),
-    );
-    let stat = |f: &dyn Fn(&Recording) -> Option<String>| {
-        recs.iter()
-            .map(|r| f(r).unwrap_or_else(|| "-".into()))
-            .collect::<Vec<_>>()
-    };
-    add(
-        "goals reached",
-        stat(&|r| match &r.runs {
-            Runs::Epuck { results, .. } => Some(format!(
-                "{} / {}",
-                results.iter().filter(|x| x.reached()).count(),
-                results.len()
-            )),
-            Runs::Grid { results, .. } => Some(format!(
-                "{} / {}",
-                results.iter().filter(|x| x.reached()).count(),
-                results.len()
-            )),
-        }),
-    );
-    add(
-        "median time (s)",
-        stat(&|r| match &r.runs {
-            Runs::Epuck { results, .. } => {
-                Some(errp_sim::fixed_or_dash(summarise(results).median_secs, 1))
-            }
-            Runs::Grid { results, .. } => Some(errp_sim::fixed_or_dash(
-                errp_sim::median(&results.iter().map(|e| e.total_secs).collect::<Vec<_>>()),
-                1,
-            )),
-        }),
-    );
-    add(
-        "median detections",
-        stat(&|r| match &r.runs {
-            Runs::Epuck { results, .. } => Some(errp_sim::fixed_or_dash(
-                summarise(results).median_detected,
-                1,
-            )),
-            Runs::Grid { .. } => None,
-        }),
-    );
-    add(
-        "median false",
-        stat(&|r| match &r.runs {
-            Runs::Epuck { results, .. } => {
-                Some(errp_sim::fixed_or_dash(summarise(results).median_false, 1))
-            }
-            Runs::Grid { .. } => None,
-        }),
-    );
-    add(
-        "hit rate (%)",
-        stat(&|r| match &r.runs {
-            Runs::Epuck { results, .. } => Some(errp_sim::fixed_or_dash(
-                100.0 * summarise(results).hit_rate,
-                1,
-            )),
-            Runs::Grid { .. } => None,
-        }),
-    );
-    add(
-        "false alarms/min",
-        stat(&|r| match &r.runs {
-            Runs::Epuck { results, .. } => Some(errp_sim::fixed_or_dash(
-                summarise(results).false_alarms_per_min,
-                2,
-            )),
-            Runs::Grid { .. } => None,
-        }),
-    );
-    add(
-        "median actions",
-        stat(&|r| match &r.runs {
-            Runs::Grid { results, .. } => Some(errp_sim::fixed_or_dash(
-                errp_sim::median(&results.iter().map(|e| e.actions as f64).collect::<Vec<_>>()),
-                1,
-            )),
-            Runs::Epuck { .. } => None,
-        }),
-    );
-    let widths: Vec<usize> = recs
-        .iter()
-        .enumerate()
-        .map(|(k, r)| {
-            rows.iter()
-                .map(|(_, v)| v[k].len())
-                .chain([name(r).len()])
-                .max()
-                .unwrap_or(8)
-        })
-        .collect();
-    let mut line = format!("{:<18}", "");
-    for (k, r) in recs.iter().enumerate() {
-        line.push_str(&format!("  {:>w$}", name(r), w = widths[k]));
-    }
-    outln!("{line}")?;
-    for (label, values) in &rows {
-        let mut line = format!("{label:<18}");
-        for (k, v) in values.iter().enumerate() {
-            line.push_str(&format!("  {:>w$}", v, w = widths[k]));
-        }
-        outln!("{line}")?;
-    }
-    Ok(())
 }
 
 /// A format of the tidy tables.

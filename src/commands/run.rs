@@ -4,7 +4,7 @@ use std::sync::Mutex;
 
 use anyhow::Result;
 use errp_bci::{OnlineStep, RequestedAccuracy, TargetingStep};
-use errp_sim::epuck::{EpuckRunHeader, EpuckRunRow, EpuckSummaryReport, summarise};
+use errp_sim::epuck::{EpuckRunsTable, EpuckSummaryReport, summarise};
 use errp_sim::grid::{DecoderChoice, GridEpisodeHeader, GridEpisodeResult, GridEpisodeRow};
 use errp_sim::{
     AnyScenario, RunObserver, RunOptions, RunOutcome, RunProvenance, ScenarioInput, ScenarioSource,
@@ -70,7 +70,13 @@ pub(crate) fn run(args: &RunArgs) -> Result<()> {
         RunOutcome::Grid(report) => out!("{report}")?,
         RunOutcome::Epuck(r) => {
             let s = &r.scenario;
-            print_epuck_runs(&r.results, &s.layout)?;
+            out!(
+                "{}",
+                EpuckRunsTable {
+                    results: &r.results,
+                    layout: &s.layout
+                }
+            )?;
             out!(
                 "{}",
                 EpuckSummaryReport {
@@ -199,24 +205,4 @@ impl RunObserver for Printer {
             errln!("  running {runs} runs in parallel");
         }
     }
-}
-
-/// Prints the per-run table of e-puck `results` (`errp run`, and `errp
-/// inspect` from a recording).
-pub(crate) fn print_epuck_runs(
-    results: &[errp_sim::epuck::EpuckEpisodeResult],
-    layout: &errp_robot::GoalLayout,
-) -> Result<()> {
-    outln!("{EpuckRunHeader}")?;
-    for (index, result) in results.iter().enumerate() {
-        outln!(
-            "{}",
-            EpuckRunRow {
-                index,
-                result,
-                layout
-            }
-        )?;
-    }
-    Ok(())
 }

@@ -34,7 +34,7 @@ pub use plant::{
     EpuckDriver, EpuckPlant, PHYSICS_DT_SECS, PlantWindow, STEPS_PER_WINDOW, WINDOW_STEP_SECS,
     WindowDecoder,
 };
-pub use report::{EpuckRunHeader, EpuckRunRow, EpuckSummaryReport};
+pub use report::{EpuckRunHeader, EpuckRunRow, EpuckRunsTable, EpuckSummaryReport};
 pub use run::{
     EpuckRunsObserver, EpuckSummary, PreparedEpuck, epuck_run_seed, finish_continuous_decoder,
     prepare_continuous_decoder, prepare_continuous_decoder_with, prepare_epuck_decoder,

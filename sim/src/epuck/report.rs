@@ -72,6 +72,32 @@ impl fmt::Display for EpuckRunRow<'_> {
     }
 }
 
+/// The per-run table: the header, then one line per run.
+pub struct EpuckRunsTable<'a> {
+    /// The runs' results, in run order.
+    pub results: &'a [EpuckEpisodeResult],
+    /// The goal layout, for the city names.
+    pub layout: &'a GoalLayout,
+}
+
+impl fmt::Display for EpuckRunsTable<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "{EpuckRunHeader}")?;
+        for (index, result) in self.results.iter().enumerate() {
+            writeln!(
+                f,
+                "{}",
+                EpuckRunRow {
+                    index,
+                    result,
+                    layout: self.layout
+                }
+            )?;
+        }
+        Ok(())
+    }
+}
+
 /// The summary of an e-puck scenario's runs, beside the paper's run of the
 /// same name if it has one.
 pub struct EpuckSummaryReport<'a> {

@@ -18,9 +18,11 @@ use crate::record::paths;
 use crate::scenario::AnyScenario;
 
 mod read;
+mod report;
 mod tables;
 
 pub use read::{MAX_RECORDING_BYTES, Table};
+pub use report::{Comparison, RecordingHeadline, RecordingReport};
 pub use tables::{CsvTable, PARQUET_TABLE_KEY, csv_tables, phase_secs};
 
 /// Why a recording cannot be read.

@@ -7,6 +7,7 @@ mod files;
 mod grid;
 mod grid_pairs;
 mod grid_trial;
+mod report;
 mod surface;
 
 pub use density::{Observed, SimRun, log_kde, log_likelihood, percentile_of, quantile, resample};
@@ -23,4 +24,5 @@ pub use grid::{
 };
 pub use grid_pairs::PairsFit;
 pub use grid_trial::TrialLatencyFit;
+pub use report::{EpuckFitReport, GridFitReport};
 pub use surface::{CHI2_1_95, Surface, argmax};
