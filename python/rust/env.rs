@@ -13,6 +13,7 @@ use errp_sim::grid::{
     AssessmentDecoder, GridEnvironment, GridScenario, GridTask as GridInfo, prepare_decoder,
 };
 use errp_sim::task::Task;
+use errp_sim::{AgentInfo, EpuckAgentRecording, GridAgentRecording};
 use numpy::PyArray2;
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
@@ -22,51 +23,14 @@ use crate::convert::{Keys, block_to_numpy, load_epuck, load_grid, py_err, value_
 use crate::interrupt::{CALIBRATING, Meter, long_shown};
 use crate::run::check_save;
 
-/// The most episodes a grid environment records (as `errp run --save`).
-#[cfg(feature = "rerun")]
-const MAX_SAVED_GRID_EPISODES: usize = 5_000;
-/// The most episodes an e-puck environment records (as `errp.run(save=)`:
-/// each adds about 2.5 MB).
-#[cfg(feature = "rerun")]
-const MAX_SAVED_EPUCK_EPISODES: usize = 100;
-
-/// The provenance of an environment's recording.
-#[cfg(feature = "rerun")]
-fn env_provenance(
-    task: &str,
-    name: &str,
-    text: String,
-    seed: u64,
-    class: &str,
-    id: &str,
-) -> errp_sim::record::data::Provenance {
-    let mut p = crate::run::provenance(task, name, text, seed, &format!("errp.gym.{class}"));
-    p.agent = Some(format!(
-        "an agent of the caller's own in errp.gym.{class} ({id}), not the shared control"
-    ));
-    p
-}
-
-/// A grid environment's recording: each episode written when it ends.
-#[cfg(feature = "rerun")]
-struct GridSave {
-    recorder: errp_sim::grid::GridRecorder,
-    provenance: errp_sim::record::data::Provenance,
-    /// The episode being stepped is recorded (under the cap) and not yet
-    /// written.
-    open: bool,
-}
-
-/// An e-puck environment's recording: each episode streamed as it runs.
-#[cfg(feature = "rerun")]
-struct EpuckSave {
-    file: errp_sim::record::RrdFile,
-    recorder: errp_sim::epuck::EpuckRecorder,
-    provenance: errp_sim::record::data::Provenance,
-    /// Episodes recorded to their end.
-    runs: usize,
-    /// The episode being stepped is recorded and has not ended.
-    open: bool,
+/// Who drives an environment's recorded episodes.
+fn agent(class: &str, id: &str) -> AgentInfo {
+    AgentInfo {
+        command: vec![format!("python: errp.gym.{class}")],
+        agent: format!(
+            "an agent of the caller's own in errp.gym.{class} ({id}), not the shared control"
+        ),
+    }
 }
 
 /// What `close()` says of a recording: the path written, or why not.
@@ -110,8 +74,7 @@ pub(crate) struct GridEnvCore {
     episode: Option<GridEnvironment>,
     /// The seed of the episode being stepped.
     seed: u64,
-    #[cfg(feature = "rerun")]
-    save: Option<GridSave>,
+    save: GridAgentRecording,
 }
 
 /// A cell from `(x, y)`.
@@ -153,27 +116,9 @@ impl GridEnvCore {
             overrides,
             "the grid environment",
         )?;
-        #[cfg(feature = "rerun")]
-        let save = match save {
-            Some(path) => {
-                let file = errp_sim::grid::grid_recording(&path).map_err(py_err)?;
-                Some(GridSave {
-                    recorder: errp_sim::grid::GridRecorder::new(file).map_err(py_err)?,
-                    provenance: env_provenance(
-                        "grid",
-                        &s.name,
-                        text,
-                        s.seed,
-                        "GridEnv",
-                        "errp/Grid-v0",
-                    ),
-                    open: false,
-                })
-            }
-            None => None,
-        };
-        #[cfg(not(feature = "rerun"))]
-        let _ = (save, text);
+        let save =
+            GridAgentRecording::create(save.as_deref(), &s, text, agent("GridEnv", "errp/Grid-v0"))
+                .map_err(py_err)?;
         let key = GridInfo::decoder_key(&s);
         let decoder = match cached(&GRID_DECODERS, &key) {
             Some(d) => d,
@@ -191,7 +136,6 @@ impl GridEnvCore {
             decoder,
             episode: None,
             seed: 0,
-            #[cfg(feature = "rerun")]
             save,
         })
     }
@@ -208,7 +152,6 @@ impl GridEnvCore {
     ) -> PyResult<((usize, usize), (usize, usize))> {
         let (start, goal) = (cell("start", start)?, cell("goal", goal)?);
         self.write_episode().map_err(py_err)?;
-        #[allow(unused_mut)]
         let mut env = GridEnvironment::new(
             self.decoder.clone(),
             self.scenario.params,
@@ -217,13 +160,7 @@ impl GridEnvCore {
             seed,
         )
         .map_err(py_err)?;
-        #[cfg(feature = "rerun")]
-        if let Some(save) = self.save.as_mut() {
-            save.open = save.recorder.episodes() < MAX_SAVED_GRID_EPISODES;
-            if save.open {
-                env.keep_steps();
-            }
-        }
+        self.save.start(&mut env);
         let (c, g) = (env.cell(), env.goal());
         self.episode = Some(env);
         self.seed = seed;
@@ -241,11 +178,7 @@ impl GridEnvCore {
     /// (5000 are).
     #[getter]
     fn recording_full(&self) -> bool {
-        #[cfg(feature = "rerun")]
-        if let Some(save) = &self.save {
-            return save.recorder.episodes() >= MAX_SAVED_GRID_EPISODES;
-        }
-        false
+        self.save.full()
     }
 
     /// Takes action 0-4 (up, down, left, right, goal reached) and returns
@@ -330,28 +263,18 @@ impl GridEnvCore {
     /// Records the episode in progress, if it is recorded, took an action
     /// and is not written yet.
     fn write_episode(&mut self) -> errp_sim::Result<()> {
-        #[cfg(feature = "rerun")]
-        if let (Some(save), Some(env)) = (self.save.as_mut(), self.episode.as_ref())
-            && save.open
-            && env.actions() > 0
-        {
-            save.open = false;
-            save.recorder
-                .episode(self.seed, self.scenario.params.epoch_secs, &env.result())?;
+        match self.episode.as_ref() {
+            Some(env) => self
+                .save
+                .write(self.seed, self.scenario.params.epoch_secs, env),
+            None => Ok(()),
         }
-        Ok(())
     }
 
     /// Writes what is left and moves the recording into place.
     fn finish(&mut self) -> errp_sim::Result<Option<PathBuf>> {
         self.write_episode()?;
-        #[cfg(feature = "rerun")]
-        if let Some(save) = self.save.take()
-            && save.recorder.episodes() > 0
-        {
-            return save.recorder.finish(&save.provenance).map(Some);
-        }
-        Ok(None)
+        self.save.finish()
     }
 }
 
@@ -369,8 +292,7 @@ pub(crate) struct EpuckEnvCore {
     scenario: EpuckScenario,
     decoder: Arc<ContinuousDecoder>,
     episode: Option<EpuckEnvironment>,
-    #[cfg(feature = "rerun")]
-    save: Option<EpuckSave>,
+    save: EpuckAgentRecording,
 }
 
 #[pymethods]
@@ -409,37 +331,18 @@ impl EpuckEnvCore {
                 keep(&EPUCK_DECODERS, key, Arc::new(d))
             }
         };
-        #[cfg(feature = "rerun")]
-        let save = match save {
-            Some(path) => {
-                let file = errp_sim::epuck::epuck_agent_recording(&path).map_err(py_err)?;
-                let t_e = decoder.detector_t_e(&s.params, false);
-                let recorder = errp_sim::epuck::EpuckRecorder::new(&file, &s.arena, &s.layout, t_e)
-                    .map_err(py_err)?;
-                Some(EpuckSave {
-                    file,
-                    recorder,
-                    provenance: env_provenance(
-                        "epuck",
-                        &s.name,
-                        text,
-                        s.seed,
-                        "EpuckEnv",
-                        "errp/Epuck-v0",
-                    ),
-                    runs: 0,
-                    open: false,
-                })
-            }
-            None => None,
-        };
-        #[cfg(not(feature = "rerun"))]
-        let _ = (save, text);
+        let save = EpuckAgentRecording::create(
+            save.as_deref(),
+            &s,
+            decoder.detector_t_e(&s.params, false),
+            text,
+            agent("EpuckEnv", "errp/Epuck-v0"),
+        )
+        .map_err(py_err)?;
         Ok(Self {
             scenario: s,
             decoder,
             episode: None,
-            #[cfg(feature = "rerun")]
             save,
         })
     }
@@ -453,25 +356,8 @@ impl EpuckEnvCore {
         let env = EpuckEnvironment::new(self.decoder.clone(), &self.scenario, goal, seed)
             .map_err(py_err)?;
         self.end_episode();
-        #[cfg(feature = "rerun")]
-        if let Some(save) = self.save.as_mut() {
-            save.open = save.runs < MAX_SAVED_EPUCK_EPISODES;
-            if save.open {
-                use errp_sim::epuck::EpuckObserver;
-                let layout = &self.scenario.layout;
-                let name = &layout.goals()[env.goal()].name;
-                save.recorder.next_run(
-                    &format!(
-                        "episode {}: the user wants {name} (an agent drives)",
-                        save.runs + 1
-                    ),
-                    seed,
-                );
-                save.recorder.on_start(&env.start());
-                save.recorder
-                    .on_event(0.0, &format!("the user wants {name}"), false);
-            }
-        }
+        let name = &self.scenario.layout.goals()[env.goal()].name;
+        self.save.start(&env, name, seed);
         let p = env.tracked();
         let g = env.goal();
         self.episode = Some(env);
@@ -490,11 +376,7 @@ impl EpuckEnvCore {
     /// (100 are).
     #[getter]
     fn recording_full(&self) -> bool {
-        #[cfg(feature = "rerun")]
-        if let Some(save) = &self.save {
-            return save.runs >= MAX_SAVED_EPUCK_EPISODES;
-        }
-        false
+        self.save.full()
     }
 
     /// Runs action 0-3 (forward, turn left, turn right, stop) for
@@ -524,25 +406,9 @@ impl EpuckEnvCore {
                 ));
             }
         };
-        #[cfg(feature = "rerun")]
-        let f = match self.save.as_mut() {
-            Some(save) if save.open => {
-                let f = py
-                    .detach(|| env.step_observed(a, windows, keep_window, &mut save.recorder))
-                    .map_err(py_err)?;
-                if env.ended() {
-                    save.open = false;
-                    save.runs += 1;
-                }
-                f
-            }
-            _ => py
-                .detach(|| env.step(a, windows, keep_window))
-                .map_err(py_err)?,
-        };
-        #[cfg(not(feature = "rerun"))]
+        let save = &mut self.save;
         let f = py
-            .detach(|| env.step(a, windows, keep_window))
+            .detach(|| save.step(env, a, windows, keep_window))
             .map_err(py_err)?;
         let d = PyDict::new(py);
         d.set_item(
@@ -638,31 +504,15 @@ impl EpuckEnvCore {
 impl EpuckEnvCore {
     /// Ends the recorded episode in progress, if it took a step.
     fn end_episode(&mut self) {
-        #[cfg(feature = "rerun")]
-        if let (Some(save), Some(env)) = (self.save.as_mut(), self.episode.as_mut())
-            && save.open
-        {
-            save.open = false;
-            if env.time_secs() > 0.0 {
-                env.end(&mut save.recorder);
-                save.runs += 1;
-            }
+        if let Some(env) = self.episode.as_mut() {
+            self.save.end(env);
         }
     }
 
     /// Ends what is in progress and moves the recording into place.
     fn finish(&mut self) -> errp_sim::Result<Option<PathBuf>> {
         self.end_episode();
-        #[cfg(feature = "rerun")]
-        if let Some(save) = self.save.take() {
-            save.recorder.finish()?;
-            if save.runs == 0 {
-                return Ok(None);
-            }
-            save.provenance.write(&save.file, save.runs)?;
-            return save.file.finish().map(Some);
-        }
-        Ok(None)
+        self.save.finish()
     }
 }
 

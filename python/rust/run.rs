@@ -7,9 +7,10 @@ use std::sync::{Mutex, PoisonError};
 
 use errp_sim::calibration::CalibrationReport;
 use errp_sim::epuck::{
-    ContinuousDecoder, ContinuousReport, EpuckScenario, EpuckTask, epuck_row, epuck_run_seed,
+    ContinuousDecoder, ContinuousReport, EpuckEpisodeResult, EpuckScenario, EpuckTask, epuck_row,
+    epuck_run_seed,
 };
-use errp_sim::grid::{GridScenario, GridTask, grid_row};
+use errp_sim::grid::{GridEpisodeResult, GridScenario, GridTask, grid_row};
 use errp_sim::task::{EpisodeRow, Task, TaskInfo, format_number};
 use errp_sim::{AnyScenario, RunOutcome};
 use errp_sweep::{
@@ -73,24 +74,41 @@ const NAMES: InputNames = InputNames {
     seed: "seed=",
 };
 
-/// The header of the frames `run` and the tasks' `run` return: the columns
-/// of `episodes.csv` without the sweep's swept values and checksum.
-pub(crate) fn header(info: &TaskInfo) -> String {
-    let mut cols = vec!["level", "accuracy", "episode", "seed"];
-    cols.extend(info.row_columns());
-    cols.join(",")
+/// A grid scenario's episodes as the CSV text `run` and the tasks' `run`
+/// return: the columns of `episodes.csv` without the sweep's swept values
+/// and checksum, one row per episode.
+pub(crate) fn grid_csv(s: &GridScenario, episodes: &[GridEpisodeResult]) -> String {
+    let rows = episodes
+        .iter()
+        .enumerate()
+        .map(|(k, r)| (errp_sim::grid::grid_episode_seed(s.seed, k), grid_row(r)));
+    csv(&GridTask::INFO, s.accuracy, rows)
 }
 
-/// One episode's CSV line under [`header`].
-pub(crate) fn line(accuracy: f64, k: usize, seed: u64, row: EpisodeRow) -> String {
-    let mut f = vec![
-        "0".to_string(),
-        format_number(accuracy),
-        k.to_string(),
-        seed.to_string(),
-    ];
-    f.extend(row.csv_fields());
-    f.join(",")
+/// An e-puck scenario's runs as CSV text, as [`grid_csv`].
+pub(crate) fn epuck_csv(s: &EpuckScenario, results: &[EpuckEpisodeResult]) -> String {
+    let rows = results
+        .iter()
+        .enumerate()
+        .map(|(k, r)| (epuck_run_seed(s.seed, k), epuck_row(&s.layout, r)));
+    csv(&EpuckTask::INFO, s.accuracy.get(), rows)
+}
+
+fn csv(info: &TaskInfo, accuracy: f64, rows: impl Iterator<Item = (u64, EpisodeRow)>) -> String {
+    let mut cols = vec!["level", "accuracy", "episode", "seed"];
+    cols.extend(info.row_columns());
+    let mut text = cols.join(",") + "\n";
+    for (k, (seed, row)) in rows.enumerate() {
+        let mut f = vec![
+            "0".to_string(),
+            format_number(accuracy),
+            k.to_string(),
+            seed.to_string(),
+        ];
+        f.extend(row.csv_fields());
+        text += &(f.join(",") + "\n");
+    }
+    text
 }
 
 /// The columns of an episode's row of `task` ("grid" or "epuck"), as
@@ -145,10 +163,17 @@ fn check_ours(path: &std::path::Path) -> PyResult<()> {
 
 /// What `errp.run` reports as it goes: the calibration, then the
 /// episodes or runs, on the meter.
-struct RunMeter<'a> {
+pub(crate) struct RunMeter<'a> {
     meter: &'a Meter,
     /// Grid episodes, or e-puck runs.
     total: usize,
+}
+
+impl<'a> RunMeter<'a> {
+    /// `total` episodes or runs shown on `meter`.
+    pub(crate) fn new(meter: &'a Meter, total: usize) -> Self {
+        Self { meter, total }
+    }
 }
 
 impl errp_sim::RunObserver for RunMeter<'_> {
@@ -218,30 +243,15 @@ pub(crate) fn run<'py>(
     match &done.outcome {
         RunOutcome::Grid(report) => {
             let s = &report.scenario;
-            let mut lines = vec![header(&GridTask::INFO)];
-            for (k, r) in report.episodes.iter().enumerate() {
-                let seed = errp_sim::grid::grid_episode_seed(s.seed, k);
-                lines.push(line(s.accuracy, k, seed, grid_row(r)));
-            }
             out.set_item("task", "grid")?;
-            out.set_item("csv", lines.join("\n") + "\n")?;
+            out.set_item("csv", grid_csv(s, &report.episodes))?;
             let info = grid_summary(s, report.calibration.as_ref());
             out.set_item("decoder", info)?;
         }
         RunOutcome::Epuck(r) => {
             let s = &r.scenario;
-            let mut lines = vec![header(&EpuckTask::INFO)];
-            for (k, result) in r.results.iter().enumerate() {
-                let seed = epuck_run_seed(s.seed, k);
-                lines.push(line(
-                    s.accuracy.get(),
-                    k,
-                    seed,
-                    epuck_row(&s.layout, result),
-                ));
-            }
             out.set_item("task", "epuck")?;
-            out.set_item("csv", lines.join("\n") + "\n")?;
+            out.set_item("csv", epuck_csv(s, &r.results))?;
             out.set_item("decoder", epuck_summary(s, &r.decoder, &r.report))?;
         }
     }
@@ -304,20 +314,6 @@ pub(crate) fn epuck_summary(
         ]);
     }
     info
-}
-
-/// The provenance of a recording made from Python.
-#[cfg(feature = "rerun")]
-pub(crate) fn provenance(
-    task: &str,
-    name: &str,
-    text: String,
-    seed: u64,
-    call: &str,
-) -> errp_sim::record::data::Provenance {
-    let mut p = errp_sim::record::data::Provenance::new(task, name, text, seed);
-    p.command = vec![format!("python: {call}")];
-    p
 }
 
 /// The keywords of `errp.sweep`, which its Python wrapper passes as one

@@ -7,15 +7,13 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use errp_bci::EegBlock;
-use errp_sim::epuck::{
-    ContinuousDecoder, EpuckScenario, EpuckTask as EpuckInfo, epuck_row, epuck_run_seed,
-    run_epuck_runs,
-};
+use errp_sim::epuck::{ContinuousDecoder, EpuckScenario};
 use errp_sim::grid::{
-    AssessmentDecoder, EegDecoder, EpochBlocks, GridDecoding, GridScenario, GridTask as GridInfo,
-    grid_row, prepare_decoder, run_grid_scenario_with,
+    AssessmentDecoder, EegDecoder, EpochBlocks, GridDecoding, GridScenario, prepare_decoder,
 };
-use errp_sim::task::Task;
+use errp_sim::{
+    BatchRecord, PendingRecording, RunProvenance, run_epuck_batch_recorded, run_grid_batch,
+};
 use numpy::{IntoPyArray, PyReadonlyArray1, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -25,18 +23,22 @@ use crate::convert::{
     Keys, PyDecoder, blocks_to_array3, channel_names, check_callable, load_epuck, load_grid,
     py_err, value_error,
 };
-use crate::interrupt::{CALIBRATING, EPISODES, Meter, RUNS, long, long_shown};
+use crate::interrupt::{CALIBRATING, Meter, long, long_shown};
 use crate::run::{
-    DecoderSummary, check_save, epuck_summary, grid_summary, header, line, summary_dict,
+    DecoderSummary, RunMeter, check_save, epuck_csv, epuck_summary, grid_csv, grid_summary,
+    summary_dict,
 };
 
-/// The command a task's recording names.
-#[cfg(feature = "rerun")]
-fn task_call(class: &str, own_decoder: bool) -> String {
-    if own_decoder {
+/// The call a task's recording names.
+fn made_by(class: &str, own_decoder: bool) -> RunProvenance {
+    let call = if own_decoder {
         format!("errp.{class}(decoder=...).run (a decoder of the caller's own)")
     } else {
         format!("errp.{class}.run")
+    };
+    RunProvenance {
+        command: vec![format!("python: {call}")],
+        commit: None,
     }
 }
 
@@ -144,67 +146,45 @@ impl GridTask {
                 ),
             ));
         }
-        #[cfg(feature = "rerun")]
-        let file = save
-            .as_ref()
-            .map(|p| errp_sim::grid::grid_recording(p))
-            .transpose()
-            .map_err(py_err)?;
-        let record = save.is_some();
-        let builtin = &self.builtin;
-        let mut lines = vec![header(&GridInfo::INFO)];
-        let meter = Meter::default();
-        let n = s.episodes.len();
-        let mut push = |k: usize, r: &errp_sim::grid::GridEpisodeResult| {
-            let seed = errp_sim::grid::grid_episode_seed(s.seed, k);
-            lines.push(line(s.accuracy, k, seed, grid_row(r)));
-            meter.set(EPISODES, k + 1, n);
+        let recording = PendingRecording::open(save.as_deref(), false).map_err(py_err)?;
+        let own = self.decoder.is_some() || self.scores.is_some();
+        let made_by = made_by("GridTask", own);
+        let record = BatchRecord {
+            flag: "save",
+            text: &self.text,
+            decoder_summary: "",
+            made_by: &made_by,
         };
-        let episodes = match (&self.decoder, &self.scores) {
+        let meter = Meter::default();
+        let watch = RunMeter::new(&meter, s.episodes.len());
+        let run = |decoding: GridDecoding<'_>| {
+            run_grid_batch(s.clone(), None, decoding, recording, record, &watch)
+        };
+        let builtin = &self.builtin;
+        let (report, _) = match (&self.decoder, &self.scores) {
             (Some(f), _) => {
                 let mut dec = PyDecoder::new(f.clone_ref(py));
                 let eeg = eeg_of(builtin).expect("checked: an EEG decoder");
                 let result = long_shown(py, &meter, progress, || {
                     let mut call = |b: &EegBlock| dec.call(b);
-                    let decoding = GridDecoding::Epochs {
+                    run(GridDecoding::Epochs {
                         source: eeg.source(),
                         decode: &mut call,
-                    };
-                    run_grid_scenario_with(s, decoding, record, &mut push)
+                    })
                 })?;
                 self.calls.fetch_add(dec.calls, Ordering::Relaxed);
-                result.map_err(|e| dec.error(e))?
+                result.map_err(|e| dec.error(e.error))?
             }
-            (None, Some((error, correct))) => {
-                let decoding = GridDecoding::Scores { error, correct };
-                long_shown(py, &meter, progress, || {
-                    run_grid_scenario_with(s, decoding, record, &mut push)
-                })?
-                .map_err(py_err)?
-            }
+            (None, Some((error, correct))) => long_shown(py, &meter, progress, || {
+                run(GridDecoding::Scores { error, correct })
+            })?
+            .map_err(|e| py_err(e.error))?,
             (None, None) => {
-                let decoding = GridDecoding::Builtin(builtin);
-                long_shown(py, &meter, progress, || {
-                    run_grid_scenario_with(s, decoding, record, &mut push)
-                })?
-                .map_err(py_err)?
+                long_shown(py, &meter, progress, || run(GridDecoding::Builtin(builtin)))?
+                    .map_err(|e| py_err(e.error))?
             }
         };
-        #[cfg(feature = "rerun")]
-        if let Some(file) = file {
-            let call = task_call("GridTask", self.decoder.is_some() || self.scores.is_some());
-            let p = crate::run::provenance("grid", &s.name, self.text.clone(), s.seed, &call);
-            let report = errp_sim::grid::GridRunReport {
-                scenario: s.clone(),
-                calibration: None,
-                episodes,
-            };
-            py.detach(|| errp_sim::grid::record_grid_run(file, &report, &p))
-                .map_err(py_err)?;
-        }
-        #[cfg(not(feature = "rerun"))]
-        let _ = (episodes, &self.text);
-        Ok(lines.join("\n") + "\n")
+        Ok(grid_csv(s, &report.episodes))
     }
 
     /// What the calibration found: the requested accuracy, the ErrP-to-noise
@@ -392,16 +372,16 @@ impl EpuckTask {
         }
         let s = &self.scenario;
         let d = &self.builtin;
+        let recording = PendingRecording::open(save.as_deref(), true).map_err(py_err)?;
+        let made_by = made_by("EpuckTask", self.decoder.is_some());
+        let record = BatchRecord {
+            flag: "save",
+            text: &self.text,
+            decoder_summary: "",
+            made_by: &made_by,
+        };
         let meter = Meter::default();
-        let one_more = |_: usize| meter.step(RUNS, runs);
-        #[cfg(feature = "rerun")]
-        let file = save
-            .as_ref()
-            .map(|p| errp_sim::epuck::epuck_recording(p))
-            .transpose()
-            .map_err(py_err)?;
-        #[cfg(not(feature = "rerun"))]
-        let _ = &self.text;
+        let watch = RunMeter::new(&meter, runs);
         let mut dec = self
             .decoder
             .as_ref()
@@ -415,34 +395,16 @@ impl EpuckTask {
                 }
                 None => None,
             };
-            #[cfg(feature = "rerun")]
-            if let Some(file) = &file {
-                let call = task_call("EpuckTask", self.decoder.is_some());
-                let p = crate::run::provenance("epuck", &s.name, self.text.clone(), s.seed, &call);
-                return errp_sim::epuck::record_epuck_runs_with(
-                    file,
-                    s,
-                    d,
-                    &p,
-                    runs,
-                    window_decoder,
-                    &one_more,
-                );
-            }
-            run_epuck_runs(s, d, runs, window_decoder, &mut (), &one_more)
+            run_epuck_batch_recorded(s, d, runs, window_decoder, recording, record, &watch)
         })?;
-        let results = match dec {
+        let (results, _) = match dec {
             Some(mut dec) => {
                 self.calls.fetch_add(dec.calls, Ordering::Relaxed);
-                result.map_err(|e| dec.error(e))?
+                result.map_err(|e| dec.error(e.error))?
             }
-            None => result.map_err(py_err)?,
+            None => result.map_err(|e| py_err(e.error))?,
         };
-        #[cfg(feature = "rerun")]
-        if let Some(file) = file {
-            py.detach(|| file.finish()).map_err(py_err)?;
-        }
-        Ok(self.rows(&results))
+        Ok(epuck_csv(&self.scenario, &results))
     }
 
     /// What the calibration found (accuracy, ErrP-to-noise ratio,
@@ -494,18 +456,5 @@ impl EpuckTask {
     #[getter]
     fn seed(&self) -> u64 {
         self.scenario.seed
-    }
-}
-
-impl EpuckTask {
-    /// The runs' rows as CSV text.
-    fn rows(&self, results: &[errp_sim::epuck::EpuckEpisodeResult]) -> String {
-        let s = &self.scenario;
-        let mut lines = vec![header(&EpuckInfo::INFO)];
-        for (k, r) in results.iter().enumerate() {
-            let seed = epuck_run_seed(s.seed, k);
-            lines.push(line(s.accuracy.get(), k, seed, epuck_row(&s.layout, r)));
-        }
-        lines.join("\n") + "\n"
     }
 }

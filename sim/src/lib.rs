@@ -60,6 +60,7 @@
 // No function over 120 lines of code (clippy.toml) outside the tests.
 #![cfg_attr(not(test), warn(clippy::too_many_lines))]
 
+mod agents;
 pub mod calibration;
 pub mod epuck;
 mod error;
@@ -83,6 +84,7 @@ mod snapshot;
 mod stats;
 pub mod task;
 
+pub use agents::{AgentInfo, EpuckAgentRecording, GridAgentRecording};
 pub use error::{Result, SimError, check_p_error};
 pub use files::{append_regular, is_foreign, open_regular, open_regular_with, write_regular};
 pub use input::{
@@ -95,9 +97,9 @@ pub use output::{
 };
 pub use paper::{PAPER, PAPER_EPUCK, PAPER_POOLED};
 pub use runner::{
-    EpuckRun, MAX_RECORDED_EPISODES, MAX_RECORDED_RUNS, RunError, RunObserver, RunOptions,
-    RunOutcome, RunProvenance, ScenarioRun, epuck_decoder_summary, grid_decoder_summary,
-    run_scenario,
+    BatchRecord, EpuckRun, MAX_RECORDED_EPISODES, MAX_RECORDED_RUNS, PendingRecording, RunError,
+    RunObserver, RunOptions, RunOutcome, RunProvenance, ScenarioRun, epuck_decoder_summary,
+    grid_decoder_summary, run_epuck_batch_recorded, run_grid_batch, run_scenario,
 };
 pub use scenario::{
     AnyScenario, apply_overrides, is_epuck, load_scenario, load_scenario_with, parse_scenario,

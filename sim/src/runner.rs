@@ -10,12 +10,13 @@ use errp_bci::{OnlineStep, TargetingStep};
 
 use crate::calibration::CalibrationReport;
 use crate::epuck::{
-    ContinuousDecoder, ContinuousReport, EpuckEpisodeResult, EpuckScenario,
-    prepare_continuous_decoder_with, run_epuck_batch_counted,
+    ContinuousDecoder, ContinuousReport, EpuckEpisodeResult, EpuckScenario, WindowDecoder,
+    prepare_continuous_decoder_with, run_epuck_runs,
 };
 use crate::error::SimError;
 use crate::grid::{
-    GridEpisodeResult, GridRunReport, GridScenario, prepare_decoder, run_grid_scenario,
+    GridDecoding, GridEpisodeResult, GridRunReport, GridScenario, prepare_decoder,
+    run_grid_scenario_with,
 };
 use crate::input::{LoadedScenario, SetterNames};
 use crate::scenario::AnyScenario;
@@ -147,11 +148,11 @@ pub fn run_scenario(
     let LoadedScenario { scenario, text } = loaded;
     check_recordable(&scenario, &options)?;
     let epuck = matches!(scenario, AnyScenario::Epuck(_));
-    let file = recording::open(options.save, epuck).map_err(at(options.names.save))?;
+    let recording = PendingRecording::open(options.save, epuck).map_err(at(options.names.save))?;
     observer.start(&scenario);
     match scenario {
-        AnyScenario::Grid(s) => run_grid(*s, file, text, options, observer),
-        AnyScenario::Epuck(s) => run_epuck(*s, file, text, options, observer),
+        AnyScenario::Grid(s) => run_grid(*s, recording, text, options, observer),
+        AnyScenario::Epuck(s) => run_epuck(*s, recording, text, options, observer),
     }
 }
 
@@ -228,19 +229,56 @@ pub fn epuck_decoder_summary(decoder: &ContinuousDecoder, report: &ContinuousRep
     text
 }
 
-fn run_grid(
-    scenario: GridScenario,
+/// A batch's recording, created before its work so that an unwritable
+/// path fails first; nothing without a path.
+pub struct PendingRecording {
     file: Option<recording::File>,
-    text: String,
-    options: RunOptions<'_>,
+}
+
+impl PendingRecording {
+    /// The `.rrd` at `save` of a grid or an e-puck (`epuck`) batch, created
+    /// now (refused by a build without the `rerun` feature).
+    pub fn open(save: Option<&Path>, epuck: bool) -> Result<Self, SimError> {
+        Ok(Self {
+            file: recording::open(save, epuck)?,
+        })
+    }
+
+    /// True if there is one.
+    pub fn is_some(&self) -> bool {
+        self.file.is_some()
+    }
+}
+
+/// What a batch's recording says of how it was made, and how errors name
+/// it.
+#[derive(Debug, Clone, Copy)]
+pub struct BatchRecord<'a> {
+    /// How the front end names the recording (`--save`, `save`).
+    pub flag: &'a str,
+    /// The scenario's text as run.
+    pub text: &'a str,
+    /// What the decoder's calibration found, as text (empty if nothing).
+    pub decoder_summary: &'a str,
+    /// The command or call.
+    pub made_by: &'a RunProvenance,
+}
+
+/// The episodes of a grid scenario decoded by `decoding` (the built-in
+/// decoder, or one of the caller's own), episode `k` from
+/// [`grid_episode_seed`](crate::grid::grid_episode_seed), each shown to
+/// `observer`, then recorded into `recording` as `record` says unless the
+/// observer stopped: the episode stage of [`run_scenario`], for callers
+/// with their decoder prepared.
+pub fn run_grid_batch(
+    scenario: GridScenario,
+    calibration: Option<CalibrationReport>,
+    decoding: GridDecoding<'_>,
+    recording: PendingRecording,
+    record: BatchRecord<'_>,
     observer: &impl RunObserver,
-) -> Result<ScenarioRun, RunError> {
-    let (decoder, calibration) = prepare_decoder(&scenario, |s| observer.targeting(s))
-        .map_err(at("calibrating the decoder"))?;
-    let decoder_summary = grid_decoder_summary(calibration.as_ref());
-    observer.decoder_ready(&decoder_summary);
-    check_going(observer)?;
-    let episodes = run_grid_scenario(&scenario, &decoder, options.save.is_some(), |k, r| {
+) -> Result<(GridRunReport, Option<PathBuf>), RunError> {
+    let episodes = run_grid_scenario_with(&scenario, decoding, recording.is_some(), |k, r| {
         observer.grid_episode(k, r)
     })
     .map_err(plain)?;
@@ -250,8 +288,75 @@ fn run_grid(
         calibration,
         episodes,
     };
-    let recording = recording::grid(file, &report, &text, &decoder_summary, &options)
-        .map_err(at(options.names.save))?;
+    let path = recording::grid(recording.file, &report, &record).map_err(at(record.flag))?;
+    Ok((report, path))
+}
+
+/// `runs` runs of an e-puck scenario with its calibrated `decoder`, or
+/// `window_decoder` of the caller's own in its place, run `k` from
+/// [`epuck_run_seed`](crate::epuck::epuck_run_seed), each told to
+/// `observer`, recorded into `recording` as `record` says (one after
+/// another) or not (in parallel with the built-in decoder): the run stage
+/// of [`run_scenario`], for callers with their decoder prepared.
+pub fn run_epuck_batch_recorded(
+    scenario: &EpuckScenario,
+    decoder: &ContinuousDecoder,
+    runs: usize,
+    window_decoder: Option<WindowDecoder<'_>>,
+    recording: PendingRecording,
+    record: BatchRecord<'_>,
+    observer: &impl RunObserver,
+) -> Result<(Vec<EpuckEpisodeResult>, Option<PathBuf>), RunError> {
+    let on_run = |_: usize| observer.epuck_run_done();
+    match recording.file {
+        Some(file) => {
+            let results = recording::epuck(
+                &file,
+                scenario,
+                decoder,
+                runs,
+                window_decoder,
+                &record,
+                &on_run,
+            )
+            .map_err(plain)?;
+            let path = recording::finish(file).map_err(at(record.flag))?;
+            Ok((results, path))
+        }
+        None => Ok((
+            run_epuck_runs(scenario, decoder, runs, window_decoder, &mut (), &on_run)
+                .map_err(plain)?,
+            None,
+        )),
+    }
+}
+
+fn run_grid(
+    scenario: GridScenario,
+    recording: PendingRecording,
+    text: String,
+    options: RunOptions<'_>,
+    observer: &impl RunObserver,
+) -> Result<ScenarioRun, RunError> {
+    let (decoder, calibration) = prepare_decoder(&scenario, |s| observer.targeting(s))
+        .map_err(at("calibrating the decoder"))?;
+    let decoder_summary = grid_decoder_summary(calibration.as_ref());
+    observer.decoder_ready(&decoder_summary);
+    check_going(observer)?;
+    let record = BatchRecord {
+        flag: options.names.save,
+        text: &text,
+        decoder_summary: &decoder_summary,
+        made_by: options.provenance,
+    };
+    let (report, recording) = run_grid_batch(
+        scenario,
+        calibration,
+        GridDecoding::Builtin(&decoder),
+        recording,
+        record,
+        observer,
+    )?;
     Ok(ScenarioRun {
         outcome: RunOutcome::Grid(Box::new(report)),
         decoder_summary,
@@ -261,7 +366,7 @@ fn run_grid(
 
 fn run_epuck(
     scenario: EpuckScenario,
-    file: Option<recording::File>,
+    recording: PendingRecording,
     text: String,
     options: RunOptions<'_>,
     observer: &impl RunObserver,
@@ -275,30 +380,22 @@ fn run_epuck(
     let decoder_summary = epuck_decoder_summary(&decoder, &report);
     observer.decoder_ready(&decoder_summary);
     check_going(observer)?;
-    let runs = scenario.runs;
-    observer.epuck_runs_start(runs as u64, file.is_none());
-    let (results, recording) = match file {
-        Some(file) => {
-            let results = recording::epuck(
-                &file,
-                &scenario,
-                &decoder,
-                &text,
-                &decoder_summary,
-                &options,
-                &|| observer.epuck_run_done(),
-            )
-            .map_err(plain)?;
-            let path = recording::finish(file).map_err(at(options.names.save))?;
-            (results, path)
-        }
-        None => {
-            let results =
-                run_epuck_batch_counted(&scenario, &decoder, runs, &|| observer.epuck_run_done())
-                    .map_err(plain)?;
-            (results, None)
-        }
+    observer.epuck_runs_start(scenario.runs as u64, !recording.is_some());
+    let record = BatchRecord {
+        flag: options.names.save,
+        text: &text,
+        decoder_summary: &decoder_summary,
+        made_by: options.provenance,
     };
+    let (results, recording) = run_epuck_batch_recorded(
+        &scenario,
+        &decoder,
+        scenario.runs,
+        None,
+        recording,
+        record,
+        observer,
+    )?;
     Ok(ScenarioRun {
         outcome: RunOutcome::Epuck(Box::new(EpuckRun {
             scenario,
@@ -316,8 +413,8 @@ fn run_epuck(
 mod recording {
     use std::path::{Path, PathBuf};
 
-    use super::RunOptions;
-    use crate::epuck::{ContinuousDecoder, EpuckEpisodeResult, EpuckScenario};
+    use super::BatchRecord;
+    use crate::epuck::{ContinuousDecoder, EpuckEpisodeResult, EpuckScenario, WindowDecoder};
     use crate::error::Result;
     use crate::grid::GridRunReport;
     use crate::record::RrdFile;
@@ -337,20 +434,13 @@ mod recording {
         .transpose()
     }
 
-    fn provenance(
-        task: &str,
-        name: &str,
-        seed: u64,
-        text: &str,
-        decoder_summary: &str,
-        options: &RunOptions<'_>,
-    ) -> Provenance {
-        let mut p = Provenance::new(task, name, text.to_string(), seed);
-        if let Some(commit) = &options.provenance.commit {
+    fn provenance(task: &str, name: &str, seed: u64, of: &BatchRecord<'_>) -> Provenance {
+        let mut p = Provenance::new(task, name, of.text.to_string(), seed);
+        if let Some(commit) = &of.made_by.commit {
             p.commit.clone_from(commit);
         }
-        p.command.clone_from(&options.provenance.command);
-        p.decoder_summary = decoder_summary.to_string();
+        p.command.clone_from(&of.made_by.command);
+        p.decoder_summary = of.decoder_summary.to_string();
         p
     }
 
@@ -358,13 +448,11 @@ mod recording {
     pub(super) fn grid(
         file: Option<File>,
         report: &GridRunReport,
-        text: &str,
-        decoder_summary: &str,
-        options: &RunOptions<'_>,
+        of: &BatchRecord<'_>,
     ) -> Result<Option<PathBuf>> {
         let Some(file) = file else { return Ok(None) };
         let s = &report.scenario;
-        let p = provenance("grid", &s.name, s.seed, text, decoder_summary, options);
+        let p = provenance("grid", &s.name, s.seed, of);
         crate::grid::record_grid_run(file, report, &p).map(Some)
     }
 
@@ -373,27 +461,20 @@ mod recording {
         file: &File,
         scenario: &EpuckScenario,
         decoder: &ContinuousDecoder,
-        text: &str,
-        decoder_summary: &str,
-        options: &RunOptions<'_>,
-        on_run: &(dyn Fn() + Sync),
+        runs: usize,
+        window_decoder: Option<WindowDecoder<'_>>,
+        of: &BatchRecord<'_>,
+        on_run: &(dyn Fn(usize) + Sync),
     ) -> Result<Vec<EpuckEpisodeResult>> {
-        let p = provenance(
-            "epuck",
-            &scenario.name,
-            scenario.seed,
-            text,
-            decoder_summary,
-            options,
-        );
+        let p = provenance("epuck", &scenario.name, scenario.seed, of);
         crate::epuck::record_epuck_runs_with(
             file,
             scenario,
             decoder,
             &p,
-            scenario.runs,
-            None,
-            &|_| on_run(),
+            runs,
+            window_decoder,
+            on_run,
         )
     }
 
@@ -408,8 +489,8 @@ mod recording {
 mod recording {
     use std::path::{Path, PathBuf};
 
-    use super::RunOptions;
-    use crate::epuck::{ContinuousDecoder, EpuckEpisodeResult, EpuckScenario};
+    use super::BatchRecord;
+    use crate::epuck::{ContinuousDecoder, EpuckEpisodeResult, EpuckScenario, WindowDecoder};
     use crate::error::{Result, SimError};
     use crate::grid::GridRunReport;
 
@@ -429,9 +510,7 @@ mod recording {
     pub(super) fn grid(
         file: Option<File>,
         _report: &GridRunReport,
-        _text: &str,
-        _decoder_summary: &str,
-        _options: &RunOptions<'_>,
+        _of: &BatchRecord<'_>,
     ) -> Result<Option<PathBuf>> {
         match file {
             None => Ok(None),
@@ -443,10 +522,10 @@ mod recording {
         file: &File,
         _scenario: &EpuckScenario,
         _decoder: &ContinuousDecoder,
-        _text: &str,
-        _decoder_summary: &str,
-        _options: &RunOptions<'_>,
-        _on_run: &(dyn Fn() + Sync),
+        _runs: usize,
+        _window_decoder: Option<WindowDecoder<'_>>,
+        _of: &BatchRecord<'_>,
+        _on_run: &(dyn Fn(usize) + Sync),
     ) -> Result<Vec<EpuckEpisodeResult>> {
         match *file {}
     }
