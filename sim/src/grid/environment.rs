@@ -11,9 +11,8 @@ use rand::Rng;
 
 use crate::error::{Result, SimError};
 use crate::grid::decoder::AssessmentDecoder;
-use crate::grid::episode::{GridDecoding, GridEpisodeResult};
 use crate::grid::params::GridTaskParams;
-use crate::grid::plant::GridPlant;
+use crate::grid::plant::{GridDecoding, GridEpisodeResult, GridPlant};
 
 /// What one action gave the agent.
 #[derive(Debug, Clone, PartialEq)]
@@ -37,7 +36,7 @@ pub struct GridFeedback {
 }
 
 /// One episode of the grid with the actions chosen from outside: the
-/// [`GridPlant`] the episode's shared control drives, driven by an agent.
+/// `GridPlant` the episode's shared control drives, driven by an agent.
 pub struct GridEnvironment {
     decoder: Arc<AssessmentDecoder>,
     plant: GridPlant,

@@ -20,16 +20,13 @@ pub use decoder::{
     INFORMATION_PER_CLASS, PErrorChoice, PErrorMapping,
 };
 pub use environment::{GridEnvironment, GridFeedback};
-pub use episode::{
-    EpochDecoder, GridDecoding, GridEpisodeResult, GridStep, run_grid_episode,
-    run_grid_episode_with,
-};
+pub use episode::{run_grid_episode, run_grid_episode_with};
 pub use pairs::{
     CENTRAL_RUN, PAIRS_PER_SET, PairFamily, keeps_to_the_centre, manhattan, pairs_text,
     total_length,
 };
 pub use params::GridTaskParams;
-pub use plant::grid_episode_seed;
+pub use plant::{EpochDecoder, GridDecoding, GridEpisodeResult, GridStep, grid_episode_seed};
 pub use report::{GridEpisodeHeader, GridEpisodeRow, Table1Report};
 pub use run::{
     GridRunReport, GridShared, HELD_OUT_PER_CLASS, PreparedGrid, eeg_decoder, pooled_accuracy,

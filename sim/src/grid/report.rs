@@ -6,7 +6,7 @@ use std::fmt;
 use errp_bci::GoalSet;
 use errp_robot::Grid;
 
-use crate::grid::episode::GridEpisodeResult;
+use crate::grid::plant::GridEpisodeResult;
 use crate::grid::run::GridRunReport;
 use crate::grid::table1::{Table1Cell, accuracy_time_correlation};
 use crate::paper::{PAPER, PAPER_POOLED};

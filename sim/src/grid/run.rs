@@ -15,7 +15,8 @@ use crate::error::Result;
 use crate::grid::decoder::{
     AssessmentDecoder, EegDecoder, EegSource, EpochBankParts, PErrorChoice,
 };
-use crate::grid::episode::{GridDecoding, GridEpisodeResult, run_grid_episode_with};
+use crate::grid::episode::run_grid_episode_with;
+use crate::grid::plant::{GridDecoding, GridEpisodeResult};
 use crate::grid::scenario::{DecoderChoice, EegMode, GridScenario};
 use crate::key::StableKey;
 use crate::task::DecoderInfo;

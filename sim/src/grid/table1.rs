@@ -7,8 +7,9 @@ use rayon::prelude::*;
 
 use crate::error::Result;
 use crate::grid::decoder::{INFORMATION_PER_CLASS, PErrorChoice};
-use crate::grid::episode::{GridEpisodeResult, run_grid_episode};
+use crate::grid::episode::run_grid_episode;
 use crate::grid::params::GridTaskParams;
+use crate::grid::plant::GridEpisodeResult;
 use crate::grid::run::prepare_decoder;
 use crate::grid::scenario::{DecoderChoice, EegMode, GridScenario, free_pairs};
 use crate::stats::mean_sd;
