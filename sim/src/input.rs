@@ -32,6 +32,14 @@ pub enum ScenarioSource {
         /// Its path in the repository.
         name: &'static str,
     },
+    /// Text held in memory (a sweep's scenario, a recording's), named in
+    /// errors by `name`.
+    Text {
+        /// The TOML text.
+        text: String,
+        /// What names it.
+        name: PathBuf,
+    },
 }
 
 impl ScenarioSource {
@@ -56,14 +64,17 @@ impl ScenarioSource {
         match self {
             ScenarioSource::File(p) => p,
             ScenarioSource::BuiltIn { name, .. } => Path::new(name),
+            ScenarioSource::Text { name, .. } => name,
         }
     }
 
-    /// Its text, read once.
-    fn text(&self) -> Result<String> {
+    /// Its text (a file's read within [`crate::MAX_SCENARIO_BYTES`], as
+    /// UTF-8).
+    pub fn read(&self) -> Result<String> {
         match self {
             ScenarioSource::File(p) => read_scenario(p),
             ScenarioSource::BuiltIn { text, .. } => Ok((*text).to_string()),
+            ScenarioSource::Text { text, .. } => Ok(text.clone()),
         }
     }
 }
@@ -85,6 +96,17 @@ pub struct SetterNames {
     /// The recording to write.
     pub save: &'static str,
 }
+
+/// The values named as the scenario file's own keys, for callers that set
+/// only dotted keys (a sweep's levels).
+pub const FILE_KEYS: SetterNames = SetterNames {
+    accuracy: "user.accuracy",
+    seed: "seed",
+    runs: "runs",
+    decoder: "decoder",
+    eeg: "eeg",
+    save: "save",
+};
 
 /// A scenario and the values set in it from outside, each checked where
 /// it entered (a flag's parser, a keyword's check).
@@ -119,6 +141,12 @@ pub struct LoadedScenario {
 }
 
 impl ScenarioInput {
+    /// Loads `source` as it is written ([`ScenarioInput::load`] with
+    /// nothing set).
+    pub fn load_as_written(source: ScenarioSource) -> Result<AnyScenario> {
+        Ok(Self::new(source).load(&FILE_KEYS)?.scenario)
+    }
+
     /// `source` with nothing set.
     pub fn new(source: ScenarioSource) -> Self {
         Self {
@@ -141,7 +169,7 @@ impl ScenarioInput {
     /// names the file and the field.
     pub fn load(&self, names: &SetterNames) -> Result<LoadedScenario> {
         let path = self.source.path();
-        let text = self.source.text()?;
+        let text = self.source.read()?;
         let table: toml::Table = parse_toml(&text, path)?;
         let epuck = table.get("task").and_then(toml::Value::as_str) == Some("epuck");
         if let Err(e) = self.check_task(epuck, &table, names) {

@@ -88,7 +88,8 @@ pub use agents::{AgentInfo, EpuckAgentRecording, GridAgentRecording};
 pub use error::{Result, SimError, check_p_error};
 pub use files::{append_regular, is_foreign, open_regular, open_regular_with, write_regular};
 pub use input::{
-    BUILT_IN_EPUCK, BUILT_IN_GRID, LoadedScenario, ScenarioInput, ScenarioSource, SetterNames,
+    BUILT_IN_EPUCK, BUILT_IN_GRID, FILE_KEYS, LoadedScenario, ScenarioInput, ScenarioSource,
+    SetterNames,
 };
 pub use key::StableKey;
 pub use output::{

@@ -14,9 +14,16 @@ pub(crate) mod table1;
 /// has none), or the shipped scenarios' user, [`errp_bci::Realism::published`].
 pub(crate) fn user_realism(path: Option<&std::path::Path>) -> anyhow::Result<errp_bci::Realism> {
     Ok(match path {
-        Some(path) => errp_sim::load_scenario(path)?.realism().clone(),
+        Some(path) => load(path)?.realism().clone(),
         None => errp_bci::Realism::published(),
     })
+}
+
+/// The scenario file at `path`, as it is written: every command loads its
+/// scenarios as an [`errp_sim::ScenarioInput`].
+pub(crate) fn load(path: &std::path::Path) -> anyhow::Result<errp_sim::AnyScenario> {
+    let input = errp_sim::ScenarioInput::new(errp_sim::ScenarioSource::File(path.to_path_buf()));
+    Ok(input.load(&run::FLAGS)?.scenario)
 }
 
 /// The command line as it was given, for a result's provenance: an

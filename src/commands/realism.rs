@@ -4,8 +4,8 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
+use errp_sim::AnyScenario;
 use errp_sim::realism::measure_realism;
-use errp_sim::{AnyScenario, load_scenario_with};
 
 use crate::out::{errln, out};
 
@@ -33,11 +33,11 @@ pub(crate) struct RealismArgs {
 }
 
 pub(crate) fn realism(args: &RealismArgs) -> Result<()> {
-    let grid = match load_scenario_with(&args.grid, &[])? {
+    let grid = match crate::commands::load(&args.grid)? {
         AnyScenario::Grid(s) => s,
         AnyScenario::Epuck(_) => wrong_task(&args.grid, "--grid", "grid")?,
     };
-    let epuck = match load_scenario_with(&args.epuck, &[])? {
+    let epuck = match crate::commands::load(&args.epuck)? {
         AnyScenario::Epuck(s) => s,
         AnyScenario::Grid(_) => wrong_task(&args.epuck, "--epuck", "epuck")?,
     };

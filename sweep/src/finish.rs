@@ -3,9 +3,9 @@
 
 use std::path::Path;
 
-use errp_sim::parse_scenario;
 use errp_sim::write_atomic;
 use errp_sim::{Result, SimError};
+use errp_sim::{ScenarioInput, ScenarioSource};
 
 use crate::figure::sweep_plot;
 use crate::manifest::{EPISODES, Manifest};
@@ -21,7 +21,10 @@ pub fn finish_dir(dir: &Path, manifest: &Manifest) -> Result<SweepReport> {
     let mut report = summarise_dir(dir, spec)?;
     // The scenario as the file gives it (the e-puck's paper point is drawn
     // at its accuracy), else the first level's.
-    let scenario = match parse_scenario(&spec.scenario_toml, &spec.scenario_path) {
+    let scenario = match ScenarioInput::load_as_written(ScenarioSource::Text {
+        text: spec.scenario_toml.clone(),
+        name: spec.scenario_path.clone(),
+    }) {
         Ok(s) => s,
         Err(_) => spec
             .levels(&InputNames::CLI)?

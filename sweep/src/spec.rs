@@ -14,11 +14,11 @@ use toml::{Table, Value};
 use errp_bci::RequestedAccuracy;
 use errp_sim::epuck::EpuckTask;
 use errp_sim::grid::GridTask;
+use errp_sim::parse_toml;
 pub use errp_sim::task::format_number;
 use errp_sim::task::{Task, TaskInfo};
-use errp_sim::{AnyScenario, is_epuck, parse_scenario_with};
+use errp_sim::{AnyScenario, FILE_KEYS, ScenarioInput, ScenarioSource, is_epuck};
 use errp_sim::{Result, SimError};
-use errp_sim::{parse_toml, read_scenario};
 
 /// The two tasks a sweep can run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -372,7 +372,7 @@ pub fn parse_axis(task: SweepTask, text: &str, names: &InputNames) -> Result<Axi
 
 /// The task of the scenario file at `path` and its text.
 pub fn read_task(path: &Path) -> Result<(SweepTask, String)> {
-    let text = read_scenario(path)?;
+    let text = ScenarioSource::File(path.to_path_buf()).read()?;
     let task = if is_epuck(&text, path)? {
         SweepTask::Epuck
     } else {
@@ -649,18 +649,28 @@ impl SweepSpec {
                 // The level's accuracy replaces the file's decoder (an online
                 // target included); the sweep's seed gives the user (the
                 // calibration).
-                let mut sets: Vec<(&str, Value)> = vec![
-                    ("user.accuracy", Value::Float(accuracy)),
-                    ("seed", Value::Integer(self.calibration_seed() as i64)),
+                let mut keys: Vec<(String, Value)> = vec![
+                    ("user.accuracy".into(), Value::Float(accuracy)),
+                    (
+                        "seed".into(),
+                        Value::Integer(self.calibration_seed() as i64),
+                    ),
                 ];
-                for (k, v) in &self.fixed {
-                    sets.push((k, v.clone()));
-                }
+                keys.extend(self.fixed.iter().cloned());
                 for (a, v) in self.axes.iter().zip(&values) {
-                    sets.push((&a.key, v.clone()));
+                    keys.push((a.key.clone(), v.clone()));
                 }
-                let scenario = parse_scenario_with(&self.scenario_toml, &self.scenario_path, &sets)
-                    .map_err(|e| context(e.to_string()))?;
+                let input = ScenarioInput {
+                    keys,
+                    ..ScenarioInput::new(ScenarioSource::Text {
+                        text: self.scenario_toml.clone(),
+                        name: self.scenario_path.clone(),
+                    })
+                };
+                let scenario = input
+                    .load(&FILE_KEYS)
+                    .map_err(|e| context(e.to_string()))?
+                    .scenario;
                 Ok(Level {
                     index,
                     accuracy,

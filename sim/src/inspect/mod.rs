@@ -88,8 +88,11 @@ impl Recording {
             path: path.to_path_buf(),
             why,
         };
-        let scenario = crate::parse_scenario(&provenance.scenario_text, Path::new("scenario"))
-            .map_err(|e| bad(format!("its scenario does not load: {e}")))?;
+        let scenario = crate::ScenarioInput::load_as_written(crate::ScenarioSource::Text {
+            text: provenance.scenario_text.clone(),
+            name: "scenario".into(),
+        })
+        .map_err(|e| bad(format!("its scenario does not load: {e}")))?;
         let tables = raw.tables;
         let runs = match scenario {
             AnyScenario::Epuck(s) => {
