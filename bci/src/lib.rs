@@ -38,7 +38,7 @@
 //! ```
 
 #![warn(clippy::unwrap_used, clippy::print_stdout, clippy::iter_over_hash_type)]
-// No function over 120 lines of code (clippy.toml) outside the tests.
+// No function over 100 lines of code (clippy.toml) outside the tests.
 #![cfg_attr(not(test), warn(clippy::too_many_lines))]
 
 mod calibration;

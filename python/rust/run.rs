@@ -332,6 +332,20 @@ pub(crate) struct SweepKeywords {
     threads: Option<usize>,
 }
 
+/// The `task=` of a sweep: none (the scenario's), "grid" or "epuck".
+fn sweep_task(task: Option<&str>) -> PyResult<Option<SweepTask>> {
+    match task {
+        None => Ok(None),
+        Some("grid") => Ok(Some(SweepTask::Grid)),
+        Some("epuck") => Ok(Some(SweepTask::Epuck)),
+        Some(other) => Err(value_error(
+            "task",
+            format!("{other:?}"),
+            "\"grid\" or \"epuck\"",
+        )),
+    }
+}
+
 /// Runs a Monte Carlo sweep as `errp sweep` does, into `out`, and returns
 /// the paths of its files. A rerun of the same sweep into the same
 /// directory resumes it.
@@ -354,18 +368,7 @@ pub(crate) fn sweep<'py>(
         cache,
         threads,
     } = keywords;
-    let want = match task.as_deref() {
-        None => None,
-        Some("grid") => Some(SweepTask::Grid),
-        Some("epuck") => Some(SweepTask::Epuck),
-        Some(other) => {
-            return Err(value_error(
-                "task",
-                format!("{other:?}"),
-                "\"grid\" or \"epuck\"",
-            ));
-        }
-    };
+    let want = sweep_task(task.as_deref())?;
     if !(1..=errp_sweep::MAX_EPISODES).contains(&episodes) {
         return Err(value_error(
             "episodes",

@@ -13,24 +13,10 @@ use errp_sweep::{ArenaPlot, GridPlot, RunPath};
 use crate::cli::{InspectArgs, check_extension};
 use crate::out::{out, outln};
 
-pub(crate) fn inspect(args: &InspectArgs) -> Result<()> {
-    if args.scenario || args.provenance {
-        if args.files.len() != 1 {
-            bail!("--scenario and --provenance print one recording's; give one file");
-        }
-        let rec = Recording::open(&args.files[0])?;
-        if args.scenario {
-            out!("{}", rec.provenance.scenario_text)?;
-        } else {
-            let json = serde_json::to_string_pretty(&rec.provenance)
-                .context("writing the provenance as JSON")?;
-            outln!("{json}")?;
-        }
-        return Ok(());
-    }
-    for f in &args.files {
-        check_extension(f, "rrd", "FILE")?;
-    }
+/// The kind of `--figure`, checked before any work: one recording, a
+/// `.png` or `.svg` name that is not an output directory, and not a file
+/// this program did not write.
+fn check_figure(args: &InspectArgs) -> Result<Option<FigureKind>> {
     if args.figure.is_some() && args.files.len() != 1 {
         bail!("--figure draws one recording; give one file");
     }
@@ -68,6 +54,28 @@ pub(crate) fn inspect(args: &InspectArgs) -> Result<()> {
         };
         crate::save::check_ours(path, magic, what, "--figure")?;
     }
+    Ok(figure_kind)
+}
+
+pub(crate) fn inspect(args: &InspectArgs) -> Result<()> {
+    if args.scenario || args.provenance {
+        if args.files.len() != 1 {
+            bail!("--scenario and --provenance print one recording's; give one file");
+        }
+        let rec = Recording::open(&args.files[0])?;
+        if args.scenario {
+            out!("{}", rec.provenance.scenario_text)?;
+        } else {
+            let json = serde_json::to_string_pretty(&rec.provenance)
+                .context("writing the provenance as JSON")?;
+            outln!("{json}")?;
+        }
+        return Ok(());
+    }
+    for f in &args.files {
+        check_extension(f, "rrd", "FILE")?;
+    }
+    let figure_kind = check_figure(args)?;
     let started = crate::commands::sweep::wall_clock();
     let recs: Vec<Recording> = args
         .files
@@ -283,6 +291,41 @@ fn write_tables(
     result
 }
 
+/// Every e-puck run's path (8 points a second, as the viewer draws the
+/// trajectory) and detections, in cm, from the recording's frames.
+fn epuck_paths(rec: &Recording, results: &[errp_sim::epuck::EpuckEpisodeResult]) -> Vec<RunPath> {
+    let frames = rec.tables.get(errp_sim::record::paths::FRAMES);
+    let col = |name: &str| match frames.and_then(|t| t.column(name)) {
+        Some(errp_sim::record::data::Column::F64(v)) => v.as_slice(),
+        _ => &[],
+    };
+    let runs_col: &[i64] = match frames.and_then(|t| t.column("run")) {
+        Some(errp_sim::record::data::Column::I64(v)) => v,
+        _ => &[],
+    };
+    let (xs, ys) = (col("x_cm"), col("y_cm"));
+    let mut paths: Vec<RunPath> = results
+        .iter()
+        .map(|r| RunPath {
+            points: Vec::new(),
+            detections: r
+                .detections
+                .iter()
+                .map(|d| [100.0 * d[0], 100.0 * d[1]])
+                .collect(),
+        })
+        .collect();
+    for (i, &run) in runs_col.iter().enumerate() {
+        // 8 points a second, as the viewer draws the trajectory.
+        if let Some(p) = usize::try_from(run).ok().and_then(|k| paths.get_mut(k))
+            && (i % 8 == 0 || p.points.is_empty())
+        {
+            p.points.push([xs[i], ys[i]]);
+        }
+    }
+    paths
+}
+
 /// The figure of `rec` with run `highlight` (from 0) drawn in full.
 fn draw(rec: &Recording, highlight: usize, kind: FigureKind) -> Result<Vec<u8>> {
     let runs_title = |n: usize| {
@@ -294,35 +337,7 @@ fn draw(rec: &Recording, highlight: usize, kind: FigureKind) -> Result<Vec<u8>> 
     };
     let bytes = match &rec.runs {
         Runs::Epuck { scenario, results } => {
-            let frames = rec.tables.get(errp_sim::record::paths::FRAMES);
-            let col = |name: &str| match frames.and_then(|t| t.column(name)) {
-                Some(errp_sim::record::data::Column::F64(v)) => v.as_slice(),
-                _ => &[],
-            };
-            let runs_col: &[i64] = match frames.and_then(|t| t.column("run")) {
-                Some(errp_sim::record::data::Column::I64(v)) => v,
-                _ => &[],
-            };
-            let (xs, ys) = (col("x_cm"), col("y_cm"));
-            let mut paths: Vec<RunPath> = results
-                .iter()
-                .map(|r| RunPath {
-                    points: Vec::new(),
-                    detections: r
-                        .detections
-                        .iter()
-                        .map(|d| [100.0 * d[0], 100.0 * d[1]])
-                        .collect(),
-                })
-                .collect();
-            for (i, &run) in runs_col.iter().enumerate() {
-                // 8 points a second, as the viewer draws the trajectory.
-                if let Some(p) = usize::try_from(run).ok().and_then(|k| paths.get_mut(k))
-                    && (i % 8 == 0 || p.points.is_empty())
-                {
-                    p.points.push([xs[i], ys[i]]);
-                }
-            }
+            let paths = epuck_paths(rec, results);
             let layout = &scenario.layout;
             let plot = ArenaPlot {
                 title: format!(

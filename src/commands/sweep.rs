@@ -266,29 +266,34 @@ impl SweepObserver for Progress {
     }
 }
 
-/// Runs `errp sweep`. Returns false if interrupted (exit code 130).
-pub fn sweep(args: &SweepArgs) -> Result<bool> {
-    const NAMES: InputNames = InputNames::CLI;
+/// The sweep the flags ask for, each flag parsed (named by `NAMES`).
+fn sweep_spec(args: &SweepArgs, names: InputNames) -> Result<SweepSpec> {
     let want = args.task.map(|t| match t {
         TaskArg::Grid => SweepTask::Grid,
         TaskArg::Epuck => SweepTask::Epuck,
     });
-    let (task, text, path) = sweep_scenario(args.scenario.as_deref(), want, NAMES)?;
-    let fixed = sweep_fixed(task, args.eeg.map(|e| e == SweepEeg::Stream), NAMES)?;
-    let spec = SweepSpec {
+    let (task, text, path) = sweep_scenario(args.scenario.as_deref(), want, names)?;
+    let fixed = sweep_fixed(task, args.eeg.map(|e| e == SweepEeg::Stream), names)?;
+    Ok(SweepSpec {
         task,
         scenario_path: path,
         scenario_toml: text,
-        accuracies: parse_accuracies(&args.accuracy, &NAMES)?,
+        accuracies: parse_accuracies(&args.accuracy, &names)?,
         axes: args
             .params
             .iter()
-            .map(|p| parse_axis(task, p, &NAMES))
+            .map(|p| parse_axis(task, p, &names))
             .collect::<errp_sim::Result<_>>()?,
         fixed,
         episodes: args.episodes as usize,
         seed: args.seed,
-    };
+    })
+}
+
+/// Runs `errp sweep`. Returns false if interrupted (exit code 130).
+pub fn sweep(args: &SweepArgs) -> Result<bool> {
+    const NAMES: InputNames = InputNames::CLI;
+    let spec = sweep_spec(args, NAMES)?;
     let shard = match &args.shard {
         Some(s) => Shard::parse(s)?,
         None => Shard::ALL,

@@ -20,16 +20,9 @@ use crate::spec::{InputNames, Level, SweepSpec, SweepTask};
 use crate::summary::SweepReport;
 use crate::writer::read_row;
 
-/// Merges the shard directories `dirs` (every shard of one sweep, in any
-/// order) into `out`: `episodes.csv` in sweep order, then the summary, plots
-/// and manifest of an unsharded run. Every row of every shard is checked
-/// as a resume checks it (fields, seeds, checksum); a shard that is
-/// incomplete, damaged or still being written is refused, naming the file
-/// and line, and a refused merge leaves no `out` it created.
-pub fn merge_sweeps(dirs: &[PathBuf], out: &Path) -> Result<SweepReport> {
-    if dirs.is_empty() {
-        return Err(SimError::Sweep("merge needs the shard directories".into()));
-    }
+/// The manifests of the shard directories `dirs`, each a shard of one
+/// and the same sweep with the same decoders.
+fn read_shards(dirs: &[PathBuf]) -> Result<Vec<(Manifest, &Path)>> {
     let mut shards: Vec<(Manifest, &Path)> = Vec::with_capacity(dirs.len());
     for d in dirs {
         if !d.join(MANIFEST).is_file() {
@@ -66,6 +59,22 @@ pub fn merge_sweeps(dirs: &[PathBuf], out: &Path) -> Result<SweepReport> {
             )));
         }
     }
+    Ok(shards)
+}
+
+/// Merges the shard directories `dirs` (every shard of one sweep, in any
+/// order) into `out`: `episodes.csv` in sweep order, then the summary, plots
+/// and manifest of an unsharded run. Every row of every shard is checked
+/// as a resume checks it (fields, seeds, checksum); a shard that is
+/// incomplete, damaged or still being written is refused, naming the file
+/// and line, and a refused merge leaves no `out` it created.
+pub fn merge_sweeps(dirs: &[PathBuf], out: &Path) -> Result<SweepReport> {
+    if dirs.is_empty() {
+        return Err(SimError::Sweep("merge needs the shard directories".into()));
+    }
+    let shards = read_shards(dirs)?;
+    let (first, _) = &shards[0];
+    let count = first.shard.expect("checked").count;
     let mut by_index: Vec<Option<&Path>> = vec![None; count];
     for (m, d) in &shards {
         let k = m.shard.expect("checked").index;

@@ -278,9 +278,8 @@ impl Realism {
         online
     }
 
-    /// Checks every field; the error names it (`realism.<field>`) and the
-    /// accepted range.
-    pub(crate) fn validate(&self, montage_names: &[&str]) -> Result<()> {
+    /// Checks the rates (fractions) and the sizes (from 0 to a bound).
+    fn check_rates_and_sizes(&self) -> Result<()> {
         let fraction = "a fraction in [0, 1]";
         for (name, v) in [
             ("realism.lapse_rate", self.lapse_rate),
@@ -330,6 +329,13 @@ impl Realism {
                 &format!("a number in [0, {max}]"),
             )?;
         }
+        Ok(())
+    }
+
+    /// Checks every field; the error names it (`realism.<field>`) and the
+    /// accepted range.
+    pub(crate) fn validate(&self, montage_names: &[&str]) -> Result<()> {
+        self.check_rates_and_sizes()?;
         for (name, v, min, max) in [
             ("realism.drift_secs", self.drift_secs, 1.0, 86_400.0),
             (

@@ -87,6 +87,45 @@ pub struct EegGenerator {
     alpha_gain_buf: Vec<f64>,
 }
 
+/// The background's mixing matrix (column-major, lower triangle): the
+/// Cholesky factor of the correlation exp(-chord / length) between EEG
+/// sites, scaled to the background's amplitude.
+fn background_mixing(params: &GeneratorParams, montage: &Montage) -> Vec<f64> {
+    let n_eeg = montage.n_eeg();
+    let pos = |i: usize| montage.channels()[i].position;
+    let corr = DMatrix::from_fn(n_eeg, n_eeg, |i, j| {
+        let (a, b) = (pos(i), pos(j));
+        let d = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
+        (-d / params.spatial_length).exp()
+    });
+    let l = corr
+        .cholesky()
+        .expect("an exponential kernel on distinct points is positive definite")
+        .l();
+    let mut mixing = vec![0.0; n_eeg * n_eeg];
+    for i in 0..n_eeg {
+        for j in 0..=i {
+            mixing[j * n_eeg + i] = l[(i, j)] * params.background_uv;
+        }
+    }
+    mixing
+}
+
+/// The mains' cosine and sine amplitudes per channel: mostly common-mode,
+/// with a small per-channel spread, drawn from `rng`.
+fn mains(params: &GeneratorParams, n_ch: usize, rng: &mut ChaCha8Rng) -> (Vec<f64>, Vec<f64>) {
+    let common_phase = rng.random::<f64>() * 2.0 * PI;
+    let mut line_cos = Vec::with_capacity(n_ch);
+    let mut line_sin = Vec::with_capacity(n_ch);
+    for _ in 0..n_ch {
+        let amp = params.line_noise_uv * rng.random_range(0.5..1.5);
+        let phase = common_phase + 0.3 * rng.sample::<f64, _>(StandardNormal);
+        line_cos.push(amp * phase.cos());
+        line_sin.push(amp * phase.sin());
+    }
+    (line_cos, line_sin)
+}
+
 impl EegGenerator {
     /// A generator for `montage` with the shipped ERP templates.
     pub fn new(params: &Valid<GeneratorParams>, montage: &Montage, seed: u64) -> Result<Self> {
@@ -109,23 +148,8 @@ impl EegGenerator {
         let n_ch = montage.len();
         let fs = params.sfreq_hz;
 
-        // Background: correlation exp(-chord / length) between EEG sites.
         let pos = |i: usize| montage.channels()[i].position;
-        let corr = DMatrix::from_fn(n_eeg, n_eeg, |i, j| {
-            let (a, b) = (pos(i), pos(j));
-            let d = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
-            (-d / params.spatial_length).exp()
-        });
-        let l = corr
-            .cholesky()
-            .expect("an exponential kernel on distinct points is positive definite")
-            .l();
-        let mut mixing = vec![0.0; n_eeg * n_eeg];
-        for i in 0..n_eeg {
-            for j in 0..=i {
-                mixing[j * n_eeg + i] = l[(i, j)] * params.background_uv;
-            }
-        }
+        let mixing = background_mixing(&params, montage);
         let pink = (0..n_ch)
             .map(|_| PinkNoise::new(fs, &mut rng_background))
             .collect();
@@ -147,16 +171,7 @@ impl EegGenerator {
             })
             .collect::<Vec<_>>();
 
-        // Mains: mostly common-mode, with a small per-channel spread.
-        let common_phase = rng_artifacts.random::<f64>() * 2.0 * PI;
-        let mut line_cos = Vec::with_capacity(n_ch);
-        let mut line_sin = Vec::with_capacity(n_ch);
-        for _ in 0..n_ch {
-            let amp = params.line_noise_uv * rng_artifacts.random_range(0.5..1.5);
-            let phase = common_phase + 0.3 * rng_artifacts.sample::<f64, _>(StandardNormal);
-            line_cos.push(amp * phase.cos());
-            line_sin.push(amp * phase.sin());
-        }
+        let (line_cos, line_sin) = mains(&params, n_ch, &mut rng_artifacts);
 
         // Eye potentials: blinks (vertical) and gaze (horizontal).
         let (blink_coeff, gaze_coeff) = eye_coefficients(montage)?;
@@ -289,6 +304,44 @@ impl EegGenerator {
         block
     }
 
+    /// The background into `data` (`n` samples per channel, the 1/f
+    /// sources in the scratch's first rows, scaled by `bg`): the EEG
+    /// sources mixed spatially (lower-triangular), four sources per pass
+    /// over the output row; EOG channels keep their own source.
+    fn mix_background(&self, n: usize, bg: f64, data: &mut [f64]) {
+        let n_ch = self.montage.len();
+        let n_eeg = self.montage.n_eeg();
+        let sources = &self.scratch[..n_ch * n];
+        data.fill(0.0);
+        for ch in 0..n_eeg {
+            let out = &mut data[ch * n..(ch + 1) * n];
+            let l = |k: usize| bg * self.mixing[k * n_eeg + ch];
+            let src = |k: usize| &sources[k * n..(k + 1) * n];
+            let mut k = 0;
+            while k + 4 <= ch + 1 {
+                let (l0, l1, l2, l3) = (l(k), l(k + 1), l(k + 2), l(k + 3));
+                let (s0, s1, s2, s3) = (src(k), src(k + 1), src(k + 2), src(k + 3));
+                for t in 0..n {
+                    out[t] += l0 * s0[t] + l1 * s1[t] + l2 * s2[t] + l3 * s3[t];
+                }
+                k += 4;
+            }
+            for k in k..=ch {
+                let (lk, sk) = (l(k), src(k));
+                for (o, s) in out.iter_mut().zip(sk) {
+                    *o += lk * s;
+                }
+            }
+        }
+        let eog_bg = bg * 0.5 * self.params.background_uv;
+        for ch in n_eeg..n_ch {
+            let src = &self.scratch[ch * n..(ch + 1) * n];
+            for (o, s) in data[ch * n..(ch + 1) * n].iter_mut().zip(src) {
+                *o = eog_bg * s;
+            }
+        }
+    }
+
     /// Fills `block` (its channel count must be the montage's) with the next
     /// `block.n_samples` samples.
     ///
@@ -300,7 +353,6 @@ impl EegGenerator {
         assert_eq!(block.n_channels, self.montage.len(), "channel count");
         let n = block.n_samples;
         let n_ch = self.montage.len();
-        let n_eeg = self.montage.n_eeg();
         let fs = self.params.sfreq_hz;
         let c = self.components;
         let bg = if c.background { 1.0 } else { 0.0 };
@@ -343,39 +395,8 @@ impl EegGenerator {
                 }
             }
         }
-        let sources = &self.scratch[..n_ch * n];
-
-        // 3. Spatial mixing of the EEG sources (lower-triangular), four
-        //    sources per pass over the output row; EOG channels keep their own
-        //    source.
-        block.data.fill(0.0);
-        for ch in 0..n_eeg {
-            let out = &mut block.data[ch * n..(ch + 1) * n];
-            let l = |k: usize| bg * self.mixing[k * n_eeg + ch];
-            let src = |k: usize| &sources[k * n..(k + 1) * n];
-            let mut k = 0;
-            while k + 4 <= ch + 1 {
-                let (l0, l1, l2, l3) = (l(k), l(k + 1), l(k + 2), l(k + 3));
-                let (s0, s1, s2, s3) = (src(k), src(k + 1), src(k + 2), src(k + 3));
-                for t in 0..n {
-                    out[t] += l0 * s0[t] + l1 * s1[t] + l2 * s2[t] + l3 * s3[t];
-                }
-                k += 4;
-            }
-            for k in k..=ch {
-                let (lk, sk) = (l(k), src(k));
-                for (o, s) in out.iter_mut().zip(sk) {
-                    *o += lk * s;
-                }
-            }
-        }
-        let eog_bg = bg * 0.5 * self.params.background_uv;
-        for ch in n_eeg..n_ch {
-            let src = &self.scratch[ch * n..(ch + 1) * n];
-            for (o, s) in block.data[ch * n..(ch + 1) * n].iter_mut().zip(src) {
-                *o = eog_bg * s;
-            }
-        }
+        // 3. Spatial mixing of the EEG sources.
+        self.mix_background(n, bg, &mut block.data);
 
         // 4. Sources shared by all channels, one value per sample.
         self.shared_sources(n);

@@ -158,6 +158,20 @@ fn information(f: &mut fmt::Formatter<'_>, cells: &[Table1Cell], set: GoalSet) -
     )
 }
 
+/// The two header lines of [`Table1Report`].
+fn table1_header(f: &mut fmt::Formatter<'_>) -> fmt::Result {
+    writeln!(
+        f,
+        "{:<10} {:>8}  {:>18}  {:>22}  {:>24}  {:>22}  {:>8}",
+        "", "reached", "actions", "net time (s)", "total time (s)", "mean accuracy (%)", "pooled"
+    )?;
+    writeln!(
+        f,
+        "{:<10} {:>8}  {:>18}  {:>22}  {:>24}  {:>22}  {:>8}",
+        "", "", "ours [paper]", "ours [paper]", "ours [paper]", "ours [paper]", "(%)"
+    )
+}
+
 /// Table 1 as `errp table1` prints it: one row per subject and goal set,
 /// ours beside the paper's, the pooled rows and the accuracy-time
 /// correlations.
@@ -166,22 +180,7 @@ pub struct Table1Report<'a>(pub &'a [Table1Cell]);
 impl fmt::Display for Table1Report<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let cells = self.0;
-        writeln!(
-            f,
-            "{:<10} {:>8}  {:>18}  {:>22}  {:>24}  {:>22}  {:>8}",
-            "",
-            "reached",
-            "actions",
-            "net time (s)",
-            "total time (s)",
-            "mean accuracy (%)",
-            "pooled"
-        )?;
-        writeln!(
-            f,
-            "{:<10} {:>8}  {:>18}  {:>22}  {:>24}  {:>22}  {:>8}",
-            "", "", "ours [paper]", "ours [paper]", "ours [paper]", "ours [paper]", "(%)"
-        )?;
+        table1_header(f)?;
         // The pooled accuracy: every action of the runs counted once, what
         // the decoder is calibrated to (the mean accuracy averages runs, as
         // the paper's row does, and so weighs short runs, where the decoder

@@ -17,6 +17,7 @@ use crate::record::data::{Column, Provenance};
 use crate::record::paths;
 use crate::scenario::AnyScenario;
 
+mod grid_replay;
 mod read;
 mod report;
 mod tables;
@@ -24,6 +25,8 @@ mod tables;
 pub use read::{MAX_RECORDING_BYTES, Table};
 pub use report::{Comparison, RecordingHeadline, RecordingReport};
 pub use tables::{CsvTable, PARQUET_TABLE_KEY, csv_tables, phase_secs};
+
+use grid_replay::grid_results;
 
 /// Why a recording cannot be read.
 #[derive(Debug, thiserror::Error)]
@@ -257,6 +260,17 @@ fn replay_frames(
     Ok((path_m, max_lateral, frame_at))
 }
 
+/// Refuses windows whose beliefs are not one value per goal.
+fn check_belief_width(windows: &View<'_>, n_goals: usize) -> Result<(), String> {
+    let (_, width) = windows.rows("belief")?;
+    if width != n_goals {
+        return Err(format!(
+            "its beliefs have {width} values, but the scenario has {n_goals} goals"
+        ));
+    }
+    Ok(())
+}
+
 /// The e-puck runs recomputed as `run_epuck_episode` scores them.
 fn epuck_results(
     tables: &std::collections::BTreeMap<String, Table>,
@@ -296,13 +310,7 @@ fn epuck_results(
         windows.bool("detected")?,
         windows.i64("step")?,
     );
-    let (belief, width) = windows.rows("belief")?;
-    if width != n_goals {
-        return Err(format!(
-            "its beliefs have {width} values, but the scenario has {n_goals} goals"
-        ));
-    }
-    let _ = belief;
+    check_belief_width(&windows, n_goals)?;
     let (e_t, e_onset, e_phase) = if errps.table.rows() == 0 {
         (&[][..], &[][..], &[][..])
     } else {
@@ -356,29 +364,13 @@ fn epuck_results(
         // user produced it (before the window that ends after it), each
         // window with the pose at its end.
         let mut score = Score::new(span, window_span, t_e[k]);
-        let mut known = 0usize;
-        let mut frame = 0usize;
-        for i in wr {
-            let t = w_t[i];
-            while known < errps_run.len() && errps_run[known].0 < t {
-                score.errp(errps_run[known].1, errps_run[known].2);
-                known += 1;
-            }
-            let step = index(w_step[i], 4, "window step")?;
-            let mut at = [f64::NAN; 2];
-            if w_detected[i] {
-                while frame + 1 < frame_at.len() && frame_at[frame + 1].0 <= t {
-                    frame += 1;
-                }
-                if let Some(&(_, xy)) = frame_at.get(frame) {
-                    at = xy;
-                }
-            }
-            score.window(t, w_p[i], step, w_detected[i], at);
-        }
-        for &(_, onset, phase) in &errps_run[known..] {
-            score.errp(onset, phase);
-        }
+        let columns = WindowColumns {
+            t: w_t,
+            p: w_p,
+            detected: w_detected,
+            step: w_step,
+        };
+        score_run(&mut score, &columns, wr, &errps_run, &frame_at)?;
         let committed = match end_committed[e] {
             -1 => None,
             c => Some(index(c, n_goals, "committed goal")?),
@@ -389,128 +381,45 @@ fn epuck_results(
     Ok(out)
 }
 
-/// The grid episodes recomputed from their actions.
-fn grid_results(
-    tables: &std::collections::BTreeMap<String, Table>,
-) -> Result<Vec<GridEpisodeResult>, String> {
-    let grid = Grid::paper();
-    let runs = View::of(tables, paths::RUNS)?;
-    let ends = View::of(tables, paths::ENDS)?;
-    let empty = Table::default();
-    let actions = View {
-        name: paths::ACTIONS,
-        table: tables.get(paths::ACTIONS).unwrap_or(&empty),
-    };
-    let run_col = runs.i64("run")?;
-    let end_run = ends.i64("run")?;
-    let a_run = if actions.table.rows() == 0 {
-        &[][..]
-    } else {
-        actions.i64("run")?
-    };
-    for (name, r) in [
-        (paths::RUNS, run_col),
-        (paths::ACTIONS, a_run),
-        (paths::ENDS, end_run),
-    ] {
-        check_run_order(name, r)?;
-    }
-    let cell = |x: i64, y: i64| -> Result<Cell, String> {
-        Ok(Cell::new(
-            index(x, grid.width, "cell column")?,
-            index(y, grid.height, "cell row")?,
-        ))
-    };
-    let (sx, sy, gx, gy, epoch) = (
-        runs.i64("start_x")?,
-        runs.i64("start_y")?,
-        runs.i64("goal_x")?,
-        runs.i64("goal_y")?,
-        runs.f64("epoch_s")?,
-    );
-    let (end_t, end_committed) = (ends.f64("t_s")?, ends.i64("committed")?);
-    let n_actions = actions.table.rows();
-    let (a_t, fx, fy, tx, ty, err, p, dec) = if n_actions == 0 {
-        (
-            &[][..],
-            &[][..],
-            &[][..],
-            &[][..],
-            &[][..],
-            &[][..],
-            &[][..],
-            &[][..],
-        )
-    } else {
-        (
-            actions.f64("t_s")?,
-            actions.i64("from_x")?,
-            actions.i64("from_y")?,
-            actions.i64("to_x")?,
-            actions.i64("to_y")?,
-            actions.bool("error")?,
-            actions.f64("p_error")?,
-            actions.bool("decoded_error")?,
-        )
-    };
-    let names: &[String] = match actions.table.column("action") {
-        Some(Column::Str(v)) => v,
-        _ if n_actions == 0 => &[],
-        _ => {
-            return Err(format!(
-                "its table {} has no column `action`",
-                paths::ACTIONS
-            ));
+/// A recording's window columns.
+struct WindowColumns<'a> {
+    t: &'a [f64],
+    p: &'a [f64],
+    detected: &'a [bool],
+    step: &'a [i64],
+}
+
+/// Feeds `score` one run's windows (rows `rows` of `w`) and its ErrPs
+/// `(seen at, onset, phase)`, with the poses of `frame_at`.
+fn score_run(
+    score: &mut Score,
+    w: &WindowColumns<'_>,
+    rows: std::ops::Range<usize>,
+    errps_run: &[(f64, f64, usize)],
+    frame_at: &[(f64, [f64; 2])],
+) -> Result<(), String> {
+    let mut known = 0usize;
+    let mut frame = 0usize;
+    for i in rows {
+        let t = w.t[i];
+        while known < errps_run.len() && errps_run[known].0 < t {
+            score.errp(errps_run[known].1, errps_run[known].2);
+            known += 1;
         }
-    };
-    let (belief, width) = if n_actions == 0 {
-        (&[][..], grid.n_cells())
-    } else {
-        actions.rows("belief")?
-    };
-    if width != grid.n_cells() {
-        return Err(format!(
-            "its beliefs have {width} values, not one per cell ({})",
-            grid.n_cells()
-        ));
-    }
-    let mut out = Vec::new();
-    for (k, &r) in run_col.iter().enumerate() {
-        if r != k as i64 {
-            return Err(format!("its table {} skips run {k}", paths::RUNS));
+        let step = index(w.step[i], 4, "window step")?;
+        let mut at = [f64::NAN; 2];
+        if w.detected[i] {
+            while frame + 1 < frame_at.len() && frame_at[frame + 1].0 <= t {
+                frame += 1;
+            }
+            if let Some(&(_, xy)) = frame_at.get(frame) {
+                at = xy;
+            }
         }
-        let Some(e) = end_run.iter().position(|&x| x == r) else {
-            break;
-        };
-        let start = cell(sx[k], sy[k])?;
-        let goal = cell(gx[k], gy[k])?;
-        // The episode's own tally, fed from the table of actions.
-        let mut tally = GridTally::new(&grid, start);
-        let mut steps = Vec::new();
-        for i in actions.run_rows(a_run, k) {
-            let to = cell(tx[i], ty[i])?;
-            tally.action(&grid, to, err[i], dec[i]);
-            let action = GridAction::ALL
-                .into_iter()
-                .find(|a| a.name() == names[i])
-                .ok_or_else(|| format!("`{}` is not an action of the grid", names[i]))?;
-            steps.push(GridStep {
-                onset_secs: a_t[i],
-                from: cell(fx[i], fy[i])?,
-                action,
-                to,
-                error: err[i],
-                p_error: p[i],
-                decoded_error: dec[i],
-                belief: belief[i * width..(i + 1) * width].to_vec(),
-                fcz: Vec::new(),
-            });
-        }
-        let committed = match end_committed[e] {
-            -1 => None,
-            c => Some(grid.cell(index(c, grid.n_cells(), "committed cell")?)),
-        };
-        out.push(tally.result(goal, committed, epoch[k], end_t[e], steps));
+        score.window(t, w.p[i], step, w.detected[i], at);
     }
-    Ok(out)
+    for &(_, onset, phase) in &errps_run[known..] {
+        score.errp(onset, phase);
+    }
+    Ok(())
 }

@@ -233,23 +233,33 @@ fn compare(f: &mut fmt::Formatter<'_>, recs: &[Recording]) -> fmt::Result {
             Runs::Epuck { .. } => None,
         }),
     );
-    let widths: Vec<usize> = recs
+    let names: Vec<String> = recs.iter().map(name).collect();
+    side_by_side(f, &names, &rows)
+}
+
+/// Rows of values under a column per recording (`names`), labels first.
+fn side_by_side(
+    f: &mut fmt::Formatter<'_>,
+    names: &[String],
+    rows: &[(String, Vec<String>)],
+) -> fmt::Result {
+    let widths: Vec<usize> = names
         .iter()
         .enumerate()
-        .map(|(k, r)| {
+        .map(|(k, name)| {
             rows.iter()
                 .map(|(_, v)| v[k].len())
-                .chain([name(r).len()])
+                .chain([name.len()])
                 .max()
                 .unwrap_or(8)
         })
         .collect();
     let mut line = format!("{:<18}", "");
-    for (k, r) in recs.iter().enumerate() {
-        line.push_str(&format!("  {:>w$}", name(r), w = widths[k]));
+    for (k, name) in names.iter().enumerate() {
+        line.push_str(&format!("  {:>w$}", name, w = widths[k]));
     }
     writeln!(f, "{line}")?;
-    for (label, values) in &rows {
+    for (label, values) in rows {
         let mut line = format!("{label:<18}");
         for (k, v) in values.iter().enumerate() {
             line.push_str(&format!("  {:>w$}", v, w = widths[k]));

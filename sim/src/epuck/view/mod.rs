@@ -253,6 +253,36 @@ impl EpuckRecorder {
         self.error.map_or(Ok(()), Err)
     }
 
+    /// Sends the run's row of the runs table: how it started.
+    fn send_start(&mut self, s: &EpisodeStart) {
+        let run = self.run as i64;
+        let off = self.offset_secs;
+        let runs = |n: usize| Column::I64(vec![run; n]);
+        let cm = |v: f64| 100.0 * v;
+        let r = send_table(
+            &self.rec,
+            paths::RUNS,
+            &[off],
+            vec![
+                ("run", runs(1)),
+                ("seed", Column::I64(vec![self.seed as i64])),
+                ("goal", Column::I64(vec![s.goal as i64])),
+                ("start_x", Column::F64(vec![cm(s.pose.x_m)])),
+                ("start_y", Column::F64(vec![cm(s.pose.y_m)])),
+                (
+                    "start_heading_deg",
+                    Column::F64(vec![s.pose.heading_rad.to_degrees()]),
+                ),
+                ("t_e", Column::F64(vec![s.t_e])),
+                ("detection_from_s", Column::F64(vec![s.detection_span.0])),
+                ("detection_to_s", Column::F64(vec![s.detection_span.1])),
+                ("window_from_s", Column::F64(vec![s.window_span.0])),
+                ("window_to_s", Column::F64(vec![s.window_span.1])),
+            ],
+        );
+        self.keep(r);
+    }
+
     /// Sends the run's data tables, one chunk each.
     fn send_tables(&mut self) {
         let t = std::mem::take(&mut self.tables);
@@ -262,28 +292,7 @@ impl EpuckRecorder {
         let runs = |n: usize| Column::I64(vec![run; n]);
         let cm = |v: f64| 100.0 * v;
         if let Some(s) = t.start {
-            let r = send_table(
-                &self.rec,
-                paths::RUNS,
-                &[off],
-                vec![
-                    ("run", runs(1)),
-                    ("seed", Column::I64(vec![self.seed as i64])),
-                    ("goal", Column::I64(vec![s.goal as i64])),
-                    ("start_x", Column::F64(vec![cm(s.pose.x_m)])),
-                    ("start_y", Column::F64(vec![cm(s.pose.y_m)])),
-                    (
-                        "start_heading_deg",
-                        Column::F64(vec![s.pose.heading_rad.to_degrees()]),
-                    ),
-                    ("t_e", Column::F64(vec![s.t_e])),
-                    ("detection_from_s", Column::F64(vec![s.detection_span.0])),
-                    ("detection_to_s", Column::F64(vec![s.detection_span.1])),
-                    ("window_from_s", Column::F64(vec![s.window_span.0])),
-                    ("window_to_s", Column::F64(vec![s.window_span.1])),
-                ],
-            );
-            self.keep(r);
+            self.send_start(&s);
         }
         let n = t.f_t.len();
         let r = send_table(

@@ -206,6 +206,35 @@ pub(super) fn table_stats(
     }
 }
 
+/// Each subject's log-likelihood at each point, for `spec.bootstrap`
+/// resamplings of its groups: the Monte Carlo spread of the estimate.
+fn bootstrap(
+    spec: &GridFitSpec,
+    fixed_groups: &[Vec<Vec<SimRun>>],
+    fixed: &[PaperRow],
+) -> Vec<Vec<Vec<f64>>> {
+    fixed_groups
+        .iter()
+        .zip(fixed)
+        .enumerate()
+        .map(|(i, (per_point, row))| {
+            per_point
+                .iter()
+                .enumerate()
+                .map(|(j, g)| {
+                    let mut rng = stream(
+                        derive_seed(spec.seed, "fit/grid/bootstrap", (i * 1000 + j) as u64),
+                        "fit/bootstrap",
+                    );
+                    (0..spec.bootstrap)
+                        .map(|_| group_log_likelihood(&resample(g, &mut rng), row.actions_mean))
+                        .collect()
+                })
+                .collect()
+        })
+        .collect()
+}
+
 pub(super) fn analyse(
     spec: &GridFitSpec,
     calibrations: &[Calibration],
@@ -236,26 +265,7 @@ pub(super) fn analyse(
                 .collect()
         })
         .collect();
-    let replicates: Vec<Vec<Vec<f64>>> = fixed_groups
-        .iter()
-        .zip(fixed)
-        .enumerate()
-        .map(|(i, (per_point, row))| {
-            per_point
-                .iter()
-                .enumerate()
-                .map(|(j, g)| {
-                    let mut rng = stream(
-                        derive_seed(spec.seed, "fit/grid/bootstrap", (i * 1000 + j) as u64),
-                        "fit/bootstrap",
-                    );
-                    (0..spec.bootstrap)
-                        .map(|_| group_log_likelihood(&resample(g, &mut rng), row.actions_mean))
-                        .collect()
-                })
-                .collect()
-        })
-        .collect();
+    let replicates = bootstrap(spec, &fixed_groups, fixed);
     let own_estimates = log_lik
         .iter()
         .map(|l| spec.goal_rewards[argmax(l)])

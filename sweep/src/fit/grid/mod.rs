@@ -483,19 +483,17 @@ pub fn run_grid_fit(
     Ok(GridFitOutcome::Complete(Box::new(fit), files))
 }
 
-/// The fit for the users of `spec.realism`: every subject's decoders
-/// calibrated, every grid point (and pair length) run and analysed; `None`
-/// if cancelled.
-fn fit_users(
+/// Every subject's decoders on either goal set, `spec.calibrations` each,
+/// calibrated in parallel through the cache; `None` if cancelled.
+fn calibrate_users(
     spec: &GridFitSpec,
     cache: &TargetCache,
-    provenance: Provenance,
     cancel: &AtomicBool,
     observer: &dyn SweepObserver,
-) -> Result<Option<GridFit>> {
+    base: GridTaskParams,
+) -> Result<Option<Vec<Calibration>>> {
     let fixed = paper_rows(GoalSet::Fixed);
     let free = paper_rows(GoalSet::Free);
-    let base = GridTaskParams::default();
     let mut jobs = Vec::new();
     for goals in [GoalSet::Fixed, GoalSet::Free] {
         for subject in 0..fixed.len() {
@@ -544,9 +542,25 @@ fn fit_users(
         .into_iter()
         .collect::<Option<Vec<_>>>()
         .unwrap_or_default();
-    if calibrations.len() != jobs.len() {
+    Ok((calibrations.len() == jobs.len()).then_some(calibrations))
+}
+
+/// The fit for the users of `spec.realism`: every subject's decoders
+/// calibrated, every grid point (and pair length) run and analysed; `None`
+/// if cancelled.
+fn fit_users(
+    spec: &GridFitSpec,
+    cache: &TargetCache,
+    provenance: Provenance,
+    cancel: &AtomicBool,
+    observer: &dyn SweepObserver,
+) -> Result<Option<GridFit>> {
+    let fixed = paper_rows(GoalSet::Fixed);
+    let free = paper_rows(GoalSet::Free);
+    let base = GridTaskParams::default();
+    let Some(calibrations) = calibrate_users(spec, cache, cancel, observer, base)? else {
         return Ok(None);
-    }
+    };
     let family = PairFamily::paper();
     let sets = spec.pair_lengths.len();
     let per_set = spec.goal_rewards.len() * spec.repeats * 5 * calibrations.len() / 2;
