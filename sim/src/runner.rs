@@ -166,6 +166,49 @@ fn check_going(observer: &impl RunObserver) -> Result<(), RunError> {
     Ok(())
 }
 
+/// What `errp run` says it is about to run: the scenario, its episodes or
+/// runs, its decoder and its seed.
+pub struct RunHeadline<'a>(pub &'a AnyScenario);
+
+impl std::fmt::Display for RunHeadline<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.0 {
+            AnyScenario::Grid(s) => write!(
+                f,
+                "{}: {} episodes, {} decoder at {:.2} % ({}), seed {}",
+                s.name,
+                s.episodes.len(),
+                match s.decoder {
+                    crate::grid::DecoderChoice::Eeg => "EEG",
+                    crate::grid::DecoderChoice::Oracle => "oracle",
+                },
+                100.0 * s.accuracy,
+                s.user,
+                s.seed
+            ),
+            AnyScenario::Epuck(s) => {
+                let start = &s.episode.start;
+                write!(
+                    f,
+                    "{}: e-puck from ({:.0}, {:.0}) cm to {}, {} run(s), {}, seed {}{}",
+                    s.name,
+                    100.0 * start.x_m,
+                    100.0 * start.y_m,
+                    s.layout.goals()[s.episode.goal].name,
+                    s.runs,
+                    s.decoder_text(),
+                    s.seed,
+                    if s.user_seed == s.seed {
+                        String::new()
+                    } else {
+                        format!(" (user seed {})", s.user_seed)
+                    }
+                )
+            }
+        }
+    }
+}
+
 /// Refuses a recording too large to write.
 fn check_recordable(scenario: &AnyScenario, options: &RunOptions<'_>) -> Result<(), RunError> {
     if options.save.is_none() {

@@ -7,8 +7,8 @@ use errp_bci::{OnlineStep, RequestedAccuracy, TargetingStep};
 use errp_sim::epuck::{EpuckRunsTable, EpuckSummaryReport, summarise};
 use errp_sim::grid::{DecoderChoice, GridEpisodeHeader, GridEpisodeResult, GridEpisodeRow};
 use errp_sim::{
-    AnyScenario, RunObserver, RunOptions, RunOutcome, RunProvenance, ScenarioInput, ScenarioSource,
-    SetterNames, run_scenario,
+    AnyScenario, RunHeadline, RunObserver, RunOptions, RunOutcome, RunProvenance, ScenarioInput,
+    ScenarioSource, SetterNames, run_scenario,
 };
 
 use crate::cli::{DecoderArg, RunArgs};
@@ -95,42 +95,6 @@ pub(crate) fn run(args: &RunArgs) -> Result<()> {
     Ok(())
 }
 
-/// What `errp run` says it is about to run.
-fn announce(scenario: &AnyScenario) -> String {
-    match scenario {
-        AnyScenario::Grid(s) => format!(
-            "{}: {} episodes, {} decoder at {:.2} % ({}), seed {}",
-            s.name,
-            s.episodes.len(),
-            match s.decoder {
-                DecoderChoice::Eeg => "EEG",
-                DecoderChoice::Oracle => "oracle",
-            },
-            100.0 * s.accuracy,
-            s.user,
-            s.seed
-        ),
-        AnyScenario::Epuck(s) => {
-            let start = &s.episode.start;
-            format!(
-                "{}: e-puck from ({:.0}, {:.0}) cm to {}, {} run(s), {}, seed {}{}",
-                s.name,
-                100.0 * start.x_m,
-                100.0 * start.y_m,
-                s.layout.goals()[s.episode.goal].name,
-                s.runs,
-                s.decoder_text(),
-                s.seed,
-                if s.user_seed == s.seed {
-                    String::new()
-                } else {
-                    format!(" (user seed {})", s.user_seed)
-                }
-            )
-        }
-    }
-}
-
 /// Prints the run as it goes: the calibration (unless quiet), the
 /// decoder's summary, and each grid episode's row.
 struct Printer {
@@ -156,7 +120,7 @@ impl Printer {
 impl RunObserver for Printer {
     fn start(&self, scenario: &AnyScenario) {
         if !self.quiet {
-            errln!("{}", announce(scenario));
+            errln!("{}", RunHeadline(scenario));
         }
     }
 
