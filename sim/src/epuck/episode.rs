@@ -119,7 +119,12 @@ pub fn run_epuck_episode_with(
     let n_windows = (scenario.params.max_secs / WINDOW_STEP_SECS).ceil() as usize;
     let mut last_target = controller.target();
     let mut committed = None;
-    for _ in 0..n_windows {
+    for k in 0..n_windows {
+        // A stop request (Ctrl-C in Python) ends a long run within a second
+        // of simulated time, not at its end.
+        if k % 16 == 0 {
+            errp_bci::stop::check()?;
+        }
         let w = plant.window(&mut controller, decoder, window_decoder.as_mut(), observer)?;
         let time_secs = plant.time_secs();
         let obs = controller.observe(w.decision.detected, &plant.tracked(), time_secs)?;
