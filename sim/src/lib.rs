@@ -100,8 +100,8 @@ pub use paper::{PAPER, PAPER_EPUCK, PAPER_POOLED};
 pub use runner::{
     BatchRecord, EpuckRun, MAX_RECORDED_EPISODES, MAX_RECORDED_RUNS, PendingRecording, RunError,
     RunHeadline, RunObserver, RunOptions, RunOutcome, RunProvenance, ScenarioRun,
-    epuck_decoder_summary, grid_decoder_summary, run_epuck_batch_recorded, run_grid_batch,
-    run_scenario,
+    check_recordable_episodes, check_recordable_runs, epuck_decoder_summary, grid_decoder_summary,
+    run_epuck_batch_recorded, run_grid_batch, run_scenario,
 };
 pub use scenario::{
     AnyScenario, apply_overrides, is_epuck, load_scenario, load_scenario_with, parse_scenario,

@@ -214,26 +214,47 @@ fn check_recordable(scenario: &AnyScenario, options: &RunOptions<'_>) -> Result<
     if options.save.is_none() {
         return Ok(());
     }
-    let save = options.names.save;
-    let error = match scenario {
-        AnyScenario::Epuck(s) if s.runs as u64 > MAX_RECORDED_RUNS => format!(
-            "{save} with {} runs: a recording holds at most {MAX_RECORDED_RUNS} runs (each adds \
-             about 2.5 MB to the file and 9 MB of memory while it is written); record at most \
-             {MAX_RECORDED_RUNS} ({}), or run them all without {save}",
-            s.runs, options.names.runs
-        ),
-        AnyScenario::Grid(s) if s.episodes.len() > MAX_RECORDED_EPISODES => format!(
-            "{save} with {} episodes: a recording holds at most {MAX_RECORDED_EPISODES} grid \
-             episodes (each adds about 20 kB to the file and 150 kB of memory while it is \
-             written, so {:.1} GB here); record fewer (lower `repeats` in {}), or run them \
-             all without {save}",
-            s.episodes.len(),
-            s.episodes.len() as f64 * 150e3 / 1e9,
-            s.path.display()
-        ),
-        _ => return Ok(()),
-    };
-    Err(plain(SimError::Scenario(error)))
+    match scenario {
+        AnyScenario::Epuck(s) => check_recordable_runs(s.runs as u64, options.names),
+        AnyScenario::Grid(s) => check_recordable_episodes(s, options.names),
+    }
+    .map_err(plain)
+}
+
+/// Refuses to record `runs` e-puck runs into one file: more than
+/// [`MAX_RECORDED_RUNS`]. The error names the inputs as `names` says.
+pub fn check_recordable_runs(runs: u64, names: &SetterNames) -> Result<(), SimError> {
+    if runs <= MAX_RECORDED_RUNS {
+        return Ok(());
+    }
+    let save = names.save;
+    Err(SimError::Scenario(format!(
+        "{save} with {runs} runs: a recording holds at most {MAX_RECORDED_RUNS} runs (each adds \
+         about 2.5 MB to the file and 9 MB of memory while it is written); record at most \
+         {MAX_RECORDED_RUNS} ({}), or run them all without {save}",
+        names.runs
+    )))
+}
+
+/// Refuses to record the episodes of `scenario` into one file: more than
+/// [`MAX_RECORDED_EPISODES`]. The error names the inputs as `names` says.
+pub fn check_recordable_episodes(
+    scenario: &GridScenario,
+    names: &SetterNames,
+) -> Result<(), SimError> {
+    let n = scenario.episodes.len();
+    if n <= MAX_RECORDED_EPISODES {
+        return Ok(());
+    }
+    let save = names.save;
+    Err(SimError::Scenario(format!(
+        "{save} with {n} episodes: a recording holds at most {MAX_RECORDED_EPISODES} grid \
+         episodes (each adds about 20 kB to the file and 150 kB of memory while it is \
+         written, so {:.1} GB here); record fewer (lower `repeats` in {}), or run them \
+         all without {save}",
+        n as f64 * 150e3 / 1e9,
+        scenario.path.display()
+    )))
 }
 
 /// What the grid decoder's calibration found, as `errp run` prints it

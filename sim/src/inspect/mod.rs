@@ -17,6 +17,7 @@ use crate::record::data::{Column, Provenance};
 use crate::record::paths;
 use crate::scenario::AnyScenario;
 
+mod frames;
 mod grid_replay;
 mod read;
 mod report;

@@ -3,7 +3,7 @@
 //! writes them.
 
 use std::collections::BTreeMap;
-use std::io::{BufReader, Read};
+use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
 
 use re_log_encoding::DecoderApp;
@@ -13,7 +13,7 @@ use rerun::external::arrow::array::{
 use rerun::external::arrow::datatypes::DataType;
 use rerun::log::{Chunk, LogMsg};
 
-use crate::inspect::InspectError;
+use crate::inspect::{InspectError, frames};
 use crate::record::data::{Column, FORMAT, FORMAT_VERSION, Provenance};
 use crate::record::paths;
 
@@ -136,18 +136,35 @@ pub(crate) fn read_raw(path: &Path) -> Result<RawRecording, InspectError> {
             RERUN_VERSION[2]
         )));
     }
-    let file = crate::open_regular(path).map_err(|e| InspectError::Io {
-        path: path.to_path_buf(),
-        source: e,
-    })?;
-    let mut messages = DecoderApp::decode_lazy(BufReader::with_capacity(1 << 20, file));
+    // Every size the file states is checked before the decoder trusts it,
+    // and a panic in the decoder is an error about the file.
+    let mut file = BufReader::with_capacity(1 << 20, file);
+    frames::check(&mut file, len).map_err(&bad)?;
+    file.seek(SeekFrom::Start(0))
+        .map_err(|e| InspectError::Io {
+            path: path.to_path_buf(),
+            source: e,
+        })?;
+    frames::guarded(|| decode(file, len))
+        .map_err(|panic| {
+            bad(format!(
+                "it is corrupt: Rerun's decoder failed on it ({panic})"
+            ))
+        })?
+        .map_err(bad)
+}
+
+/// Decodes every message of `file` (`len` bytes), keeping the provenance
+/// and the data tables.
+fn decode(file: BufReader<std::fs::File>, len: u64) -> Result<RawRecording, String> {
+    let mut messages = DecoderApp::decode_lazy(file);
     let mut raw = RawRecording {
         provenance: None,
         application: None,
         tables: BTreeMap::new(),
     };
     for msg in messages.by_ref() {
-        let msg = msg.map_err(|e| bad(format!("it is corrupt: {e}")))?;
+        let msg = msg.map_err(|e| format!("it is corrupt: {e}"))?;
         match msg {
             LogMsg::SetStoreInfo(info) => {
                 if info.info.store_id.is_recording() && raw.application.is_none() {
@@ -158,15 +175,15 @@ pub(crate) fn read_raw(path: &Path) -> Result<RawRecording, InspectError> {
                 if !store.is_recording() {
                     continue;
                 }
-                let chunk = Chunk::from_arrow_msg(&arrow)
-                    .map_err(|e| bad(format!("it is corrupt: {e}")))?;
+                let chunk =
+                    Chunk::from_arrow_msg(&arrow).map_err(|e| format!("it is corrupt: {e}"))?;
                 let entity = chunk.entity_path().to_string();
                 if entity == paths::PROVENANCE {
                     raw.provenance = first_text(&chunk);
                 } else if entity.starts_with(paths::TABLES) {
                     let table = raw.tables.entry(entity.clone()).or_default();
                     read_chunk(&chunk, table)
-                        .map_err(|e| bad(format!("its table {entity} is corrupt: {e}")))?;
+                        .map_err(|e| format!("its table {entity} is corrupt: {e}"))?;
                 }
             }
             LogMsg::BlueprintActivationCommand(_) => {}
@@ -174,10 +191,10 @@ pub(crate) fn read_raw(path: &Path) -> Result<RawRecording, InspectError> {
     }
     let read = messages.num_bytes_processed();
     if read < len {
-        return Err(bad(format!(
+        return Err(format!(
             "it is truncated or corrupt: the last {} of its {len} bytes are not a whole message",
             len - read
-        )));
+        ));
     }
     Ok(raw)
 }
