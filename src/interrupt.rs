@@ -13,7 +13,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use crate::out::errln;
 
 /// Set by the first signal while a sweep writes episodes.
-pub(crate) static CANCEL: AtomicBool = AtomicBool::new(false);
+pub(crate) static WIND_DOWN: errp_bci::stop::WindDown = errp_bci::stop::WindDown::new();
 
 /// True while a sweep writes episodes (a signal then stops it gracefully).
 static GRACEFUL: AtomicBool = AtomicBool::new(false);
@@ -35,7 +35,8 @@ pub(crate) fn install() {
     // Without a handler (an unusual platform) the default action stays:
     // the process ends, and the next run removes what it left.
     let _ = ctrlc::set_handler(|| {
-        if GRACEFUL.load(Ordering::SeqCst) && !CANCEL.swap(true, Ordering::SeqCst) {
+        if GRACEFUL.load(Ordering::SeqCst) && !WIND_DOWN.requested() {
+            WIND_DOWN.request();
             errln!(
                 "\nStopping after the episodes in progress (every row on disk is kept; signal \
                  again to stop at once)"

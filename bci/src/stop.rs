@@ -34,3 +34,29 @@ pub fn check() -> Result<()> {
         Ok(())
     }
 }
+
+/// A request to wind down, held by the caller of work that runs in units
+/// (a sweep's episodes, a fit's users): the units in flight finish and no
+/// more start, so that everything written is whole and the same call
+/// resumes. A stop [`request`]ed process-wide winds down too, so a caller
+/// that sets only that (the Python package on Ctrl-C) needs nothing else.
+#[derive(Debug, Default)]
+pub struct WindDown(AtomicBool);
+
+impl WindDown {
+    /// No request yet.
+    pub const fn new() -> Self {
+        Self(AtomicBool::new(false))
+    }
+
+    /// Asks the work to finish its units in flight and start no more.
+    pub fn request(&self) {
+        self.0.store(true, Ordering::SeqCst);
+    }
+
+    /// Whether to start no more units: this was requested, or a stop was,
+    /// process-wide.
+    pub fn requested(&self) -> bool {
+        self.0.load(Ordering::SeqCst) || requested()
+    }
+}

@@ -62,7 +62,7 @@ pub(crate) type Shown<'a, 'py> = Option<(&'a Meter, &'a Bound<'py, PyAny>)>;
 
 /// `work` run as the module says, its result once it is done.
 pub(crate) fn long<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> PyResult<T> {
-    long_or(py, || {}, None, work)
+    long_or(py, None, work)
 }
 
 /// [`long`], its progress shown by `progress` when given.
@@ -72,16 +72,16 @@ pub(crate) fn long_shown<T: Send>(
     progress: Option<&Bound<'_, PyAny>>,
     work: impl FnOnce() -> T + Send,
 ) -> PyResult<T> {
-    long_or(py, || {}, progress.map(|p| (meter, p)), work)
+    long_or(py, progress.map(|p| (meter, p)), work)
 }
 
-/// [`long`], with `on_stop` also run when a signal stops the work (a
-/// sweep's own cancel flag, which it polls between episodes), and the
-/// progress `shown`. An exception the progress callable raises stops the
-/// work as a signal does.
+/// [`long`], with the progress `shown`. An exception the progress
+/// callable raises stops the work as a signal does. A signal stops every
+/// kind of work one way ([`errp_bci::stop::request`]): a sweep sees it as a
+/// [`errp_bci::stop::WindDown`] too, so the rows it wrote are kept and the
+/// same call later resumes.
 pub(crate) fn long_or<T: Send>(
     py: Python<'_>,
-    on_stop: impl Fn(),
     shown: Shown<'_, '_>,
     work: impl FnOnce() -> T + Send,
 ) -> PyResult<T> {
@@ -120,7 +120,6 @@ pub(crate) fn long_or<T: Send>(
                 Err(RecvTimeoutError::Timeout) => {
                     if let Err(e) = py.check_signals().and_then(|()| show()) {
                         errp_bci::stop::request();
-                        on_stop();
                         // Wait for the work to see it, the GIL released
                         // (a decoder of the caller's own may need it).
                         let _ = py.detach(move || rx.recv());

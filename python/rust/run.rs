@@ -2,9 +2,9 @@
 //! them, and Monte Carlo sweeps as `errp sweep` writes them.
 
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, PoisonError};
 
+use errp_bci::stop::WindDown;
 use errp_sim::calibration::CalibrationReport;
 use errp_sim::epuck::{
     ContinuousDecoder, ContinuousReport, EpuckEpisodeResult, EpuckScenario, EpuckTask, epuck_row,
@@ -414,23 +414,20 @@ pub(crate) fn sweep<'py>(
         chunk: 0,
         repair: false,
     };
-    let cancel = AtomicBool::new(false);
+    let wind_down = WindDown::new();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .map_err(|e| PyValueError::new_err(format!("threads: cannot start them: {e}")))?;
-    // Ctrl-C also sets the sweep's own flag: the rows written so far are
-    // kept, and the same call later resumes.
+    // Ctrl-C's stop request winds the sweep down too: the rows written so
+    // far are kept, and the same call later resumes.
     let watch = SweepWatch::default();
     if let Some(why) = opts.cache.unwritable("give another cache= directory") {
         watch.keep(&format!("cache: {why}"));
     }
-    let outcome = long_or(
-        py,
-        || cancel.store(true, Ordering::SeqCst),
-        progress.map(|p| (&watch.meter, p)),
-        || pool.install(|| errp_sweep::run_sweep(&sweep, &opts, &cancel, &watch)),
-    )?
+    let outcome = long_or(py, progress.map(|p| (&watch.meter, p)), || {
+        pool.install(|| errp_sweep::run_sweep(&sweep, &opts, &wind_down, &watch))
+    })?
     .map_err(py_err)?;
     match outcome {
         SweepOutcome::Interrupted { .. } => {

@@ -20,8 +20,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::{
-    Keys, PyDecoder, blocks_to_array3, channel_names, check_callable, load_epuck, load_grid,
-    py_err, value_error,
+    KEYWORDS, Keys, PyDecoder, blocks_to_array3, channel_names, check_callable, load_epuck,
+    load_grid, py_err, value_error,
 };
 use crate::interrupt::{CALIBRATING, Meter, long, long_shown};
 use crate::run::{
@@ -136,15 +136,8 @@ impl GridTask {
     ) -> PyResult<String> {
         check_save(save.as_ref())?;
         let s = &self.scenario;
-        if save.is_some() && s.episodes.len() > errp_sim::MAX_RECORDED_EPISODES {
-            return Err(value_error(
-                "save",
-                format!("a scenario of {} episodes", s.episodes.len()),
-                &format!(
-                    "at most {} episodes in a recording",
-                    errp_sim::MAX_RECORDED_EPISODES
-                ),
-            ));
+        if save.is_some() {
+            errp_sim::check_recordable_episodes(s, &KEYWORDS).map_err(py_err)?;
         }
         let recording = PendingRecording::open(save.as_deref(), false).map_err(py_err)?;
         let own = self.decoder.is_some() || self.scores.is_some();
@@ -359,16 +352,8 @@ impl EpuckTask {
                 &format!("a whole number from 1 to {max}"),
             ));
         }
-        if save.is_some() && runs as u64 > errp_sim::MAX_RECORDED_RUNS {
-            return Err(value_error(
-                "runs",
-                runs,
-                &format!(
-                    "at most {} with save= (each run adds about 2.5 MB to \
-                     the recording)",
-                    errp_sim::MAX_RECORDED_RUNS
-                ),
-            ));
+        if save.is_some() {
+            errp_sim::check_recordable_runs(runs as u64, &KEYWORDS).map_err(py_err)?;
         }
         let s = &self.scenario;
         let d = &self.builtin;

@@ -133,6 +133,11 @@ def test_tasks_record_with_the_callers_decoder(tmp_path):
     # The same runs as without a recording.
     again = etask.run(2)
     assert list(again.time_secs) == list(df.time_secs)
+    # Too many runs for one file: refused before anything is run or written.
+    big = tmp_path / "big.rrd"
+    with pytest.raises(ValueError, match=r"save with 101 runs: a recording holds at most 100"):
+        etask.run(101, save=big)
+    assert not big.exists()
 
 
 def test_save_refuses_what_errp_did_not_write(tmp_path):

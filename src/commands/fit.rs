@@ -172,7 +172,7 @@ fn fit_epuck(args: &EpuckFitArgs) -> Result<bool> {
             &args.out,
             &cache,
             provenance,
-            &interrupt::CANCEL,
+            &interrupt::WIND_DOWN,
             &progress,
             |i, n, run, seed| {
                 progress.line(&format!(
@@ -331,7 +331,7 @@ fn fit_grid(args: &GridFitArgs) -> Result<bool> {
             &args.out,
             &cache,
             provenance(),
-            &interrupt::CANCEL,
+            &interrupt::WIND_DOWN,
             &progress,
         )
     });

@@ -342,7 +342,7 @@ pub fn sweep(args: &SweepArgs) -> Result<bool> {
     ));
     let started = wall_clock();
     let outcome = pool.install(|| {
-        run_sweep(&sweep, &opts, &interrupt::CANCEL, &progress)
+        run_sweep(&sweep, &opts, &interrupt::WIND_DOWN, &progress)
             .map_err(|e| name_flag(e, "--out", &opts.out))
     });
     interrupt::graceful(false);

@@ -5,7 +5,8 @@
 //! sweep is rerun. Run with `cargo bench -p errp_sweep --bench sweep`.
 
 use std::path::PathBuf;
-use std::sync::atomic::AtomicBool;
+
+use errp_bci::stop::WindDown;
 
 use divan::Bencher;
 use errp_sweep::{
@@ -78,7 +79,7 @@ fn sweep(spec: &SweepSpec, threads: usize, cache: &TargetCache, name: &str) {
     let outcome = pool
         .install(|| {
             let sweep = spec.clone().checked(&InputNames::CLI).unwrap();
-            run_sweep(&sweep, &opts, &AtomicBool::new(false), &())
+            run_sweep(&sweep, &opts, &WindDown::new(), &())
         })
         .unwrap();
     assert!(matches!(outcome, SweepOutcome::Complete { .. }));
@@ -124,11 +125,11 @@ fn recheck_40000_rows(bencher: Bencher) {
         chunk: 0,
         repair: false,
     };
-    let cancel = AtomicBool::new(false);
+    let wind_down = WindDown::new();
     let sweep = spec.checked(&InputNames::CLI).unwrap();
-    run_sweep(&sweep, &opts, &cancel, &()).unwrap();
+    run_sweep(&sweep, &opts, &wind_down, &()).unwrap();
     bencher.bench_local(|| {
-        let outcome = run_sweep(&sweep, &opts, &cancel, &()).unwrap();
+        let outcome = run_sweep(&sweep, &opts, &wind_down, &()).unwrap();
         assert!(matches!(outcome, SweepOutcome::Complete { ran: 0, .. }));
     });
     let _ = std::fs::remove_dir_all(&out);

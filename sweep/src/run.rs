@@ -6,8 +6,8 @@ use std::fs::OpenOptions;
 use std::io::{Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::sync::atomic::AtomicBool;
 
+use errp_bci::stop::WindDown;
 use errp_sim::epuck::EpuckTask;
 use errp_sim::grid::GridTask;
 use errp_sim::task::{DecoderInfo, Task};
@@ -60,7 +60,7 @@ pub enum SweepOutcome {
         /// writes them).
         report: Option<SweepReport>,
     },
-    /// Stopped by the cancel flag; rerunning resumes.
+    /// Wound down (its `WindDown` was requested); rerunning resumes.
     Interrupted {
         /// Episodes on disk.
         done: usize,
@@ -71,7 +71,7 @@ pub enum SweepOutcome {
 
 /// Runs (or resumes) a sweep's slice into `opts.out`, holding the
 /// directory's lock ([`DirLock`]) throughout; a whole sweep is also
-/// finished (summary, plots, final manifest). `cancel` is polled between
+/// finished (summary, plots, final manifest). `wind_down` is polled between
 /// episodes: when it is set the rows written so far stay, and the same call
 /// later resumes. Results do not depend on the thread count (run it inside
 /// a rayon pool to choose one), on `opts.chunk`, or on interruptions.
@@ -83,7 +83,7 @@ pub enum SweepOutcome {
 pub fn run_sweep(
     sweep: &CheckedSweep,
     opts: &SweepOptions,
-    cancel: &AtomicBool,
+    wind_down: &WindDown,
     observer: &dyn SweepObserver,
 ) -> Result<SweepOutcome> {
     let (spec, levels) = (sweep.spec(), sweep.levels());
@@ -130,10 +130,10 @@ pub fn run_sweep(
 
     let outcome = match spec.task {
         SweepTask::Grid => {
-            run_levels::<GridTask>(spec, opts, levels, fresh, &made_with, cancel, observer)
+            run_levels::<GridTask>(spec, opts, levels, fresh, &made_with, wind_down, observer)
         }
         SweepTask::Epuck => {
-            run_levels::<EpuckTask>(spec, opts, levels, fresh, &made_with, cancel, observer)
+            run_levels::<EpuckTask>(spec, opts, levels, fresh, &made_with, wind_down, observer)
         }
     };
     // A new directory that failed before its first row goes.
@@ -373,7 +373,7 @@ fn run_levels<T: Task>(
     levels: &[Level],
     fresh: Manifest,
     made_with: &[DecoderInfo],
-    cancel: &AtomicBool,
+    wind_down: &WindDown,
     observer: &dyn SweepObserver,
 ) -> Result<SweepOutcome> {
     let out = &opts.out;
@@ -440,7 +440,7 @@ fn run_levels<T: Task>(
         levels,
         runners: &runners,
         items,
-        cancel,
+        wind_down,
         observer,
         sync_every,
         window: 64 * rayon::current_num_threads(),

@@ -4,8 +4,9 @@ use std::fs::File;
 use std::io::{BufRead, BufReader, Read, Write};
 use std::path::Path;
 use std::sync::Mutex;
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
+use errp_bci::stop::WindDown;
 use errp_sim::task::Task;
 use errp_sim::{Result, SimError};
 
@@ -23,7 +24,7 @@ pub(crate) struct EpisodeJob<'a, T: Task> {
     pub(crate) levels: &'a [Level],
     pub(crate) runners: &'a [T::Runner],
     pub(crate) items: Slice,
-    pub(crate) cancel: &'a AtomicBool,
+    pub(crate) wind_down: &'a WindDown,
     pub(crate) observer: &'a dyn SweepObserver,
     pub(crate) sync_every: usize,
     pub(crate) window: usize,
@@ -63,7 +64,7 @@ impl<T: Task> EpisodeJob<'_, T> {
             for _ in 0..rayon::current_num_threads() {
                 scope.spawn(|_| {
                     loop {
-                        if self.cancel.load(Ordering::SeqCst) {
+                        if self.wind_down.requested() {
                             break;
                         }
                         let i = next.fetch_add(1, Ordering::SeqCst);

@@ -2,8 +2,8 @@
 //! against the committed fit (`fits/epuck.json`).
 
 use std::path::Path;
-use std::sync::atomic::AtomicBool;
 
+use errp_bci::stop::WindDown;
 use errp_sweep::fit::{
     EpuckFitSpec, FitOutcome, GridFitOutcome, GridFitSpec, Provenance, paper_runs, run_epuck_fit,
     run_grid_fit,
@@ -122,7 +122,7 @@ fn a_small_fit_writes_its_files_resumes_to_the_same_bytes_and_guards_its_directo
         seed: 3,
         bootstrap: 20,
     };
-    let cancel = AtomicBool::new(false);
+    let wind_down = WindDown::new();
     let mut sweeps = Vec::new();
     let run = |sweeps: &mut Vec<u64>| {
         run_epuck_fit(
@@ -130,7 +130,7 @@ fn a_small_fit_writes_its_files_resumes_to_the_same_bytes_and_guards_its_directo
             &out,
             &cache(),
             provenance(),
-            &cancel,
+            &wind_down,
             &(),
             |_, _, _, seed| sweeps.push(seed),
         )
@@ -166,7 +166,7 @@ fn a_small_fit_writes_its_files_resumes_to_the_same_bytes_and_guards_its_directo
         &foreign,
         &cache(),
         provenance(),
-        &cancel,
+        &wind_down,
         &(),
         |_, _, _, _| {},
     )
@@ -184,7 +184,7 @@ fn a_small_fit_writes_its_files_resumes_to_the_same_bytes_and_guards_its_directo
         &out,
         &cache(),
         provenance(),
-        &cancel,
+        &wind_down,
         &(),
         |_, _, _, _| {},
     )
@@ -235,13 +235,7 @@ fn the_median_time_to_pisa_does_not_rise_with_accuracy() {
         chunk: 0,
         repair: false,
     };
-    run_sweep(
-        &spec.checked(&names).unwrap(),
-        &opts,
-        &AtomicBool::new(false),
-        &(),
-    )
-    .unwrap();
+    run_sweep(&spec.checked(&names).unwrap(), &opts, &WindDown::new(), &()).unwrap();
     let text = std::fs::read_to_string(out.join("episodes.csv")).unwrap();
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
@@ -419,9 +413,9 @@ fn the_shipped_grid_q_scale_is_the_committed_fit() {
 
 /// Runs the grid fit of `spec` into `out` to its end.
 fn complete_grid_fit(spec: &GridFitSpec, out: &std::path::Path) -> Box<errp_sweep::fit::GridFit> {
-    let cancel = AtomicBool::new(false);
+    let wind_down = WindDown::new();
     let GridFitOutcome::Complete(fit, _) =
-        run_grid_fit(spec, out, &cache(), provenance(), &cancel, &()).unwrap()
+        run_grid_fit(spec, out, &cache(), provenance(), &wind_down, &()).unwrap()
     else {
         panic!("not interrupted")
     };
@@ -448,9 +442,9 @@ fn small_grid_spec() -> GridFitSpec {
 fn a_small_grid_fit_writes_its_files_and_refuses_bad_settings() {
     let out = temp_dir("fit-grid");
     let spec = small_grid_spec();
-    let cancel = AtomicBool::new(false);
+    let wind_down = WindDown::new();
     let GridFitOutcome::Complete(fit, files) =
-        run_grid_fit(&spec, &out, &cache(), provenance(), &cancel, &()).unwrap()
+        run_grid_fit(&spec, &out, &cache(), provenance(), &wind_down, &()).unwrap()
     else {
         panic!("not interrupted")
     };
@@ -478,7 +472,7 @@ fn a_small_grid_fit_writes_its_files_and_refuses_bad_settings() {
     let foreign = temp_dir("fit-grid-foreign");
     std::fs::create_dir_all(&foreign).unwrap();
     std::fs::write(foreign.join("mine.txt"), "mine").unwrap();
-    let e = run_grid_fit(&spec, &foreign, &cache(), provenance(), &cancel, &())
+    let e = run_grid_fit(&spec, &foreign, &cache(), provenance(), &wind_down, &())
         .unwrap_err()
         .to_string();
     assert!(e.contains("mine.txt") && e.contains("--out"), "{e}");
@@ -534,7 +528,7 @@ fn a_small_grid_fit_writes_its_files_and_refuses_bad_settings() {
             "--trial-latency-sd must list increasing",
         ),
     ] {
-        let e = run_grid_fit(&bad, &out, &cache(), provenance(), &cancel, &())
+        let e = run_grid_fit(&bad, &out, &cache(), provenance(), &wind_down, &())
             .unwrap_err()
             .to_string();
         assert!(e.contains(flag), "{e}");

@@ -4,8 +4,8 @@
 //! directory it created.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::AtomicBool;
 
+use errp_bci::stop::WindDown;
 use errp_sweep::{DirLock, Shard, SweepOutcome, SweepSpec, merge_sweeps, run_sweep};
 
 use crate::{GRID_ORACLE, complete, options, read, spec, temp_dir};
@@ -115,7 +115,7 @@ fn run(spec: &SweepSpec, out: &Path, shard: Shard, repair: bool) -> errp_sim::Re
     run_sweep(
         &spec.clone().checked(&errp_sweep::InputNames::CLI)?,
         &opts,
-        &AtomicBool::new(false),
+        &WindDown::new(),
         &(),
     )
 }

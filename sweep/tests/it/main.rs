@@ -10,8 +10,8 @@ mod integrity;
 mod results;
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::AtomicBool;
 
+use errp_bci::stop::WindDown;
 use errp_sweep::{
     InputNames, Shard, SweepOptions, SweepOutcome, SweepSpec, SweepTask, TargetCache,
     parse_accuracies, parse_axis, run_sweep,
@@ -93,12 +93,7 @@ pub(crate) fn complete(spec: &SweepSpec, out: &Path, shard: Shard, threads: usiz
     let outcome = pool
         .install(|| {
             let sweep = spec.clone().checked(&InputNames::CLI).unwrap();
-            run_sweep(
-                &sweep,
-                &options(out, shard, 7),
-                &AtomicBool::new(false),
-                &(),
-            )
+            run_sweep(&sweep, &options(out, shard, 7), &WindDown::new(), &())
         })
         .unwrap();
     let SweepOutcome::Complete { report, .. } = outcome else {

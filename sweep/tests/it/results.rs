@@ -3,8 +3,8 @@
 //! right way.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
 
+use errp_bci::stop::WindDown;
 use errp_sweep::{
     Manifest, Shard, SweepObserver, SweepOutcome, SweepSpec, merge_sweeps, run_sweep,
 };
@@ -55,16 +55,16 @@ fn sharded_and_merged_equals_unsharded_and_threads_do_not_matter() {
     }
 }
 
-/// Sets the cancel flag once `after` episodes are on disk.
+/// Requests the wind-down once `after` episodes are on disk.
 struct CancelAfter<'a> {
     after: usize,
-    cancel: &'a AtomicBool,
+    wind_down: &'a WindDown,
 }
 
 impl SweepObserver for CancelAfter<'_> {
     fn episodes_done(&self, done: usize, _total: usize) {
         if done >= self.after {
-            self.cancel.store(true, Ordering::SeqCst);
+            self.wind_down.request();
         }
     }
 }
@@ -77,13 +77,13 @@ fn an_interrupted_or_crashed_sweep_resumes_to_the_same_files() {
 
     // Ctrl-C after the first chunks: the rows so far stay on disk.
     let resumed = temp_dir("resumed");
-    let cancel = AtomicBool::new(false);
+    let wind_down = WindDown::new();
     let stop = CancelAfter {
         after: 30,
-        cancel: &cancel,
+        wind_down: &wind_down,
     };
     let sweep = spec.clone().checked(&errp_sweep::InputNames::CLI).unwrap();
-    let outcome = run_sweep(&sweep, &options(&resumed, Shard::ALL, 7), &cancel, &stop).unwrap();
+    let outcome = run_sweep(&sweep, &options(&resumed, Shard::ALL, 7), &wind_down, &stop).unwrap();
     let SweepOutcome::Interrupted { done, total } = outcome else {
         panic!("{outcome:?}")
     };
@@ -108,7 +108,7 @@ fn an_interrupted_or_crashed_sweep_resumes_to_the_same_files() {
             run_sweep(
                 &sweep,
                 &options(&resumed, Shard::ALL, 50),
-                &AtomicBool::new(false),
+                &WindDown::new(),
                 &(),
             )
         })
@@ -125,7 +125,7 @@ fn an_interrupted_or_crashed_sweep_resumes_to_the_same_files() {
     let e = run_sweep(
         &other.checked(&errp_sweep::InputNames::CLI).unwrap(),
         &options(&resumed, Shard::ALL, 7),
-        &AtomicBool::new(false),
+        &WindDown::new(),
         &(),
     )
     .unwrap_err()

@@ -18,9 +18,9 @@
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::AtomicBool;
 
 use errp_bci::rng::stream;
+use errp_bci::stop::WindDown;
 use errp_sim::{PAPER_EPUCK, Result, SimError, create_dir};
 use serde::Serialize;
 
@@ -222,7 +222,7 @@ pub fn sweep_dir(out: &Path, run: &PaperRun, seed: u64) -> PathBuf {
 /// The outcome of [`run_epuck_fit`].
 #[derive(Debug)]
 pub enum FitOutcome {
-    /// Stopped by the cancel flag; rerunning resumes the sweeps.
+    /// Wound down (its `WindDown` was requested); rerunning resumes the sweeps.
     Interrupted,
     /// The fit, and the files written.
     Complete(Box<EpuckFit>, Vec<PathBuf>),
@@ -236,7 +236,7 @@ pub fn run_epuck_fit(
     out: &Path,
     cache: &TargetCache,
     provenance: Provenance,
-    cancel: &AtomicBool,
+    wind_down: &WindDown,
     observer: &dyn SweepObserver,
     mut before_sweep: impl FnMut(usize, usize, &PaperRun, u64),
 ) -> Result<FitOutcome> {
@@ -269,7 +269,7 @@ pub fn run_epuck_fit(
                 chunk: 0,
                 repair: false,
             };
-            match run_sweep(&sweep.checked(&NAMES)?, &opts, cancel, observer)? {
+            match run_sweep(&sweep.checked(&NAMES)?, &opts, wind_down, observer)? {
                 SweepOutcome::Interrupted { .. } => return Ok(FitOutcome::Interrupted),
                 SweepOutcome::Complete { .. } => {}
             }

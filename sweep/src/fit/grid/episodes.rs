@@ -4,6 +4,7 @@
 
 #[allow(clippy::wildcard_imports)]
 use super::*;
+use errp_bci::stop::WindDown;
 
 /// `runs[point][calibration][repeat][pair]`.
 pub(super) type PointRuns = Vec<Vec<Vec<Vec<Run>>>>;
@@ -15,7 +16,7 @@ pub(super) struct Episodes<'a> {
     pub(super) calibrations: &'a [Calibration],
     pub(super) base: GridTaskParams,
     pub(super) family: &'a PairFamily,
-    pub(super) cancel: &'a AtomicBool,
+    pub(super) wind_down: &'a WindDown,
     pub(super) observer: &'a dyn SweepObserver,
     pub(super) done: AtomicUsize,
     pub(super) total: usize,
@@ -53,7 +54,7 @@ impl Episodes<'_> {
                 })
                 .collect::<Result<Vec<_>>>()
                 .or_else(|e| {
-                    if self.cancel.load(Ordering::Relaxed) {
+                    if self.wind_down.requested() {
                         Ok(Vec::new())
                     } else {
                         Err(e)
@@ -76,7 +77,7 @@ impl Episodes<'_> {
         table: &QTable,
         params: &GridTaskParams,
     ) -> Result<Vec<Run>> {
-        if self.cancel.load(Ordering::Relaxed) {
+        if self.wind_down.requested() {
             return Err(SimError::Sweep("interrupted".into()));
         }
         let group_pairs = match (c.goals, length) {

@@ -23,9 +23,10 @@
 //! episodes' seeds (common random numbers), so the surface is smooth.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use errp_bci::rng::{derive_seed, stream};
+use errp_bci::stop::WindDown;
 use errp_bci::{GoalSet, subjects};
 use errp_robot::{Cell, Grid, GridControlParams, QTable};
 use errp_sim::grid::{
@@ -309,7 +310,7 @@ impl From<&GridEpisodeResult> for Run {
 /// The outcome of [`run_grid_fit`].
 #[derive(Debug)]
 pub enum GridFitOutcome {
-    /// Stopped by the cancel flag (nothing written; the targetings found
+    /// Wound down (its `WindDown` was requested) (nothing written; the targetings found
     /// are in the cache).
     Interrupted,
     /// The fit, and the files written.
@@ -455,20 +456,20 @@ pub fn run_grid_fit(
     out: &Path,
     cache: &TargetCache,
     provenance: Provenance,
-    cancel: &AtomicBool,
+    wind_down: &WindDown,
     observer: &dyn SweepObserver,
 ) -> Result<GridFitOutcome> {
     check_spec(spec)?;
     check_out(out)?;
     let fit = if spec.trial_latency_sds.is_empty() {
-        fit_users(spec, cache, provenance, cancel, observer)?
+        fit_users(spec, cache, provenance, wind_down, observer)?
     } else {
         let mut fits = Vec::with_capacity(spec.trial_latency_sds.len());
         for &sd in &spec.trial_latency_sds {
             let mut at = spec.clone();
             at.realism.trial_latency_sd_ms = Some(sd);
             at.trial_latency_sds = Vec::new();
-            match fit_users(&at, cache, provenance.clone(), cancel, observer)? {
+            match fit_users(&at, cache, provenance.clone(), wind_down, observer)? {
                 Some(fit) => fits.push(fit),
                 None => return Ok(GridFitOutcome::Interrupted),
             }
@@ -488,7 +489,7 @@ pub fn run_grid_fit(
 fn calibrate_users(
     spec: &GridFitSpec,
     cache: &TargetCache,
-    cancel: &AtomicBool,
+    wind_down: &WindDown,
     observer: &dyn SweepObserver,
     base: GridTaskParams,
 ) -> Result<Option<Vec<Calibration>>> {
@@ -512,7 +513,7 @@ fn calibrate_users(
     let calibrations: Vec<Calibration> = jobs
         .par_iter()
         .map(|&(subject, goals, index, seed)| {
-            if cancel.load(Ordering::Relaxed) {
+            if wind_down.requested() {
                 return Ok(None);
             }
             let rows = if goals == GoalSet::Fixed {
@@ -552,13 +553,13 @@ fn fit_users(
     spec: &GridFitSpec,
     cache: &TargetCache,
     provenance: Provenance,
-    cancel: &AtomicBool,
+    wind_down: &WindDown,
     observer: &dyn SweepObserver,
 ) -> Result<Option<GridFit>> {
     let fixed = paper_rows(GoalSet::Fixed);
     let free = paper_rows(GoalSet::Free);
     let base = GridTaskParams::default();
-    let Some(calibrations) = calibrate_users(spec, cache, cancel, observer, base)? else {
+    let Some(calibrations) = calibrate_users(spec, cache, wind_down, observer, base)? else {
         return Ok(None);
     };
     let family = PairFamily::paper();
@@ -569,7 +570,7 @@ fn fit_users(
         calibrations: &calibrations,
         base,
         family: &family,
-        cancel,
+        wind_down,
         observer,
         done: AtomicUsize::new(0),
         total: per_set * (sets.max(1) + 1),
