@@ -103,10 +103,7 @@ pub use runner::{
     check_recordable_episodes, check_recordable_runs, epuck_decoder_summary, grid_decoder_summary,
     run_epuck_batch_recorded, run_grid_batch, run_scenario,
 };
-pub use scenario::{
-    AnyScenario, apply_overrides, is_epuck, load_scenario, load_scenario_with, parse_scenario,
-    parse_scenario_table, parse_scenario_with, scenario_text_with,
-};
+pub use scenario::{AnyScenario, apply_overrides, is_epuck, parse_scenario, parse_scenario_table};
 pub use scenario_file::{
     MAX_KEY_PARTS, MAX_SCENARIO_BYTES, key_parts, parse_toml, read_scenario, table_into, truncate,
 };

@@ -5,6 +5,7 @@ use std::path::Path;
 
 pub mod data;
 pub mod paths;
+pub mod schema;
 
 pub use paths::eeg_channel;
 

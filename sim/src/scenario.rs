@@ -6,9 +6,9 @@ use std::path::Path;
 use serde::Deserialize;
 
 use crate::epuck::scenario::EpuckScenario;
-use crate::error::{Result, SimError};
+use crate::error::Result;
 use crate::grid::scenario::GridScenario;
-use crate::scenario_file::{key_parts, parse_toml, read_scenario};
+use crate::scenario_file::{key_parts, parse_toml};
 
 /// A scenario of either task, as `errp run` takes it.
 #[derive(Debug, Clone)]
@@ -38,56 +38,6 @@ impl AnyScenario {
             AnyScenario::Epuck(s) => &s.realism,
         }
     }
-}
-
-/// Reads a scenario file and validates it according to its `task` field.
-pub fn load_scenario(path: impl AsRef<Path>) -> Result<AnyScenario> {
-    let path = path.as_ref();
-    parse_scenario(&read_scenario(path)?, path)
-}
-
-/// Reads a scenario file, sets `overrides` (dotted keys, as the file spells
-/// them: `user.accuracy`, `seed`, `runs`, `decoder`, ...) in its text as
-/// [`apply_overrides`] does, and validates the result: overrides are parsed
-/// and checked exactly as if the file said them, so nothing derived from a
-/// value (the accuracy the device assumes, the free goals drawn from the
-/// seed) can be left behind.
-pub fn load_scenario_with(
-    path: impl AsRef<Path>,
-    overrides: &[(&str, toml::Value)],
-) -> Result<AnyScenario> {
-    let path = path.as_ref();
-    parse_scenario_with(&read_scenario(path)?, path, overrides)
-}
-
-/// [`load_scenario_with`] for a scenario's text (`path` names it in
-/// errors). With overrides, an error names the file and the field but no
-/// line: the text read is not the file as written.
-pub fn parse_scenario_with(
-    text: &str,
-    path: &Path,
-    overrides: &[(&str, toml::Value)],
-) -> Result<AnyScenario> {
-    if overrides.is_empty() {
-        return parse_scenario(text, path);
-    }
-    let table: toml::Table = parse_toml(&scenario_text_with(text, path, overrides)?, path)?;
-    parse_scenario_table(&table, path)
-}
-
-/// A scenario's text as run: `text` with `overrides` set by
-/// [`apply_overrides`] (the text itself when there are none), for
-/// recordings that say how they were made.
-pub fn scenario_text_with(
-    text: &str,
-    path: &Path,
-    overrides: &[(&str, toml::Value)],
-) -> Result<String> {
-    if overrides.is_empty() {
-        return Ok(text.to_string());
-    }
-    apply_overrides(text, overrides)
-        .map_err(|e| SimError::Scenario(format!("{}: {e}", path.display())))
 }
 
 /// Sets `overrides` in a scenario's TOML `text`, in order, and returns the

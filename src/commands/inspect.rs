@@ -294,16 +294,8 @@ fn write_tables(
 /// Every e-puck run's path (8 points a second, as the viewer draws the
 /// trajectory) and detections, in cm, from the recording's frames.
 fn epuck_paths(rec: &Recording, results: &[errp_sim::epuck::EpuckEpisodeResult]) -> Vec<RunPath> {
-    let frames = rec.tables.get(errp_sim::record::paths::FRAMES);
-    let col = |name: &str| match frames.and_then(|t| t.column(name)) {
-        Some(errp_sim::record::data::Column::F64(v)) => v.as_slice(),
-        _ => &[],
-    };
-    let runs_col: &[i64] = match frames.and_then(|t| t.column("run")) {
-        Some(errp_sim::record::data::Column::I64(v)) => v,
-        _ => &[],
-    };
-    let (xs, ys) = (col("x_cm"), col("y_cm"));
+    let frames = errp_sim::record::schema::FramesView::or_empty(&rec.tables);
+    let (runs_col, xs, ys) = (frames.run, frames.x_cm, frames.y_cm);
     let mut paths: Vec<RunPath> = results
         .iter()
         .map(|r| RunPath {

@@ -9,7 +9,8 @@ use rerun::{Boxes2D, Color, Image, Points2D, RecordingStream, Scalars, SeriesLin
 use crate::error::Result;
 use crate::grid::run::GridRunReport;
 use crate::grid::{GridEpisodeResult, GridStep};
-use crate::record::data::{Column, Provenance, send_table};
+use crate::record::data::Provenance;
+use crate::record::schema::{Actions, Ends, GridRuns};
 use crate::record::{
     RrdFile, SIM_TIME, eeg_channel, log_decoder_series, paths, record_error, task_blueprint,
 };
@@ -225,83 +226,48 @@ fn send_episode_tables(
     ep: &GridEpisodeResult,
 ) -> std::result::Result<(), rerun::RecordingStreamError> {
     let run = k as i64;
-    let runs = |n: usize| Column::I64(vec![run; n]);
-    send_table(
-        rec,
-        paths::RUNS,
-        &[t0],
-        vec![
-            ("run", runs(1)),
-            ("seed", Column::I64(vec![seed as i64])),
-            ("goal", Column::I64(vec![grid.index(ep.goal) as i64])),
-            ("start_x", Column::I64(vec![ep.start.x as i64])),
-            ("start_y", Column::I64(vec![ep.start.y as i64])),
-            ("goal_x", Column::I64(vec![ep.goal.x as i64])),
-            ("goal_y", Column::I64(vec![ep.goal.y as i64])),
-            ("epoch_s", Column::F64(vec![epoch_secs])),
-        ],
-    )?;
+    GridRuns {
+        run: vec![run],
+        seed: vec![seed as i64],
+        goal: vec![grid.index(ep.goal) as i64],
+        start_x: vec![ep.start.x as i64],
+        start_y: vec![ep.start.y as i64],
+        goal_x: vec![ep.goal.x as i64],
+        goal_y: vec![ep.goal.y as i64],
+        epoch_s: vec![epoch_secs],
+    }
+    .send(rec, &[t0])?;
     let steps = &ep.steps;
-    let n = steps.len();
     let times: Vec<f64> = steps.iter().map(|s| t0 + s.onset_secs).collect();
     let int = |f: &dyn Fn(&crate::grid::GridStep) -> usize| {
-        Column::I64(steps.iter().map(|s| f(s) as i64).collect())
+        steps.iter().map(|s| f(s) as i64).collect::<Vec<_>>()
     };
-    send_table(
-        rec,
-        paths::ACTIONS,
-        &times,
-        vec![
-            ("run", runs(n)),
-            (
-                "t_s",
-                Column::F64(steps.iter().map(|s| s.onset_secs).collect()),
-            ),
-            ("from_x", int(&|s| s.from.x)),
-            ("from_y", int(&|s| s.from.y)),
-            (
-                "action",
-                Column::Str(steps.iter().map(|s| s.action.name().to_string()).collect()),
-            ),
-            ("to_x", int(&|s| s.to.x)),
-            ("to_y", int(&|s| s.to.y)),
-            (
-                "error",
-                Column::Bool(steps.iter().map(|s| s.error).collect()),
-            ),
-            (
-                "p_error",
-                Column::F64(steps.iter().map(|s| s.p_error).collect()),
-            ),
-            (
-                "decoded_error",
-                Column::Bool(steps.iter().map(|s| s.decoded_error).collect()),
-            ),
-            (
-                "belief",
-                Column::F64Rows(
-                    steps
-                        .iter()
-                        .flat_map(|s| s.belief.iter().copied())
-                        .collect(),
-                    grid.n_cells(),
-                ),
-            ),
-        ],
-    )?;
-    send_table(
-        rec,
-        paths::ENDS,
-        &[t0 + ep.total_secs],
-        vec![
-            ("run", runs(1)),
-            ("t_s", Column::F64(vec![ep.total_secs])),
-            (
-                "committed",
-                Column::I64(vec![ep.committed.map_or(-1, |c| grid.index(c) as i64)]),
-            ),
-        ],
-    )
+    Actions {
+        run: vec![run; steps.len()],
+        t_s: steps.iter().map(|s| s.onset_secs).collect(),
+        from_x: int(&|s| s.from.x),
+        from_y: int(&|s| s.from.y),
+        action: steps.iter().map(|s| s.action.name().to_string()).collect(),
+        to_x: int(&|s| s.to.x),
+        to_y: int(&|s| s.to.y),
+        error: steps.iter().map(|s| s.error).collect(),
+        p_error: steps.iter().map(|s| s.p_error).collect(),
+        decoded_error: steps.iter().map(|s| s.decoded_error).collect(),
+        belief: (
+            steps
+                .iter()
+                .flat_map(|s| s.belief.iter().copied())
+                .collect(),
+            grid.n_cells(),
+        ),
+    }
+    .send(rec, &times)?;
+    Ends {
+        run: vec![run],
+        t_s: vec![ep.total_secs],
+        committed: vec![ep.committed.map_or(-1, |c| grid.index(c) as i64)],
+    }
+    .send(rec, &[t0 + ep.total_secs])
 }
 
 /// One action of a grid episode that started at `t0` on the timeline: the

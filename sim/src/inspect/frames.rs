@@ -85,10 +85,13 @@ pub(crate) fn check(reader: &mut (impl Read + Seek), len: u64) -> Result<(), Str
                         "it is truncated: it ends at byte {len} inside its stream footer"
                     ));
                 }
-                at += STREAM_FOOTER;
                 reader
                     .seek(SeekFrom::Start(at))
                     .map_err(|e| e.to_string())?;
+                let mut footer = [0u8; STREAM_FOOTER as usize];
+                read_exact(reader, &mut footer, at)?;
+                stream_footer(&footer, at)?;
+                at += STREAM_FOOTER;
                 break;
             }
         }
@@ -119,6 +122,19 @@ fn stream_header(reader: &mut impl Read, at: u64, len: u64) -> Result<(), String
             &head[8..]
         )),
     }
+}
+
+/// Checks the stream footer at `at`: one entry (20 bytes: the span of
+/// the RRD footer and its checksum), then `RRF2`, `FOOT` and the number of
+/// entries, 1 (the decoder allocates as many as that number says).
+fn stream_footer(footer: &[u8; STREAM_FOOTER as usize], at: u64) -> Result<(), String> {
+    let entries = u32::from_le_bytes(footer[28..].try_into().expect("4 bytes"));
+    if &footer[20..24] != b"RRF2" || &footer[24..28] != b"FOOT" || entries != 1 {
+        return Err(format!(
+            "it is corrupt: its stream footer at byte {at} is not `RRF2` `FOOT` with one entry"
+        ));
+    }
+    Ok(())
 }
 
 /// Checks an Arrow message's stated uncompressed size against its bytes.
@@ -241,6 +257,17 @@ mod tests {
         let len = file.len() as u64;
         let e = check(&mut io::Cursor::new(file), len).unwrap_err();
         assert!(e.contains("message at byte 12 says it is"), "{e}");
+    }
+
+    #[test]
+    fn a_stream_footer_must_have_one_entry() {
+        let mut footer = [0u8; 32];
+        footer[20..28].copy_from_slice(b"RRF2FOOT");
+        footer[28] = 1;
+        stream_footer(&footer, 100).unwrap();
+        footer[31] = 0x80;
+        let e = stream_footer(&footer, 100).unwrap_err();
+        assert!(e.contains("stream footer at byte 100"), "{e}");
     }
 
     #[test]

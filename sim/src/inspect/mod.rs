@@ -13,8 +13,11 @@ use crate::epuck::plant::step_motion;
 use crate::epuck::{EpuckEpisodeResult, EpuckScenario};
 use crate::grid::plant::GridTally;
 use crate::grid::{GridEpisodeResult, GridScenario, GridStep};
-use crate::record::data::{Column, Provenance};
-use crate::record::paths;
+use crate::record::data::Provenance;
+use crate::record::schema::{
+    Ends, EndsView, EpuckRuns, EpuckRunsView, Errps, ErrpsView, EventsView, Frames, FramesView,
+    Windows, WindowsView,
+};
 use crate::scenario::AnyScenario;
 
 mod frames;
@@ -23,7 +26,8 @@ mod read;
 mod report;
 mod tables;
 
-pub use read::{MAX_RECORDING_BYTES, Table};
+pub use crate::record::data::Table;
+pub use read::MAX_RECORDING_BYTES;
 pub use report::{Comparison, RecordingHeadline, RecordingReport};
 pub use tables::{CsvTable, PARQUET_TABLE_KEY, csv_tables, phase_secs};
 
@@ -138,74 +142,12 @@ impl Recording {
     }
 }
 
-/// Typed access to a table's columns, with errors naming what is missing.
-struct View<'a> {
-    name: &'a str,
-    table: &'a Table,
-}
-
-impl<'a> View<'a> {
-    fn of(
-        tables: &'a std::collections::BTreeMap<String, Table>,
-        name: &'a str,
-    ) -> Result<Self, String> {
-        tables
-            .get(name)
-            .map(|table| Self { name, table })
-            .ok_or_else(|| format!("it has no table {name}"))
-    }
-
-    fn col(&self, c: &str) -> Result<&'a Column, String> {
-        let col = self
-            .table
-            .column(c)
-            .ok_or_else(|| format!("its table {} has no column `{c}`", self.name))?;
-        if col.len() != self.table.rows() {
-            return Err(format!(
-                "its table {} has columns of different lengths",
-                self.name
-            ));
-        }
-        Ok(col)
-    }
-
-    fn f64(&self, c: &str) -> Result<&'a [f64], String> {
-        match self.col(c)? {
-            Column::F64(v) => Ok(v),
-            _ => Err(format!("column `{c}` of {} is not numbers", self.name)),
-        }
-    }
-
-    fn i64(&self, c: &str) -> Result<&'a [i64], String> {
-        match self.col(c)? {
-            Column::I64(v) => Ok(v),
-            _ => Err(format!("column `{c}` of {} is not integers", self.name)),
-        }
-    }
-
-    fn bool(&self, c: &str) -> Result<&'a [bool], String> {
-        match self.col(c)? {
-            Column::Bool(v) => Ok(v),
-            _ => Err(format!("column `{c}` of {} is not flags", self.name)),
-        }
-    }
-
-    fn rows(&self, c: &str) -> Result<(&'a [f64], usize), String> {
-        match self.col(c)? {
-            Column::F64Rows(v, w) => Ok((v, *w)),
-            _ => Err(format!(
-                "column `{c}` of {} is not rows of numbers",
-                self.name
-            )),
-        }
-    }
-
-    /// The row indices of run `r` (runs are written in order).
-    fn run_rows(&self, runs: &[i64], r: usize) -> std::ops::Range<usize> {
-        let lo = runs.partition_point(|&x| x < r as i64);
-        let hi = runs.partition_point(|&x| x <= r as i64);
-        lo..hi
-    }
+/// The row indices of run `r` in a table's `runs` column (runs are
+/// written in order).
+fn run_rows(runs: &[i64], r: usize) -> std::ops::Range<usize> {
+    let lo = runs.partition_point(|&x| x < r as i64);
+    let hi = runs.partition_point(|&x| x <= r as i64);
+    lo..hi
 }
 
 /// Checks that `runs` counts 0, 1, ... in order (each run's rows together).
@@ -235,17 +177,8 @@ type Replayed = (f64, f64, Vec<(f64, [f64; 2])>);
 
 /// The frames `rows` of a run from `start`, measured as the episode measured
 /// them.
-fn replay_frames(
-    frames: &View<'_>,
-    rows: std::ops::Range<usize>,
-    start: Pose,
-) -> Result<Replayed, String> {
-    let (t, x, y, h) = (
-        frames.f64("t_s")?,
-        frames.f64("x_cm")?,
-        frames.f64("y_cm")?,
-        frames.f64("heading_deg")?,
-    );
+fn replay_frames(frames: &FramesView<'_>, rows: std::ops::Range<usize>, start: Pose) -> Replayed {
+    let (t, x, y, h) = (frames.t_s, frames.x_cm, frames.y_cm, frames.heading_deg);
     let mut pose = start;
     let mut path_m = 0.0;
     let mut max_lateral: f64 = 0.0;
@@ -258,12 +191,12 @@ fn replay_frames(
         pose = next;
         frame_at.push((t[i], [pose.x_m, pose.y_m]));
     }
-    Ok((path_m, max_lateral, frame_at))
+    (path_m, max_lateral, frame_at)
 }
 
 /// Refuses windows whose beliefs are not one value per goal.
-fn check_belief_width(windows: &View<'_>, n_goals: usize) -> Result<(), String> {
-    let (_, width) = windows.rows("belief")?;
+fn check_belief_width(windows: &WindowsView<'_>, n_goals: usize) -> Result<(), String> {
+    let (_, width) = windows.belief;
     if width != n_goals {
         return Err(format!(
             "its beliefs have {width} values, but the scenario has {n_goals} goals"
@@ -278,123 +211,77 @@ fn epuck_results(
     scenario: &EpuckScenario,
 ) -> Result<Vec<EpuckEpisodeResult>, String> {
     let n_goals = scenario.layout.goals().len();
-    let runs = View::of(tables, paths::RUNS)?;
-    let frames = View::of(tables, paths::FRAMES)?;
-    let windows = View::of(tables, paths::WINDOWS)?;
-    let ends = View::of(tables, paths::ENDS)?;
-    let empty = Table::default();
-    let errps = View {
-        name: paths::ERRPS,
-        table: tables.get(paths::ERRPS).unwrap_or(&empty),
-    };
-    let run_col = runs.i64("run")?;
-    let f_run = frames.i64("run")?;
-    let w_run = windows.i64("run")?;
-    let e_run = if errps.table.rows() == 0 {
-        &[][..]
-    } else {
-        errps.i64("run")?
-    };
-    let end_run = ends.i64("run")?;
+    let runs = EpuckRunsView::of(tables)?;
+    let frames = FramesView::of(tables)?;
+    let windows = WindowsView::of(tables)?;
+    let ends = EndsView::of(tables)?;
+    let errps = ErrpsView::of_or_empty(tables)?;
+    // Not needed to recompute the runs, but read as tables: checked here.
+    EventsView::of_or_empty(tables)?;
+    let (run_col, f_run, w_run, e_run, end_run) =
+        (runs.run, frames.run, windows.run, errps.run, ends.run);
     for (name, r) in [
-        (paths::RUNS, run_col),
-        (paths::FRAMES, f_run),
-        (paths::WINDOWS, w_run),
-        (paths::ERRPS, e_run),
-        (paths::ENDS, end_run),
+        (EpuckRuns::ENTITY, run_col),
+        (Frames::ENTITY, f_run),
+        (Windows::ENTITY, w_run),
+        (Errps::ENTITY, e_run),
+        (Ends::ENTITY, end_run),
     ] {
         check_run_order(name, r)?;
     }
-    let (w_t, w_p, w_detected, w_step) = (
-        windows.f64("t_s")?,
-        windows.f64("p_error")?,
-        windows.bool("detected")?,
-        windows.i64("step")?,
-    );
     check_belief_width(&windows, n_goals)?;
-    let (e_t, e_onset, e_phase) = if errps.table.rows() == 0 {
-        (&[][..], &[][..], &[][..])
-    } else {
-        (
-            errps.f64("t_s")?,
-            errps.f64("onset_s")?,
-            errps.i64("phase")?,
-        )
-    };
-    let (end_t, end_committed) = (ends.f64("t_s")?, ends.i64("committed")?);
-    let goal = runs.i64("goal")?;
-    let (sx, sy, sh) = (
-        runs.f64("start_x")?,
-        runs.f64("start_y")?,
-        runs.f64("start_heading_deg")?,
-    );
-    let t_e = runs.f64("t_e")?;
-    let (d_from, d_to) = (runs.f64("detection_from_s")?, runs.f64("detection_to_s")?);
-    let (w_from, w_to) = (runs.f64("window_from_s")?, runs.f64("window_to_s")?);
+    let (e_t, e_onset, e_phase) = (errps.t_s, errps.onset_s, errps.phase);
+    let (end_t, end_committed) = (ends.t_s, ends.committed);
 
     let mut out = Vec::new();
     for (k, &r) in run_col.iter().enumerate() {
         if r != k as i64 {
-            return Err(format!("its table {} skips run {k}", paths::RUNS));
+            return Err(format!("its table {} skips run {k}", EpuckRuns::ENTITY));
         }
         let Some(e) = end_run.iter().position(|&x| x == r) else {
             // A run without its end: the recording stopped in it.
             break;
         };
         let span = errp_bci::ResponseSpan {
-            from_secs: d_from[k],
-            to_secs: d_to[k],
+            from_secs: runs.detection_from_s[k],
+            to_secs: runs.detection_to_s[k],
         };
         let window_span = errp_bci::ResponseSpan {
-            from_secs: w_from[k],
-            to_secs: w_to[k],
+            from_secs: runs.window_from_s[k],
+            to_secs: runs.window_to_s[k],
         };
-        let fr = frames.run_rows(f_run, k);
-        let wr = windows.run_rows(w_run, k);
-        let er = errps.run_rows(e_run, k);
+        let fr = run_rows(f_run, k);
+        let wr = run_rows(w_run, k);
+        let er = run_rows(e_run, k);
         let time_secs = end_t[e];
         let errps_run: Vec<(f64, f64, usize)> = er
             .clone()
             .map(|i| Ok((e_t[i], e_onset[i], index(e_phase[i], 3, "ErrP phase")?)))
             .collect::<Result<_, String>>()?;
 
-        let start = cm_deg(sx[k], sy[k], sh[k]);
-        let (path_m, max_lateral, frame_at) = replay_frames(&frames, fr, start)?;
+        let start = cm_deg(runs.start_x[k], runs.start_y[k], runs.start_heading_deg[k]);
+        let (path_m, max_lateral, frame_at) = replay_frames(&frames, fr, start);
 
         // The episode's own scoring, fed from the tables: each ErrP once the
         // user produced it (before the window that ends after it), each
         // window with the pose at its end.
-        let mut score = Score::new(span, window_span, t_e[k]);
-        let columns = WindowColumns {
-            t: w_t,
-            p: w_p,
-            detected: w_detected,
-            step: w_step,
-        };
-        score_run(&mut score, &columns, wr, &errps_run, &frame_at)?;
+        let mut score = Score::new(span, window_span, runs.t_e[k]);
+        score_run(&mut score, &windows, wr, &errps_run, &frame_at)?;
         let committed = match end_committed[e] {
             -1 => None,
             c => Some(index(c, n_goals, "committed goal")?),
         };
-        let goal = index(goal[k], n_goals, "goal")?;
+        let goal = index(runs.goal[k], n_goals, "goal")?;
         out.push(score.finish(goal, committed, time_secs, path_m, max_lateral));
     }
     Ok(out)
-}
-
-/// A recording's window columns.
-struct WindowColumns<'a> {
-    t: &'a [f64],
-    p: &'a [f64],
-    detected: &'a [bool],
-    step: &'a [i64],
 }
 
 /// Feeds `score` one run's windows (rows `rows` of `w`) and its ErrPs
 /// `(seen at, onset, phase)`, with the poses of `frame_at`.
 fn score_run(
     score: &mut Score,
-    w: &WindowColumns<'_>,
+    w: &WindowsView<'_>,
     rows: std::ops::Range<usize>,
     errps_run: &[(f64, f64, usize)],
     frame_at: &[(f64, [f64; 2])],
@@ -402,7 +289,7 @@ fn score_run(
     let mut known = 0usize;
     let mut frame = 0usize;
     for i in rows {
-        let t = w.t[i];
+        let t = w.t_s[i];
         while known < errps_run.len() && errps_run[known].0 < t {
             score.errp(errps_run[known].1, errps_run[known].2);
             known += 1;
@@ -417,7 +304,7 @@ fn score_run(
                 at = xy;
             }
         }
-        score.window(t, w.p[i], step, w.detected[i], at);
+        score.window(t, w.p_error[i], step, w.detected[i], at);
     }
     for &(_, onset, phase) in &errps_run[known..] {
         score.errp(onset, phase);

@@ -14,7 +14,7 @@ use rerun::external::arrow::datatypes::DataType;
 use rerun::log::{Chunk, LogMsg};
 
 use crate::inspect::{InspectError, frames};
-use crate::record::data::{Column, FORMAT, FORMAT_VERSION, Provenance};
+use crate::record::data::{Column, FORMAT, FORMAT_VERSION, Provenance, Table};
 use crate::record::paths;
 
 /// The largest recording read (bytes): more than 5000 grid episodes or 200
@@ -23,57 +23,6 @@ pub const MAX_RECORDING_BYTES: u64 = 16 << 30;
 
 /// The Rerun version whose files this build reads (and writes).
 const RERUN_VERSION: [u8; 3] = [0, 36, 3];
-
-/// One table: named columns of equal length, in the order written.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct Table {
-    /// The columns.
-    pub columns: Vec<(String, Column)>,
-}
-
-impl Table {
-    /// Rows in the table.
-    pub fn rows(&self) -> usize {
-        self.columns.first().map_or(0, |(_, c)| c.len())
-    }
-
-    /// The column `name`, if present.
-    pub fn column(&self, name: &str) -> Option<&Column> {
-        self.columns.iter().find(|(n, _)| n == name).map(|(_, c)| c)
-    }
-
-    fn append(&mut self, name: &str, column: Column) -> Result<(), String> {
-        match self.columns.iter_mut().find(|(n, _)| n == name) {
-            None => {
-                self.columns.push((name.to_string(), column));
-                Ok(())
-            }
-            Some((_, have)) => match (have, column) {
-                (Column::F64(a), Column::F64(b)) => {
-                    a.extend(b);
-                    Ok(())
-                }
-                (Column::I64(a), Column::I64(b)) => {
-                    a.extend(b);
-                    Ok(())
-                }
-                (Column::Bool(a), Column::Bool(b)) => {
-                    a.extend(b);
-                    Ok(())
-                }
-                (Column::Str(a), Column::Str(b)) => {
-                    a.extend(b);
-                    Ok(())
-                }
-                (Column::F64Rows(a, w), Column::F64Rows(b, v)) if *w == v => {
-                    a.extend(b);
-                    Ok(())
-                }
-                _ => Err(format!("column `{name}` changes type between chunks")),
-            },
-        }
-    }
-}
 
 /// What a file holds before it is checked as a recording of either task.
 pub(crate) struct RawRecording {

@@ -85,13 +85,10 @@ fn describe(f: &mut fmt::Formatter<'_>, r: &Recording) -> fmt::Result {
             let layout = &scenario.layout;
             write!(f, "{}", EpuckRunsTable { results, layout })?;
             let summary = summarise(results);
-            let t_e = r
-                .tables
-                .get(crate::record::paths::RUNS)
-                .and_then(|t| match t.column("t_e") {
-                    Some(crate::record::data::Column::F64(v)) => v.first().copied(),
-                    _ => None,
-                })
+            let t_e = crate::record::schema::EpuckRunsView::or_empty(&r.tables)
+                .t_e
+                .first()
+                .copied()
                 .unwrap_or(f64::NAN);
             write!(
                 f,

@@ -6,25 +6,13 @@
 //! `errp.read_recording` read them back (the `inspect` module) and recompute
 //! each run's result from them.
 //!
-//! The tables, by entity path (columns in the order written):
-//!
-//! | entity | task | one row per | columns |
-//! |---|---|---|---|
-//! | `/errp/runs` | both | run, at its start | `run`, `seed`, `goal`, `start_x`, `start_y`, `start_heading_deg` (e-puck, cm), `t_e`, `detection_from_s`, `detection_to_s`, `window_from_s`, `window_to_s` (e-puck); `goal_x`, `goal_y`, `epoch_s` (grid, cells; `goal` is the cell index) |
-//! | `/errp/frames` | e-puck | physics step (64 Hz) | `run`, `t_s`, `x_cm`, `y_cm`, `heading_deg`, `tracked_x_cm`, `tracked_y_cm`, `phase` (0 turning, 1 driving, 2 stopped), `target` |
-//! | `/errp/windows` | e-puck | decoder window (16 Hz) | `run`, `t_s`, `p_error`, `evidence`, `detected`, `step` (0 turn, 1 linear, 2 stopped on a goal, 3 idle), `target`, `belief` (one value per goal) |
-//! | `/errp/errps` | e-puck | ErrP of the user | `run`, `t_s` (seen), `onset_s`, `phase` |
-//! | `/errp/actions` | grid | action | `run`, `t_s` (onset), `from_x`, `from_y`, `action`, `to_x`, `to_y`, `error`, `p_error`, `decoded_error`, `belief` (one value per cell) |
-//! | `/errp/ends` | both | run, at its end | `run`, `t_s`, `committed` (goal index, -1 for none; the grid: cell index) |
-//! | `/errp/events` | e-puck | event of the log | `run`, `t_s`, `warn`, `text` |
+//! The tables, their columns and types are declared once, in the
+//! `schema` module beside this one.
 
-use rerun::external::arrow::array::{
-    ArrayRef, BooleanArray, Float64Array, Int64Array, StringArray,
-};
-use rerun::{ComponentDescriptor, RecordingStream, SerializedComponentBatch};
+use rerun::RecordingStream;
 use serde::{Deserialize, Serialize};
 
-use crate::record::{RrdFile, SIM_TIME, paths, record_error};
+use crate::record::{RrdFile, paths, record_error};
 
 /// [`Provenance::format`] of the recordings this build writes.
 pub const FORMAT: &str = "errp-recording";
@@ -132,31 +120,53 @@ impl Column {
     }
 }
 
-/// Sends one table (one run's rows) as a chunk of `entity`: `times` are the
-/// rows' positions on the `sim_time` timeline (s), and every column has as
-/// many rows.
-pub(crate) fn send_table(
-    rec: &RecordingStream,
-    entity: &str,
-    times: &[f64],
-    columns: Vec<(&'static str, Column)>,
-) -> Result<(), rerun::RecordingStreamError> {
-    if times.is_empty() {
-        return Ok(());
+/// One table: named columns of equal length, in the order written.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Table {
+    /// The columns.
+    pub columns: Vec<(String, Column)>,
+}
+
+impl Table {
+    /// Rows in the table.
+    pub fn rows(&self) -> usize {
+        self.columns.first().map_or(0, |(_, c)| c.len())
     }
-    let time = rerun::log::TimeColumn::new_duration_secs(SIM_TIME, times.iter().copied());
-    let mut out = Vec::with_capacity(columns.len());
-    for (name, column) in columns {
-        let rows = column.len();
-        let (array, width): (ArrayRef, usize) = match column {
-            Column::F64(v) => (std::sync::Arc::new(Float64Array::from(v)), 1),
-            Column::I64(v) => (std::sync::Arc::new(Int64Array::from(v)), 1),
-            Column::Bool(v) => (std::sync::Arc::new(BooleanArray::from(v)), 1),
-            Column::Str(v) => (std::sync::Arc::new(StringArray::from(v)), 1),
-            Column::F64Rows(v, w) => (std::sync::Arc::new(Float64Array::from(v)), w),
-        };
-        let batch = SerializedComponentBatch::new(array, ComponentDescriptor::partial(name));
-        out.push(batch.partitioned(std::iter::repeat_n(width, rows))?);
+
+    /// The column `name`, if present.
+    pub fn column(&self, name: &str) -> Option<&Column> {
+        self.columns.iter().find(|(n, _)| n == name).map(|(_, c)| c)
     }
-    rec.send_columns(entity, [time], out)
+
+    pub(crate) fn append(&mut self, name: &str, column: Column) -> Result<(), String> {
+        match self.columns.iter_mut().find(|(n, _)| n == name) {
+            None => {
+                self.columns.push((name.to_string(), column));
+                Ok(())
+            }
+            Some((_, have)) => match (have, column) {
+                (Column::F64(a), Column::F64(b)) => {
+                    a.extend(b);
+                    Ok(())
+                }
+                (Column::I64(a), Column::I64(b)) => {
+                    a.extend(b);
+                    Ok(())
+                }
+                (Column::Bool(a), Column::Bool(b)) => {
+                    a.extend(b);
+                    Ok(())
+                }
+                (Column::Str(a), Column::Str(b)) => {
+                    a.extend(b);
+                    Ok(())
+                }
+                (Column::F64Rows(a, w), Column::F64Rows(b, v)) if *w == v => {
+                    a.extend(b);
+                    Ok(())
+                }
+                _ => Err(format!("column `{name}` changes type between chunks")),
+            },
+        }
+    }
 }

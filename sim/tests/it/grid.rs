@@ -154,8 +154,15 @@ fn an_accuracy_override_reaches_the_info_gain_planner() {
          [control]\nstrategy = \"info_gain\"\n",
     )
     .unwrap();
-    let over = [("user.accuracy", toml::Value::Float(0.9))];
-    match errp_sim::load_scenario_with(&grid, &over).unwrap() {
+    let with = |path: &std::path::Path, accuracy: f64| {
+        errp_sim::ScenarioInput {
+            keys: vec![("user.accuracy".into(), toml::Value::Float(accuracy))],
+            ..errp_sim::ScenarioInput::new(errp_sim::ScenarioSource::File(path.into()))
+        }
+        .load(&errp_sim::FILE_KEYS)
+        .map(|loaded| loaded.scenario)
+    };
+    match with(&grid, 0.9).unwrap() {
         errp_sim::AnyScenario::Grid(s) => {
             assert_eq!(s.accuracy, 0.9);
             assert_eq!(s.params.control.assumed_accuracy, 0.9);
@@ -166,7 +173,7 @@ fn an_accuracy_override_reaches_the_info_gain_planner() {
         "{}/../scenarios/mexico_to_pisa.toml",
         env!("CARGO_MANIFEST_DIR")
     );
-    match errp_sim::load_scenario_with(&path, &over).unwrap() {
+    match with(std::path::Path::new(&path), 0.9).unwrap() {
         errp_sim::AnyScenario::Epuck(s) => {
             assert_eq!(s.accuracy.get(), 0.9);
             assert_eq!(s.params.control.assumed_accuracy, 0.9);
@@ -175,10 +182,7 @@ fn an_accuracy_override_reaches_the_info_gain_planner() {
         _ => panic!("an e-puck scenario"),
     }
     // An override is checked as the file's own value would be.
-    let bad = [("user.accuracy", toml::Value::Float(1.7))];
-    let e = errp_sim::load_scenario_with(&grid, &bad)
-        .unwrap_err()
-        .to_string();
+    let e = with(&grid, 1.7).unwrap_err().to_string();
     assert!(e.contains("user.accuracy") && e.contains("1.7"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

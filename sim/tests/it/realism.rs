@@ -108,12 +108,16 @@ fn shipped() -> Vec<std::path::PathBuf> {
     files
 }
 
+fn load(path: std::path::PathBuf) -> errp_sim::AnyScenario {
+    errp_sim::ScenarioInput::load_as_written(errp_sim::ScenarioSource::File(path)).unwrap()
+}
+
 #[test]
 fn the_shipped_user_is_the_published_one_and_the_ideal_grid_variants_differ_only_by_it() {
     let files = shipped();
     assert!(files.len() >= 16, "{files:?}");
     for path in &files {
-        let scenario = errp_sim::load_scenario(path).unwrap();
+        let scenario = load(path.clone());
         let name = path.file_name().unwrap().to_string_lossy();
         if let Some(base) = name.strip_suffix("_ideal.toml") {
             assert!(scenario.realism().is_ideal(), "{name}");
@@ -123,9 +127,7 @@ fn the_shipped_user_is_the_published_one_and_the_ideal_grid_variants_differ_only
                 continue;
             }
             // The same scenario as the shipped one but for the user.
-            let shipped =
-                errp_sim::load_scenario(path.parent().unwrap().join(format!("../{base}.toml")))
-                    .unwrap();
+            let shipped = load(path.parent().unwrap().join(format!("../{base}.toml")));
             let strip = |s: &errp_sim::AnyScenario| {
                 format!("{s:?}")
                     .replace(&format!("{:?}", s.realism()), "")

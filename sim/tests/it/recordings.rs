@@ -88,6 +88,11 @@ fn stated_sizes_are_checked_and_no_damage_aborts_or_panics() {
             "{e}"
         );
     }
+    // A stream footer claiming 2^31 entries.
+    let mut b = good.clone();
+    *b.last_mut().unwrap() ^= 0x80;
+    let e = open(&dir, &b).expect("a footer of many entries is refused");
+    assert!(e.contains("stream footer"), "{e}");
     // Every Arrow message stating a huge uncompressed size.
     let mut arrow = 0;
     for &(at, kind, len) in &msgs {

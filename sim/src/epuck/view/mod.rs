@@ -24,7 +24,8 @@ use crate::epuck::run::{EpuckRunsObserver, run_epuck_runs};
 use crate::epuck::scenario::EpuckScenario;
 use crate::epuck::world::{ArenaSpec, Obstacle};
 use crate::error::{Result, SimError};
-use crate::record::data::{Column, Provenance, send_table};
+use crate::record::data::Provenance;
+use crate::record::schema::{Ends, EpuckRuns, Errps, Events, Frames, Windows};
 use crate::record::{
     RrdFile, SIM_TIME, eeg_channel, log_decoder_series, paths, record_error, task_blueprint,
 };
@@ -255,31 +256,21 @@ impl EpuckRecorder {
 
     /// Sends the run's row of the runs table: how it started.
     fn send_start(&mut self, s: &EpisodeStart) {
-        let run = self.run as i64;
-        let off = self.offset_secs;
-        let runs = |n: usize| Column::I64(vec![run; n]);
         let cm = |v: f64| 100.0 * v;
-        let r = send_table(
-            &self.rec,
-            paths::RUNS,
-            &[off],
-            vec![
-                ("run", runs(1)),
-                ("seed", Column::I64(vec![self.seed as i64])),
-                ("goal", Column::I64(vec![s.goal as i64])),
-                ("start_x", Column::F64(vec![cm(s.pose.x_m)])),
-                ("start_y", Column::F64(vec![cm(s.pose.y_m)])),
-                (
-                    "start_heading_deg",
-                    Column::F64(vec![s.pose.heading_rad.to_degrees()]),
-                ),
-                ("t_e", Column::F64(vec![s.t_e])),
-                ("detection_from_s", Column::F64(vec![s.detection_span.0])),
-                ("detection_to_s", Column::F64(vec![s.detection_span.1])),
-                ("window_from_s", Column::F64(vec![s.window_span.0])),
-                ("window_to_s", Column::F64(vec![s.window_span.1])),
-            ],
-        );
+        let row = EpuckRuns {
+            run: vec![self.run as i64],
+            seed: vec![self.seed as i64],
+            goal: vec![s.goal as i64],
+            start_x: vec![cm(s.pose.x_m)],
+            start_y: vec![cm(s.pose.y_m)],
+            start_heading_deg: vec![s.pose.heading_rad.to_degrees()],
+            t_e: vec![s.t_e],
+            detection_from_s: vec![s.detection_span.0],
+            detection_to_s: vec![s.detection_span.1],
+            window_from_s: vec![s.window_span.0],
+            window_to_s: vec![s.window_span.1],
+        };
+        let r = row.send(&self.rec, &[self.offset_secs]);
         self.keep(r);
     }
 
@@ -289,99 +280,62 @@ impl EpuckRecorder {
         let run = self.run as i64;
         let off = self.offset_secs;
         let on_timeline = |ts: &[f64]| ts.iter().map(|t| off + t).collect::<Vec<_>>();
-        let runs = |n: usize| Column::I64(vec![run; n]);
         let cm = |v: f64| 100.0 * v;
         if let Some(s) = t.start {
             self.send_start(&s);
         }
-        let n = t.f_t.len();
-        let r = send_table(
-            &self.rec,
-            paths::FRAMES,
-            &on_timeline(&t.f_t),
-            vec![
-                ("run", runs(n)),
-                ("t_s", Column::F64(t.f_t)),
-                (
-                    "x_cm",
-                    Column::F64(t.f_xy.iter().map(|p| cm(p[0])).collect()),
-                ),
-                (
-                    "y_cm",
-                    Column::F64(t.f_xy.iter().map(|p| cm(p[1])).collect()),
-                ),
-                ("heading_deg", Column::F64(t.f_heading)),
-                (
-                    "tracked_x_cm",
-                    Column::F64(t.f_tracked.iter().map(|p| cm(p[0])).collect()),
-                ),
-                (
-                    "tracked_y_cm",
-                    Column::F64(t.f_tracked.iter().map(|p| cm(p[1])).collect()),
-                ),
-                ("phase", Column::I64(t.f_phase)),
-                ("target", Column::I64(t.f_target)),
-            ],
-        );
+        let times = on_timeline(&t.f_t);
+        let frames = Frames {
+            run: vec![run; t.f_t.len()],
+            t_s: t.f_t,
+            x_cm: t.f_xy.iter().map(|p| cm(p[0])).collect(),
+            y_cm: t.f_xy.iter().map(|p| cm(p[1])).collect(),
+            heading_deg: t.f_heading,
+            tracked_x_cm: t.f_tracked.iter().map(|p| cm(p[0])).collect(),
+            tracked_y_cm: t.f_tracked.iter().map(|p| cm(p[1])).collect(),
+            phase: t.f_phase,
+            target: t.f_target,
+        };
+        let r = frames.send(&self.rec, &times);
         self.keep(r);
-        let n = t.w_t.len();
-        let goals = self.layout.goals().len();
-        let r = send_table(
-            &self.rec,
-            paths::WINDOWS,
-            &on_timeline(&t.w_t),
-            vec![
-                ("run", runs(n)),
-                ("t_s", Column::F64(t.w_t)),
-                ("p_error", Column::F64(t.w_p)),
-                ("evidence", Column::F64(t.w_evidence)),
-                ("detected", Column::Bool(t.w_detected)),
-                ("step", Column::I64(t.w_step)),
-                ("target", Column::I64(t.w_target)),
-                ("belief", Column::F64Rows(t.w_belief, goals)),
-            ],
-        );
+        let times = on_timeline(&t.w_t);
+        let windows = Windows {
+            run: vec![run; t.w_t.len()],
+            t_s: t.w_t,
+            p_error: t.w_p,
+            evidence: t.w_evidence,
+            detected: t.w_detected,
+            step: t.w_step,
+            target: t.w_target,
+            belief: (t.w_belief, self.layout.goals().len()),
+        };
+        let r = windows.send(&self.rec, &times);
         self.keep(r);
-        let n = t.e_t.len();
-        let r = send_table(
-            &self.rec,
-            paths::ERRPS,
-            &on_timeline(&t.e_t),
-            vec![
-                ("run", runs(n)),
-                ("t_s", Column::F64(t.e_t)),
-                ("onset_s", Column::F64(t.e_onset)),
-                ("phase", Column::I64(t.e_phase)),
-            ],
-        );
+        let times = on_timeline(&t.e_t);
+        let errps = Errps {
+            run: vec![run; t.e_t.len()],
+            t_s: t.e_t,
+            onset_s: t.e_onset,
+            phase: t.e_phase,
+        };
+        let r = errps.send(&self.rec, &times);
         self.keep(r);
-        let n = t.v_t.len();
-        let r = send_table(
-            &self.rec,
-            paths::EVENTS,
-            &on_timeline(&t.v_t),
-            vec![
-                ("run", runs(n)),
-                ("t_s", Column::F64(t.v_t)),
-                ("warn", Column::Bool(t.v_warn)),
-                ("text", Column::Str(t.v_text)),
-            ],
-        );
+        let times = on_timeline(&t.v_t);
+        let events = Events {
+            run: vec![run; t.v_t.len()],
+            t_s: t.v_t,
+            warn: t.v_warn,
+            text: t.v_text,
+        };
+        let r = events.send(&self.rec, &times);
         self.keep(r);
         if let Some((end, committed)) = t.end {
-            let r = send_table(
-                &self.rec,
-                paths::ENDS,
-                &[off + end],
-                vec![
-                    ("run", runs(1)),
-                    ("t_s", Column::F64(vec![end])),
-                    (
-                        "committed",
-                        Column::I64(vec![committed.map_or(-1, |c| c as i64)]),
-                    ),
-                ],
-            );
+            let ends = Ends {
+                run: vec![run],
+                t_s: vec![end],
+                committed: vec![committed.map_or(-1, |c| c as i64)],
+            };
+            let r = ends.send(&self.rec, &[off + end]);
             self.keep(r);
         }
     }

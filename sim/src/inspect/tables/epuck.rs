@@ -8,16 +8,15 @@ pub(super) fn epuck_tables(
     results: &[EpuckEpisodeResult],
     names: &[String],
 ) -> Vec<CsvTable> {
-    let empty = Table::default();
-    let frames = get(rec, paths::FRAMES).unwrap_or(&empty);
-    let windows = get(rec, paths::WINDOWS).unwrap_or(&empty);
+    let frames = FramesView::or_empty(&rec.tables);
+    let windows = WindowsView::or_empty(&rec.tables);
     vec![
         epuck_runs_table(rec, results, names),
-        trajectory_table(frames, windows, names),
-        detections_table(windows, results),
-        belief_table(windows, names),
-        errps_table(get(rec, paths::ERRPS).unwrap_or(&empty)),
-        events_table(get(rec, paths::EVENTS).unwrap_or(&empty)),
+        trajectory_table(&frames, &windows, names),
+        detections_table(&windows, results),
+        belief_table(&windows, names),
+        errps_table(&ErrpsView::or_empty(&rec.tables)),
+        events_table(&EventsView::or_empty(&rec.tables)),
     ]
 }
 
@@ -118,11 +117,15 @@ pub(super) fn epuck_runs_table(
 
 /// One row per physics step, with p(error) and the evidence of the
 /// latest window.
-pub(super) fn trajectory_table(frames: &Table, windows: &Table, names: &[String]) -> CsvTable {
+pub(super) fn trajectory_table(
+    frames: &FramesView<'_>,
+    windows: &WindowsView<'_>,
+    names: &[String],
+) -> CsvTable {
     // p(error) and the evidence of the latest window at each frame.
-    let (w_run, w_t) = (i64s(windows, "run"), f64s(windows, "t_s"));
-    let (w_p, w_ev) = (f64s(windows, "p_error"), f64s(windows, "evidence"));
-    let (f_run, f_t) = (i64s(frames, "run"), f64s(frames, "t_s"));
+    let (w_run, w_t) = (windows.run, windows.t_s);
+    let (w_p, w_ev) = (windows.p_error, windows.evidence);
+    let (f_run, f_t) = (frames.run, frames.t_s);
     let mut p = Vec::with_capacity(f_t.len());
     let mut ev = Vec::with_capacity(f_t.len());
     let mut w = 0usize;
@@ -143,24 +146,16 @@ pub(super) fn trajectory_table(frames: &Table, windows: &Table, names: &[String]
         columns: vec![
             ("run", run1(f_run)),
             ("t_s", Column::F64(f_t.to_vec())),
-            ("x_cm", Column::F64(f64s(frames, "x_cm").to_vec())),
-            ("y_cm", Column::F64(f64s(frames, "y_cm").to_vec())),
-            (
-                "heading_deg",
-                Column::F64(f64s(frames, "heading_deg").to_vec()),
-            ),
-            (
-                "tracked_x_cm",
-                Column::F64(f64s(frames, "tracked_x_cm").to_vec()),
-            ),
-            (
-                "tracked_y_cm",
-                Column::F64(f64s(frames, "tracked_y_cm").to_vec()),
-            ),
+            ("x_cm", Column::F64(frames.x_cm.to_vec())),
+            ("y_cm", Column::F64(frames.y_cm.to_vec())),
+            ("heading_deg", Column::F64(frames.heading_deg.to_vec())),
+            ("tracked_x_cm", Column::F64(frames.tracked_x_cm.to_vec())),
+            ("tracked_y_cm", Column::F64(frames.tracked_y_cm.to_vec())),
             (
                 "phase",
                 Column::Str(
-                    i64s(frames, "phase")
+                    frames
+                        .phase
                         .iter()
                         .map(|&k| {
                             PHASE_NAMES
@@ -172,12 +167,7 @@ pub(super) fn trajectory_table(frames: &Table, windows: &Table, names: &[String]
             ),
             (
                 "current_goal",
-                Column::Str(
-                    i64s(frames, "target")
-                        .iter()
-                        .map(|&k| name_of(names, k))
-                        .collect(),
-                ),
+                Column::Str(frames.target.iter().map(|&k| name_of(names, k)).collect()),
             ),
             ("p_error", Column::F64(p)),
             ("evidence", Column::F64(ev)),
@@ -186,105 +176,92 @@ pub(super) fn trajectory_table(frames: &Table, windows: &Table, names: &[String]
 }
 
 /// One row per detection, where the robot was and the controller's step.
-pub(super) fn detections_table(windows: &Table, results: &[EpuckEpisodeResult]) -> CsvTable {
-    let (w_run, w_t) = (i64s(windows, "run"), f64s(windows, "t_s"));
-    let (w_p, w_ev) = (f64s(windows, "p_error"), f64s(windows, "evidence"));
-    // Detections, with where the robot was and whether an ErrP explains it.
-    let mut d = (
-        Vec::new(),
-        Vec::new(),
-        Vec::new(),
-        Vec::new(),
-        Vec::new(),
-        Vec::new(),
-        Vec::new(),
-    );
-    let detected = bools(windows, "detected");
-    let steps = i64s(windows, "step");
+pub(super) fn detections_table(
+    windows: &WindowsView<'_>,
+    results: &[EpuckEpisodeResult],
+) -> CsvTable {
+    let w = windows;
+    // Detections, with where the robot was and the controller's step.
+    let (mut run, mut t_s, mut x_cm, mut y_cm) = (vec![], vec![], vec![], vec![]);
+    let (mut p_error, mut evidence, mut step) = (vec![], vec![], vec![]);
     let mut per_run = vec![0usize; results.len()];
-    for i in 0..w_t.len() {
-        if !detected.get(i).copied().unwrap_or(false) {
+    for i in 0..w.rows {
+        if !w.detected[i] {
             continue;
         }
-        let r = w_run[i];
+        let r = w.run[i];
         let Some(result) = usize::try_from(r).ok().and_then(|k| results.get(k)) else {
             continue;
         };
         let j = per_run[r as usize];
         per_run[r as usize] += 1;
         let xy = result.detections.get(j).copied().unwrap_or([f64::NAN; 2]);
-        d.0.push(r + 1);
-        d.1.push(w_t[i]);
-        d.2.push(100.0 * xy[0]);
-        d.3.push(100.0 * xy[1]);
-        d.4.push(w_p[i]);
-        d.5.push(w_ev[i]);
-        d.6.push(
+        run.push(r + 1);
+        t_s.push(w.t_s[i]);
+        x_cm.push(100.0 * xy[0]);
+        y_cm.push(100.0 * xy[1]);
+        p_error.push(w.p_error[i]);
+        evidence.push(w.evidence[i]);
+        step.push(
             STEP_NAMES
-                .get(steps[i] as usize)
+                .get(w.step[i] as usize)
                 .map_or(String::new(), |s| s.to_string()),
         );
     }
     CsvTable {
         name: "detections",
         columns: vec![
-            ("run", Column::I64(d.0)),
-            ("t_s", Column::F64(d.1)),
-            ("x_cm", Column::F64(d.2)),
-            ("y_cm", Column::F64(d.3)),
-            ("p_error", Column::F64(d.4)),
-            ("evidence", Column::F64(d.5)),
-            ("step", Column::Str(d.6)),
+            ("run", Column::I64(run)),
+            ("t_s", Column::F64(t_s)),
+            ("x_cm", Column::F64(x_cm)),
+            ("y_cm", Column::F64(y_cm)),
+            ("p_error", Column::F64(p_error)),
+            ("evidence", Column::F64(evidence)),
+            ("step", Column::Str(step)),
         ],
     }
 }
 
 /// The belief per goal after each window, long.
-pub(super) fn belief_table(windows: &Table, names: &[String]) -> CsvTable {
-    let (w_run, w_t) = (i64s(windows, "run"), f64s(windows, "t_s"));
-    // Belief per goal, long.
-    let (belief, width) = match windows.column("belief") {
-        Some(Column::F64Rows(v, w)) => (&v[..], *w),
-        _ => (&[][..], 0),
-    };
-    let rows = w_t.len() * width;
-    let mut b = (
-        Vec::with_capacity(rows),
-        Vec::with_capacity(rows),
-        Vec::with_capacity(rows),
-        Vec::with_capacity(rows),
-    );
-    for i in 0..w_t.len() {
+pub(super) fn belief_table(windows: &WindowsView<'_>, names: &[String]) -> CsvTable {
+    let (belief, width) = windows.belief;
+    let rows = windows.rows * width;
+    let mut run = Vec::with_capacity(rows);
+    let mut t_s = Vec::with_capacity(rows);
+    let mut goal = Vec::with_capacity(rows);
+    let mut p = Vec::with_capacity(rows);
+    for i in 0..windows.rows {
         for g in 0..width {
-            b.0.push(w_run[i] + 1);
-            b.1.push(w_t[i]);
-            b.2.push(name_of(names, g as i64));
-            b.3.push(belief[i * width + g]);
+            run.push(windows.run[i] + 1);
+            t_s.push(windows.t_s[i]);
+            goal.push(name_of(names, g as i64));
+            p.push(belief[i * width + g]);
         }
     }
     CsvTable {
         name: "belief",
         columns: vec![
-            ("run", Column::I64(b.0)),
-            ("t_s", Column::F64(b.1)),
-            ("goal", Column::Str(b.2)),
-            ("p", Column::F64(b.3)),
+            ("run", Column::I64(run)),
+            ("t_s", Column::F64(t_s)),
+            ("goal", Column::Str(goal)),
+            ("p", Column::F64(p)),
         ],
     }
 }
 
 /// One row per ErrP of the user.
-pub(super) fn errps_table(errps: &Table) -> CsvTable {
+pub(super) fn errps_table(errps: &ErrpsView<'_>) -> CsvTable {
     CsvTable {
         name: "errps",
         columns: vec![
-            ("run", run1(i64s(errps, "run"))),
-            ("t_s", Column::F64(f64s(errps, "t_s").to_vec())),
-            ("onset_s", Column::F64(f64s(errps, "onset_s").to_vec())),
+            ("run", run1(errps.run)),
+            ("t_s", Column::F64(errps.t_s.to_vec())),
+            ("onset_s", Column::F64(errps.onset_s.to_vec())),
             (
                 "judged_phase",
                 Column::Str(
-                    i64s(errps, "phase")
+                    errps
+                        .phase
                         .iter()
                         .map(|&k| {
                             PHASE_NAMES
@@ -299,28 +276,23 @@ pub(super) fn errps_table(errps: &Table) -> CsvTable {
 }
 
 /// The event log.
-pub(super) fn events_table(events: &Table) -> CsvTable {
+pub(super) fn events_table(events: &EventsView<'_>) -> CsvTable {
     CsvTable {
         name: "events",
         columns: vec![
-            ("run", run1(i64s(events, "run"))),
-            ("t_s", Column::F64(f64s(events, "t_s").to_vec())),
+            ("run", run1(events.run)),
+            ("t_s", Column::F64(events.t_s.to_vec())),
             (
                 "level",
                 Column::Str(
-                    bools(events, "warn")
+                    events
+                        .warn
                         .iter()
                         .map(|&w| if w { "WARN" } else { "INFO" }.to_string())
                         .collect(),
                 ),
             ),
-            (
-                "text",
-                match events.column("text") {
-                    Some(Column::Str(v)) => Column::Str(v.clone()),
-                    _ => Column::Str(Vec::new()),
-                },
-            ),
+            ("text", Column::Str(events.text.to_vec())),
         ],
     }
 }

@@ -7,9 +7,9 @@ use std::fmt::Write as _;
 use errp_robot::Grid;
 
 use crate::epuck::{EpuckEpisodeResult, PHASE_NAMES, PHYSICS_DT_SECS, STEP_NAMES};
-use crate::inspect::{Recording, Runs, Table};
+use crate::inspect::{Recording, Runs};
 use crate::record::data::Column;
-use crate::record::paths;
+use crate::record::schema::{ErrpsView, EventsView, FramesView, WindowsView};
 
 mod epuck;
 
@@ -129,44 +129,18 @@ fn quote(s: &str) -> String {
     }
 }
 
-fn get<'a>(rec: &'a Recording, entity: &str) -> Option<&'a crate::inspect::Table> {
-    rec.tables.get(entity)
-}
-
-fn f64s<'a>(t: &'a crate::inspect::Table, c: &str) -> &'a [f64] {
-    match t.column(c) {
-        Some(Column::F64(v)) => v,
-        _ => &[],
-    }
-}
-
-fn i64s<'a>(t: &'a crate::inspect::Table, c: &str) -> &'a [i64] {
-    match t.column(c) {
-        Some(Column::I64(v)) => v,
-        _ => &[],
-    }
-}
-
-fn bools<'a>(t: &'a crate::inspect::Table, c: &str) -> &'a [bool] {
-    match t.column(c) {
-        Some(Column::Bool(v)) => v,
-        _ => &[],
-    }
-}
-
 /// The seconds each run spent turning, driving and stopped, from its
 /// frames (one pass over them).
 pub fn phase_secs(rec: &Recording) -> Vec<[f64; 3]> {
     let mut out = vec![[0.0; 3]; rec.n_runs()];
-    if let Some(t) = get(rec, paths::FRAMES) {
-        for (r, p) in i64s(t, "run").iter().zip(i64s(t, "phase")) {
-            if let Some(slot) = usize::try_from(*r)
-                .ok()
-                .and_then(|r| out.get_mut(r))
-                .and_then(|run| usize::try_from(*p).ok().and_then(|p| run.get_mut(p)))
-            {
-                *slot += PHYSICS_DT_SECS;
-            }
+    let frames = FramesView::or_empty(&rec.tables);
+    for (r, p) in frames.run.iter().zip(frames.phase) {
+        if let Some(slot) = usize::try_from(*r)
+            .ok()
+            .and_then(|r| out.get_mut(r))
+            .and_then(|run| usize::try_from(*p).ok().and_then(|p| run.get_mut(p)))
+        {
+            *slot += PHYSICS_DT_SECS;
         }
     }
     out
