@@ -21,7 +21,7 @@ Grid scenarios run with the oracle decoder and e-puck scenarios with
 order (seeded) until --seconds have passed (default: all of them); the
 counts are printed at the end and any failure makes the exit code 1.
 
-A family of damaged recordings (`recording_cases`, about 190, in
+A family of damaged recordings (`recording_cases`, about 310, in
 fuzz_recordings.py): a grid run's, an e-puck run's and a calibration's
 recording cut short at seeded offsets, with bits flipped, doubled, followed
 by garbage, reduced to its header or zeroed, each read by `errp inspect

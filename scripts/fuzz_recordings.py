@@ -29,7 +29,7 @@ MAKERS = {
 }
 
 #: Truncation points and bit flips per recording.
-CUTS, FLIPS = 30, 20
+CUTS, FLIPS = 30, 60
 
 
 class Damage:
