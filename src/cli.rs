@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Result, bail};
 use clap::ValueEnum;
 use errp_bci::{MeanAccuracy, RequestedAccuracy};
+use errp_sim::ScenarioSeed;
 use errp_sim::grid::EegMode;
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -78,14 +79,14 @@ pub(crate) struct RunArgs {
     /// Override the scenario's seed (a new simulated user, new runs, new
     /// free goals).
     #[arg(long, value_parser = parse_scenario_seed, allow_negative_numbers = true)]
-    pub(crate) seed: Option<u64>,
+    pub(crate) seed: Option<ScenarioSeed>,
     /// Override the scenario's decoder (grid scenarios).
     #[arg(long, value_enum)]
     pub(crate) decoder: Option<DecoderArg>,
     /// Override the decoder's accuracy (mean of the per-class rates, in
     /// (0.5, 1); 1 for the grid's oracle decoder).
     #[arg(long, value_parser = parse_run_accuracy, allow_negative_numbers = true)]
-    pub(crate) accuracy: Option<f64>,
+    pub(crate) accuracy: Option<RequestedAccuracy>,
     /// Override the number of runs (e-puck scenarios); each run has its own
     /// seed derived from the scenario's.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=100_000))]
@@ -147,11 +148,11 @@ pub(crate) fn parse_accuracy(s: &str) -> Result<MeanAccuracy, String> {
 
 /// `--accuracy` of `errp run`: a mean accuracy in (0.5, 1), or 1 (for the
 /// grid's oracle; `errp run` checks the decoder).
-pub(crate) fn parse_run_accuracy(s: &str) -> Result<f64, String> {
+pub(crate) fn parse_run_accuracy(s: &str) -> Result<RequestedAccuracy, String> {
     match s.trim().parse::<f64>().map(RequestedAccuracy::new) {
-        Ok(Ok(a)) => Ok(a.get()),
+        Ok(Ok(a)) => Ok(a),
         _ => parse_accuracy(s)
-            .map(|a| a.get())
+            .map(RequestedAccuracy::Targeted)
             .map_err(|e| format!("{e} (or 1 with --decoder oracle)")),
     }
 }
@@ -168,15 +169,15 @@ pub(crate) fn parse_seed(s: &str) -> Result<u64, String> {
 
 /// A scenario's seed: a whole number from 0 to 2^63 - 1 (a TOML integer,
 /// as the file holds it).
-pub(crate) fn parse_scenario_seed(s: &str) -> Result<u64, String> {
+pub(crate) fn parse_scenario_seed(s: &str) -> Result<ScenarioSeed, String> {
     s.trim()
         .parse::<u64>()
         .ok()
-        .filter(|&seed| i64::try_from(seed).is_ok())
+        .and_then(ScenarioSeed::new)
         .ok_or_else(|| {
             format!(
                 "{s:?} is not a scenario's seed: give a whole number from 0 to {}",
-                i64::MAX
+                ScenarioSeed::MAX
             )
         })
 }

@@ -7,7 +7,9 @@ use std::path::PathBuf;
 use errp_bci::{EegBlock, Montage, RequestedAccuracy};
 use errp_sim::epuck::EpuckScenario;
 use errp_sim::grid::GridScenario;
-use errp_sim::{AnyScenario, LoadedScenario, ScenarioInput, ScenarioSource, SetterNames, SimError};
+use errp_sim::{
+    AnyScenario, LoadedScenario, ScenarioInput, ScenarioSeed, ScenarioSource, SetterNames, SimError,
+};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray2};
 use pyo3::exceptions::{PyFileNotFoundError, PyKeyboardInterrupt, PyOSError, PyValueError};
@@ -268,15 +270,18 @@ impl Keys {
                 })
             })
             .transpose()?;
-        if let Some(seed) = self.seed
-            && i64::try_from(seed).is_err()
-        {
-            return Err(value_error(
-                "seed",
-                seed,
-                &format!("a whole number from 0 to {}", i64::MAX),
-            ));
-        }
+        let seed = self
+            .seed
+            .map(|seed| {
+                ScenarioSeed::new(seed).ok_or_else(|| {
+                    value_error(
+                        "seed",
+                        seed,
+                        &format!("a whole number from 0 to {}", ScenarioSeed::MAX),
+                    )
+                })
+            })
+            .transpose()?;
         let runs = match self.runs {
             None => None,
             Some(runs) => {
@@ -289,7 +294,7 @@ impl Keys {
         };
         let set: Vec<&str> = [
             (accuracy.is_some(), "user.accuracy"),
-            (self.seed.is_some(), "seed"),
+            (seed.is_some(), "seed"),
             (runs.is_some(), "runs"),
         ]
         .into_iter()
@@ -297,7 +302,7 @@ impl Keys {
         .collect();
         Ok(ScenarioInput {
             accuracy,
-            seed: self.seed,
+            seed,
             runs,
             keys: overrides(&set, given)?,
             ..ScenarioInput::new(source)

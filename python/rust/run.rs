@@ -82,7 +82,7 @@ pub(crate) fn grid_csv(s: &GridScenario, episodes: &[GridEpisodeResult]) -> Stri
         .iter()
         .enumerate()
         .map(|(k, r)| (errp_sim::grid::grid_episode_seed(s.seed, k), grid_row(r)));
-    csv(&GridTask::INFO, s.accuracy, rows)
+    csv(&GridTask::INFO, s.accuracy.get(), rows)
 }
 
 /// An e-puck scenario's runs as CSV text, as [`grid_csv`].
@@ -278,7 +278,7 @@ pub(crate) fn grid_summary(
     s: &GridScenario,
     calibration: Option<&CalibrationReport>,
 ) -> DecoderSummary {
-    let mut info = vec![("accuracy", s.accuracy)];
+    let mut info = vec![("accuracy", s.accuracy.get())];
     if let Some(c) = calibration {
         let a = c.calibrated.accuracy;
         info.extend([

@@ -21,7 +21,11 @@ static SETUP: LazyLock<(EpuckScenario, ContinuousDecoder)> = LazyLock::new(|| {
         env!("CARGO_MANIFEST_DIR"),
         "/../scenarios/mexico_to_pisa.toml"
     );
-    let mut s = EpuckScenario::load(path).unwrap();
+    let mut s =
+        errp_sim::ScenarioInput::load_as_written(errp_sim::ScenarioSource::File(path.into()))
+            .unwrap()
+            .into_epuck()
+            .unwrap();
     // Exactly 60 s every time: no convergence, no early end.
     s.params.control = s.params.control.with(|c| c.p_c = 0.999_999).unwrap();
     s.params.max_secs = 60.0;

@@ -8,9 +8,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use divan::{Bencher, black_box};
-use errp_sim::epuck::{
-    EpuckScenario, epuck_recording, prepare_continuous_decoder, record_epuck_runs,
-};
+use errp_sim::epuck::{epuck_recording, prepare_continuous_decoder, record_epuck_runs};
 use errp_sim::inspect::{Recording, csv_tables};
 use errp_sim::record::data::Provenance;
 
@@ -37,7 +35,11 @@ fn make_recording() -> PathBuf {
         env!("CARGO_MANIFEST_DIR"),
         "/../scenarios/mexico_to_pisa.toml"
     );
-    let mut s = EpuckScenario::load(path).unwrap();
+    let mut s =
+        errp_sim::ScenarioInput::load_as_written(errp_sim::ScenarioSource::File(path.into()))
+            .unwrap()
+            .into_epuck()
+            .unwrap();
     s.runs = RUNS;
     let (d, _) = prepare_continuous_decoder(&s, |_| {}).unwrap();
     let out = std::env::temp_dir().join(format!("errp-bench-inspect-{}.rrd", std::process::id()));

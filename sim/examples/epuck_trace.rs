@@ -3,9 +3,7 @@
 //!
 //! `cargo run -p errp_sim --example epuck_trace -- scenarios/mexico_to_pisa.toml [seed]`
 
-use errp_sim::epuck::{
-    EpuckObserver, EpuckScenario, WindowFrame, prepare_continuous_decoder, run_epuck_once,
-};
+use errp_sim::epuck::{EpuckObserver, WindowFrame, prepare_continuous_decoder, run_epuck_once};
 
 struct Trace {
     names: Vec<String>,
@@ -45,7 +43,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = args
         .first()
         .map_or("scenarios/mexico_to_pisa.toml", String::as_str);
-    let mut scenario = EpuckScenario::load(path)?;
+    let mut scenario =
+        errp_sim::ScenarioInput::load_as_written(errp_sim::ScenarioSource::File(path.into()))?
+            .into_epuck()
+            .ok_or("not an e-puck scenario")?;
     if let Some(seed) = args.get(1) {
         scenario.seed = seed.parse()?;
     }

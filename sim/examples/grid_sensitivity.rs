@@ -13,8 +13,8 @@
 
 use errp_robot::{Grid, GridControlParams, QTable};
 use errp_sim::grid::{
-    AssessmentDecoder, EegDecoder, FIXED_PAIRS, GridScenario, GridTaskParams, PErrorChoice,
-    prepare_decoder, run_grid_episode,
+    AssessmentDecoder, EegDecoder, FIXED_PAIRS, GridTaskParams, PErrorChoice, prepare_decoder,
+    run_grid_episode,
 };
 use errp_sim::mean_sd;
 
@@ -98,12 +98,16 @@ fn main() {
     for accuracy in [0.7438, 0.90] {
         // The grid's decoder, targeted as every grid scenario's is (online,
         // on held-out epochs), from calibration seed 3.
-        let mut scenario = GridScenario::load(
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join("../scenarios/grid_fixed_goals.toml"),
-        )
-        .expect("the shipped scenario");
-        scenario.accuracy = accuracy;
+        let mut scenario =
+            errp_sim::ScenarioInput::load_as_written(errp_sim::ScenarioSource::File(
+                std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                    .join("../scenarios/grid_fixed_goals.toml"),
+            ))
+            .ok()
+            .and_then(errp_sim::AnyScenario::into_grid)
+            .expect("the shipped grid scenario");
+        scenario.accuracy =
+            errp_bci::RequestedAccuracy::new(accuracy).expect("a targeted accuracy");
         scenario.seed = 3;
         let (_, report) = prepare_decoder(&scenario, |_| {}).expect("calibration");
         let report = report.expect("an EEG decoder");

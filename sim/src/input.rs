@@ -108,6 +108,31 @@ pub const FILE_KEYS: SetterNames = SetterNames {
     save: "save",
 };
 
+/// A scenario's seed set from outside (`--seed`, `seed=`): a whole number
+/// from 0 to `i64::MAX`, as a TOML integer holds it; checked once, where
+/// it enters.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ScenarioSeed(u64);
+
+impl ScenarioSeed {
+    /// The largest seed.
+    pub const MAX: u64 = i64::MAX as u64;
+
+    /// `seed` if it is at most [`Self::MAX`].
+    pub fn new(seed: u64) -> Option<Self> {
+        (seed <= Self::MAX).then_some(Self(seed))
+    }
+
+    /// The seed.
+    pub fn get(self) -> u64 {
+        self.0
+    }
+
+    fn as_toml(self) -> i64 {
+        i64::try_from(self.0).expect("checked: at most i64::MAX")
+    }
+}
+
 /// A scenario and the values set in it from outside, each checked where
 /// it entered (a flag's parser, a keyword's check).
 #[derive(Debug, Clone, PartialEq)]
@@ -117,9 +142,8 @@ pub struct ScenarioInput {
     /// `user.accuracy`: a new decoder accuracy, which replaces the file's
     /// other ways of giving it.
     pub accuracy: Option<RequestedAccuracy>,
-    /// `seed`: a new simulated user, new runs and new free goals (at most
-    /// `i64::MAX`, as a TOML integer).
-    pub seed: Option<u64>,
+    /// `seed`: a new simulated user, new runs and new free goals.
+    pub seed: Option<ScenarioSeed>,
     /// `runs` (e-puck scenarios).
     pub runs: Option<u64>,
     /// `decoder` (grid scenarios).
@@ -218,15 +242,6 @@ impl ScenarioInput {
                 self.source.path().display()
             )));
         }
-        if let Some(seed) = self.seed
-            && i64::try_from(seed).is_err()
-        {
-            return Err(SimError::Scenario(format!(
-                "{} {seed} is invalid: expected a whole number from 0 to {}",
-                names.seed,
-                i64::MAX
-            )));
-        }
         if self.accuracy == Some(RequestedAccuracy::Perfect) {
             let oracle = match self.decoder {
                 Some(d) => d == DecoderChoice::Oracle,
@@ -251,7 +266,7 @@ impl ScenarioInput {
             out.push(("user.accuracy", toml::Value::Float(a.get())));
         }
         if let Some(seed) = self.seed {
-            out.push(("seed", toml::Value::Integer(seed as i64)));
+            out.push(("seed", toml::Value::Integer(seed.as_toml())));
         }
         if epuck && let Some(runs) = self.runs {
             out.push(("runs", toml::Value::Integer(runs as i64)));

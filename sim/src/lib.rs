@@ -88,8 +88,8 @@ pub use agents::{AgentInfo, EpuckAgentRecording, GridAgentRecording};
 pub use error::{Result, SimError, check_p_error};
 pub use files::{append_regular, is_foreign, open_regular, open_regular_with, write_regular};
 pub use input::{
-    BUILT_IN_EPUCK, BUILT_IN_GRID, FILE_KEYS, LoadedScenario, ScenarioInput, ScenarioSource,
-    SetterNames,
+    BUILT_IN_EPUCK, BUILT_IN_GRID, FILE_KEYS, LoadedScenario, ScenarioInput, ScenarioSeed,
+    ScenarioSource, SetterNames,
 };
 pub use key::StableKey;
 pub use output::{
@@ -105,7 +105,7 @@ pub use runner::{
 };
 pub use scenario::{AnyScenario, apply_overrides, is_epuck, parse_scenario, parse_scenario_table};
 pub use scenario_file::{
-    MAX_KEY_PARTS, MAX_SCENARIO_BYTES, key_parts, parse_toml, read_scenario, table_into, truncate,
+    MAX_KEY_PARTS, MAX_SCENARIO_BYTES, key_parts, parse_toml, table_into, truncate,
 };
 pub use stats::{
     StreamingPearson, correlation_p_value, fixed_or_dash, incomplete_beta, mean_sd, median,

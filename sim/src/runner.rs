@@ -182,7 +182,7 @@ impl std::fmt::Display for RunHeadline<'_> {
                     crate::grid::DecoderChoice::Eeg => "EEG",
                     crate::grid::DecoderChoice::Oracle => "oracle",
                 },
-                100.0 * s.accuracy,
+                100.0 * s.accuracy.get(),
                 s.user,
                 s.seed
             ),

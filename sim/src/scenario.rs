@@ -30,6 +30,22 @@ impl AnyScenario {
         any.downcast_ref()
     }
 
+    /// The grid scenario, if it is one.
+    pub fn into_grid(self) -> Option<GridScenario> {
+        match self {
+            AnyScenario::Grid(s) => Some(*s),
+            AnyScenario::Epuck(_) => None,
+        }
+    }
+
+    /// The e-puck scenario, if it is one.
+    pub fn into_epuck(self) -> Option<EpuckScenario> {
+        match self {
+            AnyScenario::Epuck(s) => Some(*s),
+            AnyScenario::Grid(_) => None,
+        }
+    }
+
     /// The scenario's simulated user (its `[realism]` table; the ideal
     /// user if it has none).
     pub fn realism(&self) -> &errp_bci::Realism {

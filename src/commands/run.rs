@@ -3,7 +3,7 @@
 use std::sync::Mutex;
 
 use anyhow::Result;
-use errp_bci::{OnlineStep, RequestedAccuracy, TargetingStep};
+use errp_bci::{OnlineStep, TargetingStep};
 use errp_sim::epuck::{EpuckRunsTable, EpuckSummaryReport, summarise};
 use errp_sim::grid::{DecoderChoice, GridEpisodeHeader, GridEpisodeResult, GridEpisodeRow};
 use errp_sim::{
@@ -29,7 +29,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<()> {
     // The flags are keys of the scenario file, set before it is parsed, so
     // they are checked and carried through exactly as the file's own.
     let input = ScenarioInput {
-        accuracy: args.accuracy.map(RequestedAccuracy::new).transpose()?,
+        accuracy: args.accuracy,
         seed: args.seed,
         runs: args.runs,
         decoder: args.decoder.map(|d| match d {

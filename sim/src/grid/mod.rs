@@ -34,8 +34,8 @@ pub use run::{
     target_online_accuracy,
 };
 pub use scenario::{
-    DecoderChoice, EegMode, GridScenario, MAX_ACTIONS, MAX_BANK_PER_CLASS, MAX_EPISODES,
-    MAX_INTERVAL_SECS, MAX_PAIRS, free_pairs,
+    DecoderChoice, EegMode, GridScenario, GridScenarioBuilder, MAX_ACTIONS, MAX_BANK_PER_CLASS,
+    MAX_EPISODES, MAX_INTERVAL_SECS, MAX_PAIRS, free_pairs,
 };
 pub use table1::{
     CORNER_PAIRS, FIXED_PAIRS, Table1Cell, Table1Options, accuracy_time_correlation, run_table1,

@@ -11,10 +11,8 @@ use errp_bci::{
 use errp_robot::{Grid, GridControlParams, QTable};
 
 use crate::calibration::{CalibrationReport, CalibrationRequest, NoCache, TargetingCache};
-use crate::error::Result;
-use crate::grid::decoder::{
-    AssessmentDecoder, EegDecoder, EegSource, EpochBankParts, PErrorChoice,
-};
+use crate::error::{Result, SimError};
+use crate::grid::decoder::{AssessmentDecoder, EegDecoder, EegSource, EpochBankParts};
 use crate::grid::episode::run_grid_episode_with;
 use crate::grid::plant::{GridDecoding, GridEpisodeResult};
 use crate::grid::scenario::{DecoderChoice, EegMode, GridScenario};
@@ -82,7 +80,7 @@ impl PreparedGrid {
         let calibration = self.calibration.as_ref();
         let accuracy = calibration.map(|c| c.calibrated.accuracy);
         DecoderInfo {
-            accuracy: s.accuracy,
+            accuracy: s.accuracy.get(),
             kind: if calibration.is_some() {
                 "lda"
             } else {
@@ -251,7 +249,7 @@ pub fn prepare_grid_decoder(
     if scenario.decoder == DecoderChoice::Oracle {
         return Ok(PreparedGrid {
             decoder: AssessmentDecoder::Oracle {
-                accuracy: scenario.accuracy,
+                accuracy: scenario.accuracy.get(),
             },
             calibration: None,
             cached: false,
@@ -259,7 +257,7 @@ pub fn prepare_grid_decoder(
     }
     let request = CalibrationRequest {
         setup: grid_setup(scenario)?,
-        ..CalibrationRequest::new(MeanAccuracy::new(scenario.accuracy)?, scenario.seed)
+        ..CalibrationRequest::new(targeted(scenario)?, scenario.seed)
     };
     let simulated;
     let parts = match shared.sessions.get(&session_key(scenario)) {
@@ -368,26 +366,25 @@ pub fn online_accuracy_at(
     Ok(held_out.score(&model, ratio))
 }
 
+/// The accuracy the EEG decoder of `scenario` is targeted at (a scenario
+/// changed after it was checked may ask a perfect one).
+fn targeted(scenario: &GridScenario) -> Result<MeanAccuracy> {
+    scenario.accuracy.targeted().ok_or_else(|| {
+        SimError::Scenario(format!(
+            "{}: the EEG decoder cannot be perfect (user.accuracy = 1 is the oracle's)",
+            scenario.path.display()
+        ))
+    })
+}
+
 /// The streamed EEG decoder of a synthetic user calibrated at `accuracy`
 /// (online, as every grid decoder: [`target_online_accuracy`]; seed
 /// `seed`), with Platt-scaled p(error): for benches, examples and tests that
 /// need one decoder without a scenario file.
 pub fn eeg_decoder(accuracy: f64, seed: u64) -> Result<AssessmentDecoder> {
-    let scenario = GridScenario {
-        path: "eeg_decoder".into(),
-        name: "eeg_decoder".into(),
-        description: String::new(),
-        seed,
-        decoder: DecoderChoice::Eeg,
-        p_error: PErrorChoice::Platt,
-        eeg: EegMode::Stream,
-        bank_per_class: 1,
-        accuracy,
-        user: String::new(),
-        episodes: Vec::new(),
-        params: crate::grid::GridTaskParams::default(),
-        realism: errp_bci::Realism::default(),
-    };
+    let scenario = GridScenario::builder("eeg_decoder", DecoderChoice::Eeg, accuracy, seed)
+        .bank_per_class(1)
+        .build()?;
     Ok(prepare_decoder(&scenario, |_| {})?.0)
 }
 

@@ -1,7 +1,7 @@
 //! Scenario files: what to run, validated on load.
 //!
 //! A scenario is TOML. `ScenarioFile` mirrors the file (serde, unknown keys
-//! rejected); [`GridScenario::load`] checks every value and returns a checked
+//! rejected); loading (through [`crate::ScenarioInput`]) checks every value and returns a checked
 //! [`GridScenario`], or an error naming the file, the field, the value and the
 //! accepted range.
 
@@ -16,8 +16,7 @@ use crate::error::Result;
 use crate::grid::decoder::PErrorChoice;
 use crate::grid::params::GridTaskParams;
 use crate::scenario_file::{
-    Pair, checked_realism, field_error, parse_toml, read_scenario, robot_error, scenario_name,
-    table_into, whole,
+    Pair, checked_realism, field_error, parse_toml, robot_error, scenario_name, table_into, whole,
 };
 
 /// Most epochs per class in an epoch bank (about 9 KB each, per level of a
@@ -162,8 +161,11 @@ struct TimingFile {
     max_actions: Option<f64>,
 }
 
-/// A validated grid scenario.
+/// A validated grid scenario: loaded through [`crate::ScenarioInput`] or
+/// made in code ([`GridScenario::builder`]), checked either way; it cannot
+/// be written as a struct literal outside this crate.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct GridScenario {
     /// The file it came from.
     pub path: PathBuf,
@@ -181,8 +183,9 @@ pub struct GridScenario {
     pub eeg: EegMode,
     /// Epochs per class in the bank (bank mode).
     pub bank_per_class: usize,
-    /// The decoder's mean accuracy, in (0.5, 1] (1 only for the oracle).
-    pub accuracy: f64,
+    /// The decoder's mean accuracy: targeted in (0.5, 1), or perfect (the
+    /// oracle only).
+    pub accuracy: RequestedAccuracy,
     /// Who the accuracy comes from ("accuracy 0.7438", "subject S2, fixed goals").
     pub user: String,
     /// (start, goal) of every episode, in order (repeats included).
@@ -194,12 +197,6 @@ pub struct GridScenario {
 }
 
 impl GridScenario {
-    /// Reads and validates a scenario file.
-    pub fn load(path: impl AsRef<Path>) -> Result<Self> {
-        let path = path.as_ref();
-        Self::parse(&read_scenario(path)?, path)
-    }
-
     /// Validates scenario text; `path` names it in errors.
     pub fn parse(text: &str, path: &Path) -> Result<Self> {
         Self::from_file(parse_toml(text, path)?, path)
@@ -228,7 +225,7 @@ impl GridScenario {
         // The device knows its decoder's accuracy from the calibration.
         // Checked here, once: the controllers take it checked.
         let control = GridControlParams {
-            assumed_accuracy: accuracy,
+            assumed_accuracy: accuracy.get(),
             ..file.control
         };
         let mut params = GridTaskParams {
@@ -287,7 +284,7 @@ impl GridScenario {
 
 /// The user of a `[user]` table, an accuracy or a subject of Table 1 with
 /// a goal set, in words too; an accuracy `decoder` can be asked for.
-fn user_accuracy(file: &ScenarioFile, path: &Path) -> Result<(f64, String)> {
+fn user_accuracy(file: &ScenarioFile, path: &Path) -> Result<(RequestedAccuracy, String)> {
     let bad =
         |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
     // The user: an accuracy, or a subject of Table 1 with a goal set.
@@ -320,21 +317,142 @@ fn user_accuracy(file: &ScenarioFile, path: &Path) -> Result<(f64, String)> {
             ));
         }
     };
-    // A real decoder is targeted at a mean accuracy; the oracle may also
-    // be perfect.
-    let ok = matches!(
-        (RequestedAccuracy::new(accuracy), file.decoder),
-        (Ok(RequestedAccuracy::Targeted(_)), _)
-            | (Ok(RequestedAccuracy::Perfect), DecoderChoice::Oracle)
-    );
-    if !ok {
-        return Err(bad(
-            "user.accuracy",
-            accuracy.to_string(),
-            "a mean accuracy in (0.5, 1) for the EEG decoder, (0.5, 1] for the oracle",
-        ));
+    let requested = checked_accuracy(accuracy, file.decoder)
+        .ok_or_else(|| bad("user.accuracy", accuracy.to_string(), ACCURACY_RANGE))?;
+    Ok((requested, user))
+}
+
+/// The accuracies a grid decoder may have, in words.
+const ACCURACY_RANGE: &str =
+    "a mean accuracy in (0.5, 1) for the EEG decoder, (0.5, 1] for the oracle";
+
+/// `accuracy` if `decoder` can have it: a real decoder is targeted at a
+/// mean accuracy; the oracle may also be perfect.
+fn checked_accuracy(accuracy: f64, decoder: DecoderChoice) -> Option<RequestedAccuracy> {
+    match (RequestedAccuracy::new(accuracy), decoder) {
+        (Ok(a @ RequestedAccuracy::Targeted(_)), _)
+        | (Ok(a @ RequestedAccuracy::Perfect), DecoderChoice::Oracle) => Some(a),
+        _ => None,
     }
-    Ok((accuracy, user))
+}
+
+/// A grid scenario made in code, field by field, and checked once by
+/// [`GridScenarioBuilder::build`] as a file's values are (Table 1's cells,
+/// a fit's users, a decoder for benches).
+#[derive(Debug, Clone)]
+pub struct GridScenarioBuilder {
+    scenario: GridScenario,
+    accuracy: f64,
+}
+
+impl GridScenario {
+    /// A scenario at `path` (a label in errors and its name, until
+    /// [`GridScenarioBuilder::name`]) whose `decoder` has the mean
+    /// `accuracy`, run from `seed`; everything else as a file that sets
+    /// nothing has it
+    /// (streamed EEG, Platt-scaled p(error), 1000 epochs per class, the
+    /// paper's strategy and timing, the ideal user), with no episodes.
+    pub fn builder(
+        path: &str,
+        decoder: DecoderChoice,
+        accuracy: f64,
+        seed: u64,
+    ) -> GridScenarioBuilder {
+        GridScenarioBuilder {
+            scenario: Self {
+                path: path.into(),
+                name: path.to_string(),
+                description: String::new(),
+                seed,
+                decoder,
+                p_error: PErrorChoice::Platt,
+                eeg: EegMode::Stream,
+                bank_per_class: 1000,
+                // Set by `build`, once checked.
+                accuracy: RequestedAccuracy::Perfect,
+                user: format!("accuracy {accuracy}"),
+                episodes: Vec::new(),
+                params: GridTaskParams::default(),
+                realism: Realism::default(),
+            },
+            accuracy,
+        }
+    }
+}
+
+impl GridScenarioBuilder {
+    /// The display name.
+    pub fn name(mut self, name: &str) -> Self {
+        self.scenario.name = name.to_string();
+        self
+    }
+
+    /// Streamed or banked EEG.
+    pub fn eeg(mut self, eeg: EegMode) -> Self {
+        self.scenario.eeg = eeg;
+        self
+    }
+
+    /// Epochs per class in the bank.
+    pub fn bank_per_class(mut self, n: usize) -> Self {
+        self.scenario.bank_per_class = n;
+        self
+    }
+
+    /// Strategy and timing.
+    pub fn params(mut self, params: GridTaskParams) -> Self {
+        self.scenario.params = params;
+        self
+    }
+
+    /// The simulated user's distance from the ideal one.
+    pub fn realism(mut self, realism: Realism) -> Self {
+        self.scenario.realism = realism;
+        self
+    }
+
+    /// Who the accuracy comes from, in words.
+    pub fn user(mut self, user: &str) -> Self {
+        self.scenario.user = user.to_string();
+        self
+    }
+
+    /// The (start, goal) of every episode, in order.
+    pub fn episodes(mut self, episodes: Vec<(Cell, Cell)>) -> Self {
+        self.scenario.episodes = episodes;
+        self
+    }
+
+    /// The scenario, checked as a file's values are: the accuracy against
+    /// the decoder, the bank's size, the number of episodes. The error
+    /// names the scenario and the field.
+    pub fn build(self) -> Result<GridScenario> {
+        let Self {
+            mut scenario,
+            accuracy,
+        } = self;
+        let path = scenario.path.clone();
+        let bad =
+            |field: &str, value: String, expected: &str| field_error(&path, field, value, expected);
+        scenario.accuracy = checked_accuracy(accuracy, scenario.decoder)
+            .ok_or_else(|| bad("user.accuracy", accuracy.to_string(), ACCURACY_RANGE))?;
+        let bank = scenario.bank_per_class;
+        if bank == 0 || bank as u64 > MAX_BANK_PER_CLASS {
+            return Err(bad(
+                "bank_per_class",
+                bank.to_string(),
+                &format!("a whole number from 1 to {MAX_BANK_PER_CLASS}"),
+            ));
+        }
+        if scenario.episodes.len() > MAX_EPISODES {
+            return Err(bad(
+                "episodes",
+                scenario.episodes.len().to_string(),
+                &format!("at most {MAX_EPISODES}"),
+            ));
+        }
+        Ok(scenario)
+    }
 }
 
 /// The timing of a `[timing]` table set in `p`, on the paper's defaults:
@@ -462,6 +580,27 @@ pub fn free_pairs(grid: &Grid, count: usize, rng: &mut impl Rng) -> Vec<(Cell, C
 mod tests {
     use super::*;
 
+    #[test]
+    fn a_built_scenario_is_checked_as_a_file_is() {
+        let built = |decoder, accuracy| GridScenario::builder("made", decoder, accuracy, 3);
+        let s = built(DecoderChoice::Oracle, 1.0).build().unwrap();
+        assert_eq!(s.accuracy, RequestedAccuracy::Perfect);
+        assert_eq!((s.seed, s.name.as_str()), (3, "made"));
+        let s = built(DecoderChoice::Eeg, 0.8).name("S1").build().unwrap();
+        assert_eq!((s.accuracy.get(), s.name.as_str()), (0.8, "S1"));
+        for (b, field) in [
+            (built(DecoderChoice::Eeg, 1.0), "user.accuracy"),
+            (built(DecoderChoice::Oracle, 0.5), "user.accuracy"),
+            (
+                built(DecoderChoice::Eeg, 0.8).bank_per_class(0),
+                "bank_per_class",
+            ),
+        ] {
+            let e = b.build().unwrap_err().to_string();
+            assert!(e.starts_with("made: field `") && e.contains(field), "{e}");
+        }
+    }
+
     const OK: &str = r#"
 task = "grid"
 [user]
@@ -543,6 +682,6 @@ goal = [4, 4]
         assert_eq!(a.episodes, b.episodes);
         assert_eq!(a.episodes.len(), 5);
         assert!(a.episodes.iter().all(|(s, g)| s != g));
-        assert!((a.accuracy - 0.8248).abs() < 1e-12);
+        assert!((a.accuracy.get() - 0.8248).abs() < 1e-12);
     }
 }

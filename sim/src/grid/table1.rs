@@ -6,7 +6,7 @@ use errp_robot::{Cell, Grid, GridControlParams, QTable};
 use rayon::prelude::*;
 
 use crate::error::Result;
-use crate::grid::decoder::{INFORMATION_PER_CLASS, PErrorChoice};
+use crate::grid::decoder::INFORMATION_PER_CLASS;
 use crate::grid::episode::run_grid_episode;
 use crate::grid::params::GridTaskParams;
 use crate::grid::plant::GridEpisodeResult;
@@ -131,21 +131,13 @@ pub fn run_table1(
                     &mut errp_bci::rng::stream(cell_seed, "table1/free-goals"),
                 ),
             };
-            let scenario = GridScenario {
-                path: "table1".into(),
-                name: format!("{name} {goals:?}"),
-                description: String::new(),
-                seed: cell_seed,
-                decoder: options.decoder,
-                p_error: PErrorChoice::Platt,
-                eeg: options.eeg,
-                bank_per_class: 1000,
-                accuracy: *accuracy,
-                user: name.clone(),
-                episodes: Vec::new(),
-                params: options.params,
-                realism: options.realism.clone(),
-            };
+            let scenario = GridScenario::builder("table1", options.decoder, *accuracy, cell_seed)
+                .name(&format!("{name} {goals:?}"))
+                .eeg(options.eeg)
+                .user(name)
+                .params(options.params)
+                .realism(options.realism.clone())
+                .build()?;
             let label = format!(
                 "{name} {}",
                 if *goals == GoalSet::Fixed {

@@ -115,7 +115,7 @@ impl Task for GridTask {
             PErrorChoice::Platt => "platt",
         };
         StableKey::new("grid-decoder", 1)
-            .float("accuracy", s.accuracy)
+            .float("accuracy", s.accuracy.get())
             .int("seed", s.seed)
             .text("decoder", s.decoder.key())
             .text("p_error", p_error)

@@ -11,7 +11,10 @@ use rand::{Rng, SeedableRng};
 
 pub(crate) fn scenario(name: &str) -> EpuckScenario {
     let path = format!("{}/../scenarios/{name}", env!("CARGO_MANIFEST_DIR"));
-    EpuckScenario::load(path).unwrap()
+    errp_sim::ScenarioInput::load_as_written(errp_sim::ScenarioSource::File(path.into()))
+        .unwrap()
+        .into_epuck()
+        .unwrap()
 }
 
 /// Checks every physics frame against the arena's walls.
@@ -142,7 +145,11 @@ fn every_epuck_scenario_loads_and_runs_inside_the_arena() {
         if !text.contains("task = \"epuck\"") {
             continue;
         }
-        let mut s = EpuckScenario::load(&path).unwrap();
+        let mut s =
+            errp_sim::ScenarioInput::load_as_written(errp_sim::ScenarioSource::File(path.clone()))
+                .unwrap()
+                .into_epuck()
+                .unwrap();
         s.params.max_secs = 30.0;
         let (decoder, _) = prepare_continuous_decoder(&s, |_| {}).unwrap();
         let mut bounds = Bounds {

@@ -164,7 +164,7 @@ fn an_accuracy_override_reaches_the_info_gain_planner() {
     };
     match with(&grid, 0.9).unwrap() {
         errp_sim::AnyScenario::Grid(s) => {
-            assert_eq!(s.accuracy, 0.9);
+            assert_eq!(s.accuracy.get(), 0.9);
             assert_eq!(s.params.control.assumed_accuracy, 0.9);
         }
         _ => panic!("a grid scenario"),
@@ -194,10 +194,12 @@ fn the_grid_decoder_is_targeted_on_held_out_epochs_not_by_cross_validation() {
     // hits that; cross-validation, which trains on 4/5 of the session, reads
     // lower at the same ErrP-to-noise ratio (for the idealised user, whose
     // calibration and closed loop are one user).
-    let scenario = errp_sim::grid::GridScenario::load(
+    let scenario = errp_sim::ScenarioInput::load_as_written(errp_sim::ScenarioSource::File(
         std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../scenarios/variants/grid_fixed_goals_ideal.toml"),
-    )
+    ))
+    .unwrap()
+    .into_grid()
     .unwrap();
     let (_, report) = errp_sim::grid::prepare_decoder(&scenario, |_| {}).unwrap();
     let report = report.unwrap();

@@ -187,7 +187,7 @@ fn within_bounds(s: &AnyScenario) {
             assert!((1..=MAX_ACTIONS as usize).contains(&p.max_actions));
             assert!(p.interval_max_secs <= MAX_INTERVAL_SECS);
             assert!(p.epoch_secs > 0.0 && p.epoch_secs <= p.interval_min_secs);
-            assert!(g.accuracy > 0.5 && g.accuracy <= 1.0);
+            assert!(g.accuracy.get() > 0.5 && g.accuracy.get() <= 1.0);
         }
         AnyScenario::Epuck(e) => {
             assert!((1..=MAX_RUNS as usize).contains(&e.runs));

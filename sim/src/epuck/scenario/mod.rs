@@ -17,8 +17,7 @@ use crate::epuck::user::UserParams;
 use crate::epuck::world::{ArenaSpec, Obstacle};
 use crate::error::{Result, SimError};
 use crate::scenario_file::{
-    checked_realism, field_error, parse_toml, read_scenario, robot_error, scenario_name,
-    table_into, whole,
+    checked_realism, field_error, parse_toml, robot_error, scenario_name, table_into, whole,
 };
 
 mod arena;
@@ -52,8 +51,11 @@ fn table_error(path: &Path, table: &str, e: errp_bci::BciError) -> SimError {
     }
 }
 
-/// A validated e-puck scenario.
+/// A validated e-puck scenario, loaded through
+/// [`crate::ScenarioInput`]; it cannot be written as a struct
+/// literal outside this crate.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct EpuckScenario {
     /// The file it came from.
     pub path: PathBuf,
@@ -110,12 +112,6 @@ impl EpuckScenario {
                     .unwrap_or_default()
             ),
         }
-    }
-
-    /// Reads and validates an e-puck scenario file.
-    pub fn load(path: impl AsRef<Path>) -> Result<Self> {
-        let path = path.as_ref();
-        Self::parse(&read_scenario(path)?, path)
     }
 
     /// Validates scenario text; `path` names it in errors.

@@ -31,8 +31,7 @@ use errp_bci::{GoalSet, subjects};
 use errp_robot::{Cell, Grid, GridControlParams, QTable};
 use errp_sim::grid::{
     AssessmentDecoder, DecoderChoice, EegMode, FIXED_PAIRS, GridEpisodeResult, GridScenario,
-    GridShared, GridTaskParams, PErrorChoice, PairFamily, free_pairs, prepare_grid_decoder,
-    run_grid_episode,
+    GridShared, GridTaskParams, PairFamily, free_pairs, prepare_grid_decoder, run_grid_episode,
 };
 use errp_sim::{PAPER, Result, SimError, create_dir, mean_sd, pearson};
 use rayon::prelude::*;
@@ -418,22 +417,15 @@ fn scenario(
     subject: &str,
     params: GridTaskParams,
     realism: &errp_bci::Realism,
-) -> GridScenario {
-    GridScenario {
-        path: "fit grid".into(),
-        name: format!("{subject} (fit grid)"),
-        description: String::new(),
-        seed,
-        decoder: DecoderChoice::Eeg,
-        p_error: PErrorChoice::Platt,
-        eeg: EegMode::Bank,
-        bank_per_class: GRID_FIT_BANK,
-        accuracy,
-        user: subject.to_string(),
-        episodes: Vec::new(),
-        params,
-        realism: realism.clone(),
-    }
+) -> errp_sim::Result<GridScenario> {
+    GridScenario::builder("fit grid", DecoderChoice::Eeg, accuracy, seed)
+        .name(&format!("{subject} (fit grid)"))
+        .eeg(EegMode::Bank)
+        .bank_per_class(GRID_FIT_BANK)
+        .user(subject)
+        .params(params)
+        .realism(realism.clone())
+        .build()
 }
 
 /// The start/goal pairs of group `repeat` of a calibration.
@@ -522,7 +514,7 @@ fn calibrate_users(
                 &free
             };
             let row = &rows[subject];
-            let s = scenario(row.accuracy, seed, &row.subject, base, &spec.realism);
+            let s = scenario(row.accuracy, seed, &row.subject, base, &spec.realism)?;
             let warn = |w: &str| observer.warning(w);
             let cache = cache.reporting(&warn);
             let prepared = prepare_grid_decoder(&s, &GridShared::default(), &cache, |_| {})?;
