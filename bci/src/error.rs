@@ -37,6 +37,10 @@ pub enum BciError {
     /// Training data cannot produce a model (e.g. one class is missing).
     #[error("cannot train: {0}")]
     Training(String),
+    /// A file's content is not what its format requires (the caller names
+    /// the file).
+    #[error("{0}")]
+    Format(String),
     /// Writing an export file failed.
     #[error("I/O error: {0}")]
     Io(#[from] std::io::Error),

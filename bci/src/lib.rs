@@ -22,7 +22,11 @@
 //!   operating point on a held-out recording ([`operating_point`]);
 //! * the information one decoded action carries about the user's verdict
 //!   ([`ActionInformation`]);
-//! * the subjects of Table 1 ([`subject`]) and EDF+ export ([`EdfWriter`]).
+//! * the subjects of Table 1 ([`subject`]), EDF+ export ([`EdfWriter`]);
+//! * a person's own recording in place of the synthetic EEG: EDF, EDF+,
+//!   BDF and BDF+ read and checked ([`EdfFile`]), matched to the montage
+//!   ([`Recording`]) and split into a calibration part and held-out epochs
+//!   ([`split_recording`]).
 //!
 //! ```
 //! use errp_bci::{MeanAccuracy, RequestedAccuracy, subject};
@@ -58,6 +62,7 @@ mod online;
 mod platt;
 mod preprocess;
 mod psd;
+mod recorded;
 pub mod rng;
 mod smo;
 pub mod stop;
@@ -81,7 +86,9 @@ pub use calibration::{
 };
 pub use classify::{Classifier, ErrorModel, Features, sigmoid, stratified_folds};
 pub use continuous::ContinuousFeatures;
-pub use edf::EdfWriter;
+pub use edf::{
+    EdfAnnotation, EdfFile, EdfFormat, EdfSignal, EdfWriter, MAX_EDF_SAMPLES, MAX_EDF_SIGNALS,
+};
 pub use erp::{AssessmentKind, Component, ErpTemplates};
 pub use error::{BciError, Result};
 pub use errp_valid::{Check, Valid, shown};
@@ -104,5 +111,9 @@ pub use online::{
 pub use platt::PlattScaling;
 pub use preprocess::{PreprocessParams, Preprocessing, Preprocessor};
 pub use psd::ThetaPsd;
+pub use recorded::{
+    CalibrationPart, EOG_CHANNELS, EventNames, MIN_CALIBRATION_PER_CLASS, RecordedEpoch,
+    RecordedSession, Recording, split_recording,
+};
 pub use subjects::{GoalSet, Subject, subject, subjects};
 pub use svm::{SvmDecoder, SvmModel, SvmParts};

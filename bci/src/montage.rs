@@ -84,6 +84,24 @@ impl Montage {
         Ok(Self { channels, n_eeg })
     }
 
+    /// The channels at `keep` (increasing indices), EEG still first: the
+    /// part of the montage a recording has.
+    pub fn subset(&self, keep: &[usize]) -> Result<Self> {
+        if !keep.windows(2).all(|w| w[0] < w[1]) || keep.iter().any(|&i| i >= self.len()) {
+            return Err(BciError::InvalidParameter {
+                name: "keep",
+                value: format!("{keep:?}"),
+                expected: format!("increasing channel indices below {}", self.len()),
+            });
+        }
+        let channels: Vec<Channel> = keep.iter().map(|&i| self.channels[i].clone()).collect();
+        let n_eeg = channels
+            .iter()
+            .filter(|c| c.kind == ChannelKind::Eeg)
+            .count();
+        Ok(Self { channels, n_eeg })
+    }
+
     /// All channels, EEG first.
     pub fn channels(&self) -> &[Channel] {
         &self.channels

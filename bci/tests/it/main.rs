@@ -6,3 +6,4 @@ mod decoder;
 mod determinism;
 mod eeg;
 mod realism;
+mod recorded;
