@@ -15,7 +15,7 @@ use errp_valid::Valid;
 use nalgebra::DMatrix;
 
 use crate::calibration::CalibrationSession;
-use crate::edf::{EdfFile, EdfSignal};
+use crate::edf::{EdfFile, EdfSignal, find};
 use crate::erp::AssessmentKind;
 use crate::error::{BciError, Result};
 use crate::features::EpochWindow;
@@ -62,27 +62,6 @@ pub struct Recording {
     pub sfreq_hz: f64,
     /// The labelled events, by onset.
     pub events: Vec<Assessment>,
-}
-
-/// A name as compared: trimmed, lower case, without an `EEG ` or `EOG `
-/// prefix (MNE drops `EOG ` when it infers channel types).
-fn bare(name: &str) -> String {
-    let n = name.trim().to_ascii_lowercase();
-    for prefix in ["eeg ", "eog ", "eeg-", "eog-"] {
-        if let Some(rest) = n.strip_prefix(prefix) {
-            return rest.trim().to_string();
-        }
-    }
-    n
-}
-
-/// The index in `labels` of montage channel `name`: as written, else
-/// compared bare.
-fn find(labels: &[&str], name: &str) -> Option<usize> {
-    labels
-        .iter()
-        .position(|l| l.trim() == name)
-        .or_else(|| labels.iter().position(|l| bare(l) == bare(name)))
 }
 
 /// A short list of names, for messages.

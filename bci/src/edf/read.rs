@@ -388,23 +388,39 @@ impl EdfFile {
         Ok(())
     }
 
-    /// The ordinary signal labelled `label` (compared as written, then
-    /// without a type prefix such as `EEG ` and ignoring case).
+    /// The ordinary signal labelled `label`, matched as a recording's
+    /// channels are ([`Recording`](crate::Recording)): as written, else
+    /// ignoring case and an `EEG ` or `EOG ` prefix.
     pub fn signal(&self, label: &str) -> Option<&EdfSignal> {
-        let bare = |s: &str| {
-            let s = s.trim();
-            s.strip_prefix("EEG ").unwrap_or(s).to_ascii_lowercase()
-        };
-        self.signals
-            .iter()
-            .find(|s| s.label == label)
-            .or_else(|| self.signals.iter().find(|s| bare(&s.label) == bare(label)))
+        let labels: Vec<&str> = self.signals.iter().map(|s| s.label.as_str()).collect();
+        find(&labels, label).map(|i| &self.signals[i])
     }
 
     /// The recording's duration, in seconds.
     pub fn duration_secs(&self) -> f64 {
         self.records as f64 * self.record_secs
     }
+}
+
+/// A name as compared: trimmed, lower case, without an `EEG ` or `EOG `
+/// prefix (MNE drops `EOG ` when it infers channel types).
+fn bare(name: &str) -> String {
+    let n = name.trim().to_ascii_lowercase();
+    for prefix in ["eeg ", "eog ", "eeg-", "eog-"] {
+        if let Some(rest) = n.strip_prefix(prefix) {
+            return rest.trim().to_string();
+        }
+    }
+    n
+}
+
+/// The index in `labels` of montage channel `name`: as written, else
+/// compared bare.
+pub(crate) fn find(labels: &[&str], name: &str) -> Option<usize> {
+    labels
+        .iter()
+        .position(|l| l.trim() == name)
+        .or_else(|| labels.iter().position(|l| bare(l) == bare(name)))
 }
 
 /// A TAL's onset (signed) or duration (unsigned), as EDF+ writes them.

@@ -22,6 +22,8 @@ use crate::scenario_file::{
 /// Most epochs per class in an epoch bank (about 9 KB each, per level of a
 /// sweep).
 pub const MAX_BANK_PER_CLASS: u64 = 20_000;
+/// Epochs per class in a bank when a scenario sets none.
+pub(crate) const DEFAULT_BANK_PER_CLASS: usize = 1000;
 /// Most `[[episode]]` pairs, free goals or repeats in a scenario file.
 pub const MAX_PAIRS: u64 = 10_000;
 /// Most episodes a scenario runs (pairs times repeats).
@@ -242,9 +244,9 @@ impl GridScenario {
                 n,
                 1,
                 MAX_BANK_PER_CLASS,
-                " (default 1000)",
+                &format!(" (default {DEFAULT_BANK_PER_CLASS})"),
             )?,
-            None => 1000,
+            None => DEFAULT_BANK_PER_CLASS,
         };
         let repeats = match file.repeats {
             Some(n) => whole(path, "repeats", n, 1, MAX_PAIRS, " (default 1)")?,
@@ -367,7 +369,7 @@ impl GridScenario {
                 decoder,
                 p_error: PErrorChoice::Platt,
                 eeg: EegMode::Stream,
-                bank_per_class: 1000,
+                bank_per_class: DEFAULT_BANK_PER_CLASS,
                 // Set by `build`, once checked.
                 accuracy: RequestedAccuracy::Perfect,
                 user: format!("accuracy {accuracy}"),
@@ -436,14 +438,14 @@ impl GridScenarioBuilder {
             |field: &str, value: String, expected: &str| field_error(&path, field, value, expected);
         scenario.accuracy = checked_accuracy(accuracy, scenario.decoder)
             .ok_or_else(|| bad("user.accuracy", accuracy.to_string(), ACCURACY_RANGE))?;
-        let bank = scenario.bank_per_class;
-        if bank == 0 || bank as u64 > MAX_BANK_PER_CLASS {
-            return Err(bad(
-                "bank_per_class",
-                bank.to_string(),
-                &format!("a whole number from 1 to {MAX_BANK_PER_CLASS}"),
-            ));
-        }
+        whole(
+            &path,
+            "bank_per_class",
+            scenario.bank_per_class as f64,
+            1,
+            MAX_BANK_PER_CLASS,
+            &format!(" (default {DEFAULT_BANK_PER_CLASS})"),
+        )?;
         if scenario.episodes.len() > MAX_EPISODES {
             return Err(bad(
                 "episodes",
