@@ -10,7 +10,9 @@ use errp_sim::epuck::{
     ContinuousDecoder, ContinuousReport, EpuckEpisodeResult, EpuckScenario, EpuckTask, epuck_row,
     epuck_run_seed,
 };
-use errp_sim::grid::{GridEpisodeResult, GridScenario, GridTask, grid_row};
+use errp_sim::grid::{
+    GridEpisodeResult, GridScenario, GridTask, RecordedReport, decoder_accuracy, grid_row,
+};
 use errp_sim::task::{EpisodeRow, Task, TaskInfo, format_number};
 use errp_sim::{AnyScenario, RunOutcome};
 use errp_sweep::{
@@ -77,12 +79,16 @@ const NAMES: InputNames = InputNames {
 /// A grid scenario's episodes as the CSV text `run` and the tasks' `run`
 /// return: the columns of `episodes.csv` without the sweep's swept values
 /// and checksum, one row per episode.
-pub(crate) fn grid_csv(s: &GridScenario, episodes: &[GridEpisodeResult]) -> String {
+pub(crate) fn grid_csv(
+    s: &GridScenario,
+    recorded: Option<&RecordedReport>,
+    episodes: &[GridEpisodeResult],
+) -> String {
     let rows = episodes
         .iter()
         .enumerate()
         .map(|(k, r)| (errp_sim::grid::grid_episode_seed(s.seed, k), grid_row(r)));
-    csv(&GridTask::INFO, s.accuracy.get(), rows)
+    csv(&GridTask::INFO, decoder_accuracy(s, recorded), rows)
 }
 
 /// An e-puck scenario's runs as CSV text, as [`grid_csv`].
@@ -244,8 +250,9 @@ pub(crate) fn run<'py>(
         RunOutcome::Grid(report) => {
             let s = &report.scenario;
             out.set_item("task", "grid")?;
-            out.set_item("csv", grid_csv(s, &report.episodes))?;
-            let info = grid_summary(s, report.calibration.as_ref());
+            let recorded = report.recorded.as_ref();
+            out.set_item("csv", grid_csv(s, recorded, &report.episodes))?;
+            let info = grid_summary(s, recorded, report.calibration.as_ref());
             out.set_item("decoder", info)?;
         }
         RunOutcome::Epuck(r) => {
@@ -276,9 +283,19 @@ pub(crate) fn summary_dict<'py>(
 /// What the grid decoder's calibration found (none for the oracle).
 pub(crate) fn grid_summary(
     s: &GridScenario,
+    recorded: Option<&RecordedReport>,
     calibration: Option<&CalibrationReport>,
 ) -> DecoderSummary {
-    let mut info = vec![("accuracy", s.accuracy.get())];
+    let mut info = vec![("accuracy", decoder_accuracy(s, recorded))];
+    if let Some(r) = recorded {
+        let a = r.cross_validated;
+        info.extend([
+            ("cv_correct", a.correct),
+            ("cv_error", a.error),
+            ("cv_mean", a.mean()),
+            ("held_out_mean", r.held_out.mean()),
+        ]);
+    }
     if let Some(c) = calibration {
         let a = c.calibrated.accuracy;
         info.extend([

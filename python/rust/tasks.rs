@@ -47,7 +47,7 @@ fn eeg_of(d: &AssessmentDecoder) -> Option<&EegDecoder> {
     match d {
         AssessmentDecoder::Eeg(e) => Some(e),
         AssessmentDecoder::EegBank(b) => Some(&b.decoder),
-        AssessmentDecoder::Oracle { .. } => None,
+        AssessmentDecoder::Oracle { .. } | AssessmentDecoder::Recorded(_) => None,
     }
 }
 
@@ -102,7 +102,18 @@ impl GridTask {
             prepare_decoder(&s, |_| meter.step(CALIBRATING, 0))
         })?
         .map_err(py_err)?;
-        let info = grid_summary(&s, calibration.as_ref());
+        let recorded = match &builtin {
+            AssessmentDecoder::Recorded(bank) => Some(&bank.report),
+            _ => None,
+        };
+        let info = grid_summary(&s, recorded, calibration.as_ref());
+        if (decoder.is_some() || batch_decoder.is_some()) && recorded.is_some() {
+            return Err(PyValueError::new_err(
+                "decoder: the scenario's EEG is a recording, decoded by a decoder calibrated on \
+                 its first part; a decoder of your own reads the synthetic user's EEG (remove \
+                 the [eeg] table, or fit your decoder on the recording yourself)",
+            ));
+        }
         if (decoder.is_some() || batch_decoder.is_some()) && eeg_of(&builtin).is_none() {
             return Err(PyValueError::new_err(
                 "decoder: the scenario's decoder is the oracle (no EEG); a decoder of your own \
@@ -177,7 +188,7 @@ impl GridTask {
                     .map_err(|e| py_err(e.error))?
             }
         };
-        Ok(grid_csv(s, &report.episodes))
+        Ok(grid_csv(s, report.recorded.as_ref(), &report.episodes))
     }
 
     /// What the calibration found: the requested accuracy, the ErrP-to-noise

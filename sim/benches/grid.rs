@@ -4,9 +4,14 @@
 use std::sync::LazyLock;
 
 use divan::{Bencher, black_box};
+use errp_bci::{
+    Assessment, CalibrationParams, CalibrationSetup, EdfWriter, EegBlock, SessionOptions, Valid,
+    simulate_session,
+};
 use errp_robot::{Grid, GridControlParams, QTable};
 use errp_sim::grid::{
-    AssessmentDecoder, CORNER_PAIRS, EpochBank, GridTaskParams, eeg_decoder, run_grid_episode,
+    AssessmentDecoder, CORNER_PAIRS, EpochBank, GridTaskParams, eeg_decoder, prepare_decoder,
+    run_grid_episode,
 };
 
 fn main() {
@@ -49,6 +54,48 @@ static BANK: LazyLock<AssessmentDecoder> = LazyLock::new(|| {
 #[divan::bench]
 fn episode_eeg_bank(bencher: Bencher) {
     episodes(bencher, &BANK);
+}
+
+/// The decoder calibrated on a recording (the first half of an exported
+/// 400-action session at about 78 %), its held-out epochs drawn.
+static RECORDED: LazyLock<AssessmentDecoder> = LazyLock::new(|| {
+    let dir = std::env::temp_dir().join(format!("errp-bench-recorded-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let setup = Valid::new(CalibrationSetup {
+        calibration: CalibrationParams {
+            n_actions: 400,
+            ..CalibrationParams::default()
+        },
+        ..CalibrationSetup::with_ratio(0.94).unwrap()
+    })
+    .unwrap();
+    let file = std::io::BufWriter::new(std::fs::File::create(dir.join("s.edf")).unwrap());
+    let mut writer = EdfWriter::new(file, &setup.montage, 256.0).unwrap();
+    let mut sink = |b: &EegBlock, e: &[Assessment]| writer.write(b, e);
+    let options = SessionOptions {
+        raw_sink: Some(&mut sink),
+        ..SessionOptions::default()
+    };
+    simulate_session(&setup, 1, options).unwrap();
+    writer.finish().unwrap();
+    let text = "task = \"grid\"\n[free_goals]\ncount = 1\n[eeg]\nrecording = \"s.edf\"\n";
+    std::fs::write(dir.join("s.toml"), text).unwrap();
+    let scenario = errp_sim::ScenarioInput::load_as_written(errp_sim::ScenarioSource::File(
+        dir.join("s.toml"),
+    ))
+    .ok()
+    .and_then(errp_sim::AnyScenario::into_grid)
+    .unwrap();
+    let decoder = prepare_decoder(&scenario, |_| {}).unwrap().0;
+    std::fs::remove_dir_all(&dir).unwrap();
+    decoder
+});
+
+/// One grid episode with the decoder calibrated on a recording, reading
+/// its held-out epochs (`[eeg] recording = ...`).
+#[divan::bench]
+fn episode_recorded(bencher: Bencher) {
+    episodes(bencher, &RECORDED);
 }
 
 /// One grid episode with the oracle decoder (no EEG).

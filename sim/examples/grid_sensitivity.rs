@@ -106,8 +106,9 @@ fn main() {
             .ok()
             .and_then(errp_sim::AnyScenario::into_grid)
             .expect("the shipped grid scenario");
-        scenario.accuracy =
-            errp_bci::RequestedAccuracy::new(accuracy).expect("a targeted accuracy");
+        scenario.accuracy = errp_sim::grid::GridAccuracy::Requested(
+            errp_bci::RequestedAccuracy::new(accuracy).expect("a targeted accuracy"),
+        );
         scenario.seed = 3;
         let (_, report) = prepare_decoder(&scenario, |_| {}).expect("calibration");
         let report = report.expect("an EEG decoder");

@@ -242,6 +242,39 @@ impl ScenarioInput {
                 self.source.path().display()
             )));
         }
+        let recording = table
+            .get("eeg")
+            .and_then(toml::Value::as_table)
+            .and_then(|t| t.get("recording"))
+            .and_then(toml::Value::as_str);
+        if let (false, Some(recording)) = (epuck, recording) {
+            let why = format!(
+                "the EEG of {} is a recording (eeg.recording = {recording:?})",
+                self.source.path().display()
+            );
+            if self.accuracy.is_some() {
+                return Err(SimError::Scenario(format!(
+                    "{}: {why}: its decoder is calibrated on the recording's first part and has \
+                     the accuracy the recording gives (reported when it is read); no accuracy \
+                     is targeted. Leave out {}, or remove the [eeg] table to simulate a user",
+                    names.accuracy, names.accuracy
+                )));
+            }
+            if let Some(eeg) = self.eeg {
+                return Err(SimError::Scenario(format!(
+                    "{} {}: {why}, whose held-out epochs the decoder reads; remove the [eeg] \
+                     table to simulate a user",
+                    names.eeg,
+                    eeg.key()
+                )));
+            }
+            if self.decoder == Some(DecoderChoice::Oracle) {
+                return Err(SimError::Scenario(format!(
+                    "{} oracle: {why}, which only the EEG decoder reads",
+                    names.decoder
+                )));
+            }
+        }
         if self.accuracy == Some(RequestedAccuracy::Perfect) {
             let oracle = match self.decoder {
                 Some(d) => d == DecoderChoice::Oracle,

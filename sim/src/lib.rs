@@ -76,6 +76,7 @@ mod paper;
 pub mod realism;
 #[cfg(feature = "rerun")]
 pub mod record;
+pub mod recorded;
 mod runner;
 mod scenario;
 mod scenario_file;

@@ -15,8 +15,8 @@ use crate::epuck::{
 };
 use crate::error::SimError;
 use crate::grid::{
-    GridDecoding, GridEpisodeResult, GridRunReport, GridScenario, prepare_decoder,
-    run_grid_scenario_with,
+    AssessmentDecoder, GridDecoding, GridEpisodeResult, GridRunReport, GridScenario,
+    prepare_decoder, run_grid_scenario_with,
 };
 use crate::input::{LoadedScenario, SetterNames};
 use crate::scenario::AnyScenario;
@@ -173,19 +173,29 @@ pub struct RunHeadline<'a>(pub &'a AnyScenario);
 impl std::fmt::Display for RunHeadline<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self.0 {
-            AnyScenario::Grid(s) => write!(
-                f,
-                "{}: {} episodes, {} decoder at {:.2} % ({}), seed {}",
-                s.name,
-                s.episodes.len(),
-                match s.decoder {
-                    crate::grid::DecoderChoice::Eeg => "EEG",
-                    crate::grid::DecoderChoice::Oracle => "oracle",
-                },
-                100.0 * s.accuracy.get(),
-                s.user,
-                s.seed
-            ),
+            AnyScenario::Grid(s) => match s.accuracy.requested() {
+                Some(a) => write!(
+                    f,
+                    "{}: {} episodes, {} decoder at {:.2} % ({}), seed {}",
+                    s.name,
+                    s.episodes.len(),
+                    match s.decoder {
+                        crate::grid::DecoderChoice::Eeg => "EEG",
+                        crate::grid::DecoderChoice::Oracle => "oracle",
+                    },
+                    100.0 * a.get(),
+                    s.user,
+                    s.seed
+                ),
+                None => write!(
+                    f,
+                    "{}: {} episodes, EEG decoder on the {}, seed {}",
+                    s.name,
+                    s.episodes.len(),
+                    s.user,
+                    s.seed
+                ),
+            },
             AnyScenario::Epuck(s) => {
                 let start = &s.episode.start;
                 write!(
@@ -257,9 +267,16 @@ pub fn check_recordable_episodes(
     )))
 }
 
-/// What the grid decoder's calibration found, as `errp run` prints it
-/// (nothing for the oracle).
-pub fn grid_decoder_summary(calibration: Option<&CalibrationReport>) -> String {
+/// What the grid decoder's calibration found, as `errp run` prints it:
+/// the synthetic session's (`calibration`) or the recording's (nothing for
+/// the oracle).
+pub fn grid_decoder_summary(
+    decoder: &AssessmentDecoder,
+    calibration: Option<&CalibrationReport>,
+) -> String {
+    if let AssessmentDecoder::Recorded(bank) = decoder {
+        return bank.report.to_string();
+    }
     match calibration {
         Some(c) => format!(
             "Decoder calibrated on 400 actions: mean accuracy {:.2} % on held-out epochs (the \
@@ -342,6 +359,10 @@ pub fn run_grid_batch(
     record: BatchRecord<'_>,
     observer: &impl RunObserver,
 ) -> Result<(GridRunReport, Option<PathBuf>), RunError> {
+    let recorded = match &decoding {
+        GridDecoding::Builtin(AssessmentDecoder::Recorded(bank)) => Some(bank.report.clone()),
+        _ => None,
+    };
     let episodes = run_grid_scenario_with(&scenario, decoding, recording.is_some(), |k, r| {
         observer.grid_episode(k, r)
     })
@@ -350,6 +371,7 @@ pub fn run_grid_batch(
     let report = GridRunReport {
         scenario,
         calibration,
+        recorded,
         episodes,
     };
     let path = recording::grid(recording.file, &report, &record).map_err(at(record.flag))?;
@@ -404,7 +426,7 @@ fn run_grid(
 ) -> Result<ScenarioRun, RunError> {
     let (decoder, calibration) = prepare_decoder(&scenario, |s| observer.targeting(s))
         .map_err(at("calibrating the decoder"))?;
-    let decoder_summary = grid_decoder_summary(calibration.as_ref());
+    let decoder_summary = grid_decoder_summary(&decoder, calibration.as_ref());
     observer.decoder_ready(&decoder_summary);
     check_going(observer)?;
     let record = BatchRecord {
@@ -516,7 +538,8 @@ mod recording {
     ) -> Result<Option<PathBuf>> {
         let Some(file) = file else { return Ok(None) };
         let s = &report.scenario;
-        let p = provenance("grid", &s.name, s.seed, of);
+        let mut p = provenance("grid", &s.name, s.seed, of);
+        p.eeg_recording = report.recorded.as_ref().map(|r| r.file.clone());
         crate::grid::record_grid_run(file, report, &p).map(Some)
     }
 

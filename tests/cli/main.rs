@@ -7,6 +7,7 @@ mod edges;
 mod hostile;
 mod inspect;
 mod realism;
+mod recorded;
 mod reliability;
 mod scripts;
 

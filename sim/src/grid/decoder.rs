@@ -13,6 +13,7 @@ use serde::{Deserialize, Serialize};
 use crate::calibration::CalibrationReport;
 use crate::error::{Result, SimError};
 use crate::grid::params::GridTaskParams;
+use crate::grid::recorded::RecordedBank;
 
 /// What turns the user's assessment into p(error).
 #[derive(Debug, Clone)]
@@ -34,6 +35,9 @@ pub enum AssessmentDecoder {
     /// action, but no EEG is synthesised during the episode. For Monte Carlo
     /// speed; epochs are reused across episodes.
     EegBank(Box<EpochBank>),
+    /// A decoder calibrated on a person's recording, decoding held-out
+    /// epochs of the same recording (`[eeg] recording = ...`).
+    Recorded(Box<RecordedBank>),
 }
 
 /// Epochs per class on which [`AssessmentDecoder::information`] measures an
@@ -67,6 +71,11 @@ impl AssessmentDecoder {
             }
             Self::Eeg(d) => d.as_ref(),
             Self::EegBank(bank) => &bank.decoder,
+            // The recording's epochs are what there is: every held-out one.
+            Self::Recorded(bank) => {
+                let [error, correct] = bank.decisions();
+                return measured(&error, &correct);
+            }
         };
         let (error, correct) = stream_classes(
             d.source(),

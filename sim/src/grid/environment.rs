@@ -13,6 +13,7 @@ use crate::error::{Result, SimError};
 use crate::grid::decoder::AssessmentDecoder;
 use crate::grid::params::GridTaskParams;
 use crate::grid::plant::{GridDecoding, GridEpisodeResult, GridPlant};
+use crate::grid::recorded::recorded_control;
 
 /// What one action gave the agent.
 #[derive(Debug, Clone, PartialEq)]
@@ -77,6 +78,14 @@ impl GridEnvironment {
         let goal = draw(goal, "goal")?;
         let start = draw(start, "start")?;
         let plant = GridPlant::new(grid, start, goal, &GridDecoding::Builtin(&decoder), seed)?;
+        // A decoder calibrated on a recording knows its own accuracy.
+        let params = match decoder.as_ref() {
+            AssessmentDecoder::Recorded(bank) => GridTaskParams {
+                control: recorded_control(&params, bank)?,
+                ..params
+            },
+            _ => params,
+        };
         Ok(Self {
             decoder,
             plant,

@@ -9,6 +9,7 @@ use crate::error::{Result, SimError};
 use crate::grid::decoder::AssessmentDecoder;
 use crate::grid::params::GridTaskParams;
 use crate::grid::plant::{GridDecoding, GridEpisodeResult, GridPlant};
+use crate::grid::recorded::recorded_control;
 
 /// Runs one episode from `start` towards the user's `goal`. Everything random
 /// derives from `seed`: the same seed gives the same episode, bit for bit.
@@ -52,7 +53,12 @@ pub fn run_grid_episode_with(
             )));
         }
     }
-    let mut controller = GridController::with_table(table.clone(), params.control);
+    // A decoder calibrated on a recording knows its own accuracy.
+    let control = match &decoding {
+        GridDecoding::Builtin(AssessmentDecoder::Recorded(bank)) => recorded_control(params, bank)?,
+        _ => params.control,
+    };
+    let mut controller = GridController::with_table(table.clone(), control);
     let mut rng_policy = stream(seed, "grid/policy");
     let mut plant = GridPlant::new(grid, start, goal, &decoding, seed)?;
     if record_steps {

@@ -7,6 +7,7 @@ pub(crate) mod episode;
 pub(crate) mod pairs;
 pub(crate) mod params;
 pub(crate) mod plant;
+pub(crate) mod recorded;
 pub(crate) mod report;
 pub(crate) mod run;
 pub(crate) mod scenario;
@@ -27,15 +28,16 @@ pub use pairs::{
 };
 pub use params::GridTaskParams;
 pub use plant::{EpochDecoder, GridDecoding, GridEpisodeResult, GridStep, grid_episode_seed};
+pub use recorded::{RecordedBank, RecordedReport};
 pub use report::{GridEpisodeHeader, GridEpisodeRow, Table1Report};
 pub use run::{
-    GridRunReport, GridShared, HELD_OUT_PER_CLASS, PreparedGrid, eeg_decoder, pooled_accuracy,
-    prepare_decoder, prepare_grid_decoder, run_grid_scenario, run_grid_scenario_with,
-    target_online_accuracy,
+    GridRunReport, GridShared, HELD_OUT_PER_CLASS, PreparedGrid, decoder_accuracy, eeg_decoder,
+    pooled_accuracy, prepare_decoder, prepare_grid_decoder, run_grid_scenario,
+    run_grid_scenario_with, target_online_accuracy,
 };
 pub use scenario::{
-    DecoderChoice, EegMode, GridScenario, GridScenarioBuilder, MAX_ACTIONS, MAX_BANK_PER_CLASS,
-    MAX_EPISODES, MAX_INTERVAL_SECS, MAX_PAIRS, free_pairs,
+    DecoderChoice, EegMode, GridAccuracy, GridScenario, GridScenarioBuilder, MAX_ACTIONS,
+    MAX_BANK_PER_CLASS, MAX_EPISODES, MAX_INTERVAL_SECS, MAX_PAIRS, free_pairs,
 };
 pub use table1::{
     CORNER_PAIRS, FIXED_PAIRS, Table1Cell, Table1Options, accuracy_time_correlation, run_table1,

@@ -15,6 +15,7 @@ use rand_chacha::ChaCha8Rng;
 use crate::error::{Result, SimError, check_p_error};
 use crate::grid::decoder::{AssessmentDecoder, EegSource, OnlineEeg, decide, oracle_report};
 use crate::grid::params::GridTaskParams;
+use crate::grid::recorded::RecordedDraw;
 
 /// One action of an episode, as recorded.
 #[derive(Debug, Clone, PartialEq)]
@@ -360,6 +361,7 @@ pub(crate) struct ActionDecoder {
     online: Option<OnlineEeg>,
     rng_oracle: ChaCha8Rng,
     rng_bank: ChaCha8Rng,
+    recorded: RecordedDraw,
 }
 
 impl ActionDecoder {
@@ -393,6 +395,7 @@ impl ActionDecoder {
             online,
             rng_oracle: stream(seed, "grid/oracle"),
             rng_bank: stream(seed, "grid/bank/draw"),
+            recorded: RecordedDraw::new(),
         })
     }
 
@@ -448,6 +451,16 @@ impl ActionDecoder {
                 let pool = if error { e } else { c };
                 let p = pool[self.rng_bank.random_range(0..pool.len())];
                 (p, p >= 0.5, Vec::new())
+            }
+            (GridDecoding::Builtin(AssessmentDecoder::Recorded(bank)), _) => {
+                let epoch = self.recorded.draw(bank, error, &mut self.rng_bank);
+                let (p, says) = bank.decide(&epoch.features);
+                let fcz = if record_steps {
+                    epoch.fcz.clone()
+                } else {
+                    Vec::new()
+                };
+                (p, says, fcz)
             }
             (GridDecoding::Builtin(AssessmentDecoder::EegBank(bank)), _) => {
                 let pool = if error { &bank.error } else { &bank.correct };

@@ -308,6 +308,7 @@ accuracy = 0.8
         let report = GridRunReport {
             scenario,
             calibration,
+            recorded: None,
             episodes,
         };
         out.push_str(&report.to_string());

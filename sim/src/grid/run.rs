@@ -5,8 +5,9 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 use errp_bci::{
-    Accuracy, CalibrationSetup, Classifier, LdaDecoder, MeanAccuracy, SessionParts,
-    TargetingResult, TargetingStep, Valid, calibrate_session, rng::derive_seed, search_ratio,
+    Accuracy, CalibrationSetup, Classifier, LdaDecoder, MeanAccuracy, RequestedAccuracy,
+    SessionParts, TargetingResult, TargetingStep, Valid, calibrate_session, rng::derive_seed,
+    search_ratio,
 };
 use errp_robot::{Grid, GridControlParams, QTable};
 
@@ -15,6 +16,7 @@ use crate::error::{Result, SimError};
 use crate::grid::decoder::{AssessmentDecoder, EegDecoder, EegSource, EpochBankParts};
 use crate::grid::episode::run_grid_episode_with;
 use crate::grid::plant::{GridDecoding, GridEpisodeResult};
+use crate::grid::recorded::{RecordedReport, prepare_recorded};
 use crate::grid::scenario::{DecoderChoice, EegMode, GridScenario};
 use crate::key::StableKey;
 use crate::task::DecoderInfo;
@@ -24,8 +26,11 @@ use crate::task::DecoderInfo;
 pub struct GridRunReport {
     /// The scenario as run.
     pub scenario: GridScenario,
-    /// The calibration behind the EEG decoder (none for the oracle).
+    /// The calibration behind the EEG decoder (none for the oracle and a
+    /// recording).
     pub calibration: Option<CalibrationReport>,
+    /// What a person's recording gave (`[eeg] recording = ...`).
+    pub recorded: Option<RecordedReport>,
     /// One result per episode, in scenario order.
     pub episodes: Vec<GridEpisodeResult>,
 }
@@ -78,11 +83,21 @@ impl PreparedGrid {
     /// accuracy, the ratio found and the session's cross-validated rates.
     pub fn info(&self, s: &GridScenario) -> DecoderInfo {
         let calibration = self.calibration.as_ref();
-        let accuracy = calibration.map(|c| c.calibrated.accuracy);
+        let recorded = match &self.decoder {
+            AssessmentDecoder::Recorded(bank) => Some(&bank.report),
+            _ => None,
+        };
+        let accuracy = calibration
+            .map(|c| c.calibrated.accuracy)
+            .or(recorded.map(|r| r.cross_validated));
         DecoderInfo {
-            accuracy: s.accuracy.get(),
+            // A recording's decoder has the accuracy it has: its
+            // cross-validated one, which the control assumes.
+            accuracy: decoder_accuracy(s, recorded),
             kind: if calibration.is_some() {
                 "lda"
+            } else if recorded.is_some() {
+                "lda-recorded"
             } else {
                 "oracle"
             }
@@ -96,6 +111,18 @@ impl PreparedGrid {
             online_false_alarms_per_min: None,
             cached: self.cached,
         }
+    }
+}
+
+/// The accuracy the decoder of `s` is known by: the one asked for, or
+/// (its EEG a recording) the one cross-validated on the recording's
+/// calibration part, which the control assumes. Not a number for a
+/// recording's scenario without its `recorded` report.
+pub fn decoder_accuracy(s: &GridScenario, recorded: Option<&RecordedReport>) -> f64 {
+    match (s.accuracy.requested(), recorded) {
+        (Some(a), _) => a.get(),
+        (None, Some(r)) => r.cross_validated.mean(),
+        (None, None) => f64::NAN,
     }
 }
 
@@ -246,10 +273,18 @@ pub fn prepare_grid_decoder(
     cache: &dyn TargetingCache,
     mut progress: impl FnMut(&TargetingStep),
 ) -> Result<PreparedGrid> {
+    if let Some(eeg) = scenario.accuracy.recorded() {
+        let bank = prepare_recorded(scenario, eeg, &grid_setup(scenario)?)?;
+        return Ok(PreparedGrid {
+            decoder: AssessmentDecoder::Recorded(Box::new(bank)),
+            calibration: None,
+            cached: false,
+        });
+    }
     if scenario.decoder == DecoderChoice::Oracle {
         return Ok(PreparedGrid {
             decoder: AssessmentDecoder::Oracle {
-                accuracy: scenario.accuracy.get(),
+                accuracy: requested(scenario)?.get(),
             },
             calibration: None,
             cached: false,
@@ -369,9 +404,19 @@ pub fn online_accuracy_at(
 /// The accuracy the EEG decoder of `scenario` is targeted at (a scenario
 /// changed after it was checked may ask a perfect one).
 fn targeted(scenario: &GridScenario) -> Result<MeanAccuracy> {
-    scenario.accuracy.targeted().ok_or_else(|| {
+    requested(scenario)?.targeted().ok_or_else(|| {
         SimError::Scenario(format!(
             "{}: the EEG decoder cannot be perfect (user.accuracy = 1 is the oracle's)",
+            scenario.path.display()
+        ))
+    })
+}
+
+/// The accuracy `scenario` asks for (none when its EEG is a recording).
+fn requested(scenario: &GridScenario) -> Result<RequestedAccuracy> {
+    scenario.accuracy.requested().ok_or_else(|| {
+        SimError::Scenario(format!(
+            "{}: a recording's decoder has the accuracy the recording gives; none is asked for",
             scenario.path.display()
         ))
     })

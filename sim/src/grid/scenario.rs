@@ -15,6 +15,7 @@ use serde::Deserialize;
 use crate::error::Result;
 use crate::grid::decoder::PErrorChoice;
 use crate::grid::params::GridTaskParams;
+use crate::recorded::{RecordedEeg, RecordedFile};
 use crate::scenario_file::{
     Pair, checked_realism, field_error, parse_toml, robot_error, scenario_name, table_into, whole,
 };
@@ -67,11 +68,12 @@ struct ScenarioFile {
     decoder: DecoderChoice,
     #[serde(default = "default_p_error")]
     p_error: PErrorChoice,
-    #[serde(default = "default_eeg_mode")]
-    eeg: EegMode,
+    #[serde(default)]
+    eeg: Option<EegFile>,
     #[serde(default)]
     bank_per_class: Option<f64>,
-    user: UserFile,
+    #[serde(default)]
+    user: Option<UserFile>,
     #[serde(default)]
     episode: Vec<EpisodeFile>,
     #[serde(default)]
@@ -98,8 +100,40 @@ fn default_decoder() -> DecoderChoice {
 fn default_p_error() -> PErrorChoice {
     PErrorChoice::Platt
 }
-fn default_eeg_mode() -> EegMode {
-    EegMode::Stream
+
+/// A scenario's `eeg`: a mode (`eeg = "bank"`) or a recording (an `[eeg]`
+/// table with `recording = "s01.edf"`).
+#[derive(Debug)]
+enum EegFile {
+    Mode(EegMode),
+    Recorded(RecordedFile),
+}
+
+impl<'de> Deserialize<'de> for EegFile {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        struct Visitor;
+        impl<'de> serde::de::Visitor<'de> for Visitor {
+            type Value = EegFile;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str(
+                    "\"stream\", \"bank\" or a table naming a recording \
+                     ([eeg] recording = \"s01.edf\")",
+                )
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> std::result::Result<EegFile, E> {
+                EegMode::deserialize(serde::de::value::StrDeserializer::<E>::new(v))
+                    .map(EegFile::Mode)
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                map: A,
+            ) -> std::result::Result<EegFile, A::Error> {
+                RecordedFile::deserialize(serde::de::value::MapAccessDeserializer::new(map))
+                    .map(EegFile::Recorded)
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
 }
 
 /// How the EEG reaches the decoder during episodes.
@@ -123,7 +157,7 @@ impl EegMode {
     }
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct UserFile {
     #[serde(default)]
@@ -163,6 +197,35 @@ struct TimingFile {
     max_actions: Option<f64>,
 }
 
+/// Where a grid decoder's accuracy comes from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum GridAccuracy {
+    /// Asked for: the synthetic user's EEG is targeted at it (or the
+    /// oracle has it).
+    Requested(RequestedAccuracy),
+    /// Whatever a person's recording gives: the decoder is calibrated on
+    /// its first part and decodes epochs of the rest.
+    Recorded(Box<RecordedEeg>),
+}
+
+impl GridAccuracy {
+    /// The accuracy asked for, if any.
+    pub fn requested(&self) -> Option<RequestedAccuracy> {
+        match self {
+            Self::Requested(a) => Some(*a),
+            Self::Recorded(_) => None,
+        }
+    }
+
+    /// The recording, if the EEG is one.
+    pub fn recorded(&self) -> Option<&RecordedEeg> {
+        match self {
+            Self::Requested(_) => None,
+            Self::Recorded(r) => Some(r),
+        }
+    }
+}
+
 /// A validated grid scenario: loaded through [`crate::ScenarioInput`] or
 /// made in code ([`GridScenario::builder`]), checked either way; it cannot
 /// be written as a struct literal outside this crate.
@@ -185,9 +248,9 @@ pub struct GridScenario {
     pub eeg: EegMode,
     /// Epochs per class in the bank (bank mode).
     pub bank_per_class: usize,
-    /// The decoder's mean accuracy: targeted in (0.5, 1), or perfect (the
-    /// oracle only).
-    pub accuracy: RequestedAccuracy,
+    /// The decoder's mean accuracy: targeted in (0.5, 1), perfect (the
+    /// oracle only), or what a person's recording gives.
+    pub accuracy: GridAccuracy,
     /// Who the accuracy comes from ("accuracy 0.7438", "subject S2, fixed goals").
     pub user: String,
     /// (start, goal) of every episode, in order (repeats included).
@@ -221,13 +284,32 @@ impl GridScenario {
             ));
         }
 
-        let (accuracy, user) = user_accuracy(&file, path)?;
+        let (eeg, recorded) = match &file.eeg {
+            None => (EegMode::Stream, None),
+            Some(EegFile::Mode(mode)) => (*mode, None),
+            Some(EegFile::Recorded(r)) => (EegMode::Bank, Some(r.clone().check(path)?)),
+        };
+        let (accuracy, user) = match recorded {
+            Some(r) => {
+                refuse_with_recording(&file, path)?;
+                let user = format!("recording {}", r.written);
+                (GridAccuracy::Recorded(Box::new(r)), user)
+            }
+            None => {
+                let (a, user) = user_accuracy(&file, path)?;
+                (GridAccuracy::Requested(a), user)
+            }
+        };
 
         // Strategy and timing, on top of the paper's defaults.
-        // The device knows its decoder's accuracy from the calibration.
+        // The device knows its decoder's accuracy from the calibration: the
+        // one asked for, or (a recording) its cross-validated accuracy, set
+        // when the recording is read.
         // Checked here, once: the controllers take it checked.
         let control = GridControlParams {
-            assumed_accuracy: accuracy.get(),
+            assumed_accuracy: accuracy
+                .requested()
+                .map_or(file.control.assumed_accuracy, RequestedAccuracy::get),
             ..file.control
         };
         let mut params = GridTaskParams {
@@ -273,7 +355,7 @@ impl GridScenario {
             seed: file.seed,
             decoder: file.decoder,
             p_error: file.p_error,
-            eeg: file.eeg,
+            eeg,
             bank_per_class,
             accuracy,
             user,
@@ -290,7 +372,9 @@ fn user_accuracy(file: &ScenarioFile, path: &Path) -> Result<(RequestedAccuracy,
     let bad =
         |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
     // The user: an accuracy, or a subject of Table 1 with a goal set.
-    let (accuracy, user) = match (&file.user.accuracy, &file.user.subject) {
+    let empty = UserFile::default();
+    let u = file.user.as_ref().unwrap_or(&empty);
+    let (accuracy, user) = match (&u.accuracy, &u.subject) {
         (Some(_), Some(_)) => {
             return Err(bad(
                 "user",
@@ -302,7 +386,7 @@ fn user_accuracy(file: &ScenarioFile, path: &Path) -> Result<(RequestedAccuracy,
         (None, Some(name)) => {
             let s = subject(name)
                 .map_err(|e| bad("user.subject", format!("{name:?}"), &e.to_string()))?;
-            let (set, label) = match file.user.goals.unwrap_or(GoalSetFile::Fixed) {
+            let (set, label) = match u.goals.unwrap_or(GoalSetFile::Fixed) {
                 GoalSetFile::Fixed => (GoalSet::Fixed, "fixed"),
                 GoalSetFile::Free => (GoalSet::Free, "free"),
             };
@@ -322,6 +406,53 @@ fn user_accuracy(file: &ScenarioFile, path: &Path) -> Result<(RequestedAccuracy,
     let requested = checked_accuracy(accuracy, file.decoder)
         .ok_or_else(|| bad("user.accuracy", accuracy.to_string(), ACCURACY_RANGE))?;
     Ok((requested, user))
+}
+
+/// Refuses what a scenario whose EEG is a recording cannot also set: a
+/// user (the recording is the user), the oracle (it has no EEG), a bank's
+/// size (the bank is the recording's held-out epochs), a simulated user's
+/// realism.
+fn refuse_with_recording(file: &ScenarioFile, path: &Path) -> Result<()> {
+    let bad =
+        |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
+    const WHY: &str = "nothing, with a recording (eeg.recording): the decoder is calibrated on \
+                       the recording's first part and has the accuracy the recording gives; no \
+                       accuracy is targeted";
+    if let Some(u) = &file.user {
+        if let Some(a) = u.accuracy {
+            return Err(bad("user.accuracy", a.to_string(), WHY));
+        }
+        if let Some(name) = &u.subject {
+            return Err(bad("user.subject", format!("{name:?}"), WHY));
+        }
+        if let Some(g) = u.goals {
+            return Err(bad("user.goals", format!("{g:?}").to_lowercase(), WHY));
+        }
+    }
+    if file.decoder == DecoderChoice::Oracle {
+        return Err(bad(
+            "decoder",
+            "\"oracle\"".into(),
+            "\"eeg\" with a recording (eeg.recording): the oracle reads no EEG",
+        ));
+    }
+    if let Some(n) = file.bank_per_class {
+        return Err(bad(
+            "bank_per_class",
+            n.to_string(),
+            "nothing, with a recording (eeg.recording): the bank is the recording's held-out \
+             epochs",
+        ));
+    }
+    if file.realism != Realism::default() {
+        return Err(bad(
+            "realism",
+            "a [realism] table".into(),
+            "nothing, with a recording (eeg.recording): the recording is the person; \
+             [realism] describes a simulated one",
+        ));
+    }
+    Ok(())
 }
 
 /// The accuracies a grid decoder may have, in words.
@@ -371,7 +502,7 @@ impl GridScenario {
                 eeg: EegMode::Stream,
                 bank_per_class: DEFAULT_BANK_PER_CLASS,
                 // Set by `build`, once checked.
-                accuracy: RequestedAccuracy::Perfect,
+                accuracy: GridAccuracy::Requested(RequestedAccuracy::Perfect),
                 user: format!("accuracy {accuracy}"),
                 episodes: Vec::new(),
                 params: GridTaskParams::default(),
@@ -436,8 +567,10 @@ impl GridScenarioBuilder {
         let path = scenario.path.clone();
         let bad =
             |field: &str, value: String, expected: &str| field_error(&path, field, value, expected);
-        scenario.accuracy = checked_accuracy(accuracy, scenario.decoder)
-            .ok_or_else(|| bad("user.accuracy", accuracy.to_string(), ACCURACY_RANGE))?;
+        scenario.accuracy = GridAccuracy::Requested(
+            checked_accuracy(accuracy, scenario.decoder)
+                .ok_or_else(|| bad("user.accuracy", accuracy.to_string(), ACCURACY_RANGE))?,
+        );
         whole(
             &path,
             "bank_per_class",
@@ -586,10 +719,16 @@ mod tests {
     fn a_built_scenario_is_checked_as_a_file_is() {
         let built = |decoder, accuracy| GridScenario::builder("made", decoder, accuracy, 3);
         let s = built(DecoderChoice::Oracle, 1.0).build().unwrap();
-        assert_eq!(s.accuracy, RequestedAccuracy::Perfect);
+        assert_eq!(s.accuracy.requested(), Some(RequestedAccuracy::Perfect));
         assert_eq!((s.seed, s.name.as_str()), (3, "made"));
         let s = built(DecoderChoice::Eeg, 0.8).name("S1").build().unwrap();
-        assert_eq!((s.accuracy.get(), s.name.as_str()), (0.8, "S1"));
+        assert_eq!(
+            (
+                s.accuracy.requested().map(RequestedAccuracy::get),
+                s.name.as_str()
+            ),
+            (Some(0.8), "S1")
+        );
         for (b, field) in [
             (built(DecoderChoice::Eeg, 1.0), "user.accuracy"),
             (built(DecoderChoice::Oracle, 0.5), "user.accuracy"),
@@ -684,6 +823,6 @@ goal = [4, 4]
         assert_eq!(a.episodes, b.episodes);
         assert_eq!(a.episodes.len(), 5);
         assert!(a.episodes.iter().all(|(s, g)| s != g));
-        assert!((a.accuracy.get() - 0.8248).abs() < 1e-12);
+        assert!((a.accuracy.requested().unwrap().get() - 0.8248).abs() < 1e-12);
     }
 }

@@ -11,7 +11,7 @@ use crate::grid::decoder::{AssessmentDecoder, PErrorChoice};
 use crate::grid::episode::run_grid_episode;
 use crate::grid::plant::GridEpisodeResult;
 use crate::grid::run::{GridShared, prepare_grid_decoder};
-use crate::grid::scenario::{DecoderChoice, EegMode, GridScenario};
+use crate::grid::scenario::{DecoderChoice, EegMode, GridAccuracy, GridScenario};
 use crate::key::StableKey;
 
 /// About the memory of one epoch in a bank: 312 features and the FCz
@@ -114,9 +114,17 @@ impl Task for GridTask {
             PErrorChoice::Sigmoid => "sigmoid",
             PErrorChoice::Platt => "platt",
         };
-        StableKey::new("grid-decoder", 1)
-            .float("accuracy", s.accuracy.get())
-            .int("seed", s.seed)
+        let key = StableKey::new("grid-decoder", 1);
+        let key = match &s.accuracy {
+            GridAccuracy::Requested(a) => key.float("accuracy", a.get()),
+            GridAccuracy::Recorded(r) => key
+                .text("recording", &r.file.display().to_string())
+                .text("calibration", &format!("{:?}", r.part))
+                .text("error", &r.names.error)
+                .text("correct", &r.names.correct)
+                .value("draw", &r.draw),
+        };
+        key.int("seed", s.seed)
             .text("decoder", s.decoder.key())
             .text("p_error", p_error)
             .text("eeg", s.eeg.key())

@@ -128,6 +128,7 @@ fn describe(f: &mut fmt::Formatter<'_>, r: &Recording) -> fmt::Result {
             let report = GridRunReport {
                 scenario: (**scenario).clone(),
                 calibration: None,
+                recorded: None,
                 episodes: results.clone(),
             };
             write!(f, "{report}")?;

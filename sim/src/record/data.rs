@@ -50,6 +50,10 @@ pub struct Provenance {
     /// drove them. Each run's seed is in `/errp/runs`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub agent: Option<String>,
+    /// Set when the EEG was a person's recording (`[eeg] recording =
+    /// ...`): the file's name, size and SHA-256.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eeg_recording: Option<crate::recorded::FileDigest>,
 }
 
 impl Provenance {
@@ -68,6 +72,7 @@ impl Provenance {
             command: Vec::new(),
             decoder_summary: String::new(),
             agent: None,
+            eeg_recording: None,
         }
     }
 

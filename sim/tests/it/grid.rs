@@ -164,7 +164,7 @@ fn an_accuracy_override_reaches_the_info_gain_planner() {
     };
     match with(&grid, 0.9).unwrap() {
         errp_sim::AnyScenario::Grid(s) => {
-            assert_eq!(s.accuracy.get(), 0.9);
+            assert_eq!(s.accuracy.requested().map(|a| a.get()), Some(0.9));
             assert_eq!(s.params.control.assumed_accuracy, 0.9);
         }
         _ => panic!("a grid scenario"),

@@ -8,6 +8,7 @@ mod epuck;
 mod grid;
 mod hooks;
 mod realism;
+mod recorded;
 #[cfg(feature = "rerun")]
 mod recordings;
 mod scenario_fuzz;

@@ -187,7 +187,10 @@ fn within_bounds(s: &AnyScenario) {
             assert!((1..=MAX_ACTIONS as usize).contains(&p.max_actions));
             assert!(p.interval_max_secs <= MAX_INTERVAL_SECS);
             assert!(p.epoch_secs > 0.0 && p.epoch_secs <= p.interval_min_secs);
-            assert!(g.accuracy.get() > 0.5 && g.accuracy.get() <= 1.0);
+            if let Some(a) = g.accuracy.requested() {
+                assert!(a.get() > 0.5 && a.get() <= 1.0);
+                assert_eq!(p.control.assumed_accuracy, a.get());
+            }
         }
         AnyScenario::Epuck(e) => {
             assert!((1..=MAX_RUNS as usize).contains(&e.runs));

@@ -327,12 +327,43 @@ impl SweepSpec {
         Ok(CheckedSweep { spec: self, levels })
     }
 
+    /// Refuses a person's recording as the EEG (`[eeg] recording = ...`,
+    /// in the file or swept): a sweep's levels are synthetic users targeted
+    /// at its accuracies, and a recording has the accuracy it gives.
+    fn refuse_recordings(&self, table: &Table) -> Result<()> {
+        let written = table
+            .get("eeg")
+            .and_then(Value::as_table)
+            .and_then(|t| t.get("recording"))
+            .map(|r| {
+                format!(
+                    "{}: its EEG is a recording (eeg.recording = {r})",
+                    self.scenario_path.display()
+                )
+            });
+        let swept = self
+            .axes
+            .iter()
+            .find(|a| a.key.starts_with("eeg."))
+            .map(|a| format!("the swept {}", a.key));
+        match written.or(swept) {
+            Some(what) => Err(SimError::Sweep(format!(
+                "{what}: a sweep runs synthetic users targeted at its accuracies, and a \
+                 recording's decoder has the accuracy the recording gives; run a recording \
+                 with `errp run` (its [free_goals] or [[episode]] tables and `repeats` set \
+                 how many episodes)"
+            ))),
+            None => Ok(()),
+        }
+    }
+
     /// Builds and validates every level's scenario. An invalid swept value
     /// is reported with the level and the scenario's own field error.
     pub(crate) fn levels(&self, names: &InputNames) -> Result<Vec<Level>> {
         self.check(names)?;
         // The file's own errors quote its lines.
-        let _: Table = parse_toml(&self.scenario_toml, &self.scenario_path)?;
+        let table: Table = parse_toml(&self.scenario_toml, &self.scenario_path)?;
+        self.refuse_recordings(&table)?;
         (0..self.n_levels())
             .map(|index| {
                 let (accuracy, values) = self.level_values(index);

@@ -1,0 +1,309 @@
+//! A person's own recording as a scenario's EEG: the `[eeg]` table that
+//! names it, checked when the scenario loads, and the file's loading when
+//! the decoder is prepared (a regular file within [`MAX_RECORDING_BYTES`],
+//! hashed as it is read, checked as EDF or BDF and matched to the montage).
+//!
+//! Loading a scenario never opens the recording: a recording's stored
+//! scenario is read back (`errp inspect`, a sweep's finished scenario) far
+//! from the file it names.
+
+use std::io::{self, BufReader, Read};
+use std::path::{Path, PathBuf};
+
+use errp_bci::{CalibrationPart, EdfFile, EventNames, Recording};
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+
+use crate::error::{Result, SimError};
+use crate::files::open_regular;
+use crate::scenario_file::field_error;
+
+/// The largest recording file read (1 GiB).
+pub const MAX_RECORDING_BYTES: u64 = 1 << 30;
+
+/// The calibration part when a scenario sets none: the first half of the
+/// events.
+pub const DEFAULT_CALIBRATION: f64 = 0.5;
+
+/// How the closed loop draws held-out epochs of a class.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BankDraw {
+    /// Any epoch of the class, each time (the default; epochs repeat).
+    #[default]
+    WithReplacement,
+    /// Each epoch of the class once before any repeats.
+    WithoutReplacement,
+}
+
+/// The `[eeg]` table of a scenario, as written.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RecordedFile {
+    recording: String,
+    #[serde(default)]
+    calibration: Option<f64>,
+    #[serde(default)]
+    calibration_events: Option<f64>,
+    #[serde(default)]
+    error: Option<String>,
+    #[serde(default)]
+    correct: Option<String>,
+    #[serde(default)]
+    draw: BankDraw,
+}
+
+/// A scenario's recorded EEG, checked (the file itself is read when the
+/// decoder is prepared).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RecordedEeg {
+    /// The path as the scenario writes it.
+    pub written: String,
+    /// The path, relative ones resolved against the scenario's directory.
+    pub file: PathBuf,
+    /// How much of the recording calibrates the decoder.
+    pub part: CalibrationPart,
+    /// The annotations that mark each class.
+    pub names: EventNames,
+    /// How held-out epochs are drawn.
+    pub draw: BankDraw,
+}
+
+impl RecordedFile {
+    /// Checks the table of the scenario at `scenario`; errors name the
+    /// field (`eeg.calibration`).
+    pub(crate) fn check(self, scenario: &Path) -> Result<RecordedEeg> {
+        let bad = |field: &str, value: String, expected: &str| {
+            field_error(scenario, &format!("eeg.{field}"), value, expected)
+        };
+        if self.recording.trim().is_empty() {
+            return Err(bad(
+                "recording",
+                format!("{:?}", self.recording),
+                "the path of an EDF or BDF file, relative to the scenario's directory",
+            ));
+        }
+        let part = match (self.calibration, self.calibration_events) {
+            (Some(_), Some(_)) => {
+                return Err(bad(
+                    "calibration_events",
+                    "set with eeg.calibration".into(),
+                    "one of eeg.calibration (a fraction of the events) and \
+                     eeg.calibration_events (a count)",
+                ));
+            }
+            (Some(f), None) if f > 0.0 && f < 1.0 => CalibrationPart::Fraction(f),
+            (Some(f), None) => {
+                return Err(bad(
+                    "calibration",
+                    f.to_string(),
+                    "a fraction of the events strictly between 0 and 1, e.g. 0.5",
+                ));
+            }
+            (None, Some(n)) if n.fract() == 0.0 && (1.0..=1e6).contains(&n) => {
+                CalibrationPart::Events(n as usize)
+            }
+            (None, Some(n)) => {
+                return Err(bad(
+                    "calibration_events",
+                    n.to_string(),
+                    "a whole number of events from 1 to 1000000",
+                ));
+            }
+            (None, None) => CalibrationPart::Fraction(DEFAULT_CALIBRATION),
+        };
+        let defaults = EventNames::default();
+        let names = EventNames {
+            error: self.error.unwrap_or(defaults.error),
+            correct: self.correct.unwrap_or(defaults.correct),
+        };
+        for (field, name) in [("error", &names.error), ("correct", &names.correct)] {
+            if name.trim().is_empty() || name.len() > 256 {
+                return Err(bad(
+                    field,
+                    format!("{name:?}"),
+                    "the annotation text of the class, 1 to 256 bytes",
+                ));
+            }
+        }
+        if names
+            .error
+            .trim()
+            .eq_ignore_ascii_case(names.correct.trim())
+        {
+            return Err(bad(
+                "correct",
+                format!("{:?}", names.correct),
+                "an annotation text other than eeg.error's",
+            ));
+        }
+        let written = self.recording;
+        let file = match scenario.parent() {
+            Some(dir) if Path::new(&written).is_relative() => dir.join(&written),
+            _ => PathBuf::from(&written),
+        };
+        Ok(RecordedEeg {
+            written,
+            file,
+            part,
+            names,
+            draw: self.draw,
+        })
+    }
+}
+
+/// What identifies a file's content: its name as given, its size and its
+/// SHA-256.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FileDigest {
+    /// The file's name, as the scenario writes it.
+    pub name: String,
+    /// Its size in bytes.
+    pub bytes: u64,
+    /// Its SHA-256, in lower-case hex.
+    pub sha256: String,
+}
+
+/// A reader that hashes and counts what it reads.
+struct Hashing<R> {
+    inner: R,
+    hash: Sha256,
+    bytes: u64,
+}
+
+impl<R: Read> Read for Hashing<R> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.hash.update(&buf[..n]);
+        self.bytes += n as u64;
+        Ok(n)
+    }
+}
+
+/// Reads the recording `eeg` names, at the decoder's `sfreq_hz`: opened as
+/// a regular file (never waiting on a FIFO or a device), at most
+/// [`MAX_RECORDING_BYTES`], read as EDF or BDF, every byte hashed, and
+/// matched to the montage. Errors name the file.
+pub fn load_recording(eeg: &RecordedEeg, sfreq_hz: f64) -> Result<(Recording, FileDigest)> {
+    let path = &eeg.file;
+    let input = |source| SimError::Input {
+        path: path.clone(),
+        source,
+    };
+    let file = open_regular(path).map_err(input)?;
+    let len = file.metadata().map_err(input)?.len();
+    if len > MAX_RECORDING_BYTES {
+        return Err(SimError::Scenario(format!(
+            "{}: {len} bytes; a recording may have at most {MAX_RECORDING_BYTES} bytes (1 GiB)",
+            path.display()
+        )));
+    }
+    let named = |e: errp_bci::BciError| SimError::Scenario(format!("{}: {e}", path.display()));
+    let mut reader = Hashing {
+        inner: BufReader::new(file.take(MAX_RECORDING_BYTES)),
+        hash: Sha256::new(),
+        bytes: 0,
+    };
+    let edf = EdfFile::read(&mut reader, Some(len)).map_err(named)?;
+    // What the records did not cover (nothing, in a well-formed file) is
+    // part of the file all the same.
+    io::copy(&mut reader, &mut io::sink()).map_err(input)?;
+    let recording = Recording::from_edf(&edf, &eeg.names, sfreq_hz).map_err(named)?;
+    let digest = FileDigest {
+        name: eeg.written.clone(),
+        bytes: reader.bytes,
+        sha256: format!("{:x}", reader.hash.finalize()),
+    };
+    Ok((recording, digest))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn checked(text: &str) -> Result<RecordedEeg> {
+        let f: RecordedFile = toml::from_str(text).expect("a table");
+        f.check(Path::new("scenarios/s.toml"))
+    }
+
+    #[test]
+    fn the_table_is_checked_naming_its_fields() {
+        let r = checked("recording = \"s01.edf\"").unwrap();
+        assert_eq!(r.file, Path::new("scenarios/s01.edf"));
+        assert_eq!(r.part, CalibrationPart::Fraction(0.5));
+        assert_eq!(
+            (r.names, r.draw),
+            (EventNames::default(), BankDraw::WithReplacement)
+        );
+        let r = checked("recording = \"/data/s01.bdf\"\ncalibration_events = 120\ndraw = \"without_replacement\"\nerror = \"S 96\"").unwrap();
+        assert_eq!(r.file, Path::new("/data/s01.bdf"));
+        assert_eq!(r.part, CalibrationPart::Events(120));
+        assert_eq!(
+            (r.names.error.as_str(), r.draw),
+            ("S 96", BankDraw::WithoutReplacement)
+        );
+        for (text, field) in [
+            ("recording = \"\"", "eeg.recording"),
+            ("recording = \"a\"\ncalibration = 1.0", "eeg.calibration"),
+            (
+                "recording = \"a\"\ncalibration_events = 2.5",
+                "eeg.calibration_events",
+            ),
+            (
+                "recording = \"a\"\ncalibration = 0.5\ncalibration_events = 9",
+                "eeg.calibration_events",
+            ),
+            ("recording = \"a\"\ncorrect = \"ERROR\"", "eeg.correct"),
+        ] {
+            let e = checked(text).unwrap_err().to_string();
+            assert!(
+                e.starts_with("scenarios/s.toml: field `") && e.contains(field),
+                "{e}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_digest_is_sha_256() {
+        let mut r = Hashing {
+            inner: &b"abc"[..],
+            hash: Sha256::new(),
+            bytes: 0,
+        };
+        io::copy(&mut r, &mut io::sink()).unwrap();
+        assert_eq!(r.bytes, 3);
+        assert_eq!(
+            format!("{:x}", r.hash.finalize()),
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
+        );
+    }
+
+    #[test]
+    fn a_file_is_hashed_whole_and_refused_naming_it() {
+        let dir = std::env::temp_dir().join(format!("errp-recorded-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let eeg = |name: &str| RecordedEeg {
+            written: name.into(),
+            file: dir.join(name),
+            part: CalibrationPart::Fraction(0.5),
+            names: EventNames::default(),
+            draw: BankDraw::WithReplacement,
+        };
+        std::fs::write(dir.join("text.edf"), "not EEG at all").unwrap();
+        let e = load_recording(&eeg("text.edf"), 256.0)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("text.edf") && e.contains("not an EDF or BDF file"),
+            "{e}"
+        );
+        let e = load_recording(&eeg("missing.edf"), 256.0)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("cannot read") && e.contains("missing.edf"),
+            "{e}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
