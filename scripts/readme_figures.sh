@@ -45,6 +45,7 @@ FIGURES=(
   "fit_grid_trial_latency|slow|fit grid --trial-latency-sd 16.7,19,21.3,25 --out OUT_DIR --quiet"
   "table1_seeds|slow|sh: python3 scripts/table1_seeds.py --seeds 10"
   "realism|cheap|realism --quiet"
+  "grid_own_eeg|cheap|sh: d=\$(mktemp -d) && cp scenarios/recorded/own_eeg.toml \$d/ && \$ERRP calibrate --accuracy 0.78 --seed 1 --quiet --export \$d/s01.edf >/dev/null && \$ERRP run \$d/own_eeg.toml --quiet; s=\$?; rm -rf \$d; exit \$s"
   "sweep_realism|cheap|sweep --task grid --accuracy 0.75 --param realism.lapse_rate=0,0.1,0.2 --param realism.background_drift=0,0.3 --param strategy=greedy,thompson --episodes 200 --seed 1 --out OUT_DIR --quiet"
   "python_decoders|slow|sh: \${PYTHON:-target/ci-venv/bin/python} python/examples/decoders_in_the_loop.py 2>/dev/null | sed -E 's/ +\\([0-9.]+ s\\)\$//'"
   "python_cross_validation|slow|sh: \${PYTHON:-target/ci-venv/bin/python} python/examples/cross_validate_decoders.py 2>/dev/null"

@@ -99,7 +99,9 @@ pub struct Preprocessor {
 impl Preprocessor {
     /// Fits the EOG regression on `eog_session` (raw samples of every
     /// channel, ideally a recording with deliberate blinks and saccades) and
-    /// returns a preprocessor producing the EEG channels `outputs`.
+    /// returns a preprocessor producing the EEG channels `outputs`. A
+    /// montage without EOG channels (a recording that has none) gets no
+    /// EOG regression: CAR and the filters only.
     pub fn fit(
         montage: &Montage,
         preprocessing: &Valid<Preprocessing>,
@@ -125,7 +127,13 @@ impl Preprocessor {
                 FIT_SKIP_SECS + 10.0
             )));
         }
-        let derivation = eog_derivation(montage)?;
+        // A recording without EOG channels gets no EOG regression.
+        let n_eog = montage.n_eog();
+        let derivation = if n_eog == 0 {
+            DMatrix::zeros(3, 0)
+        } else {
+            eog_derivation(montage)?
+        };
 
         // Filter every channel, drop the start-up, then CAR and derive the EOG.
         let n = eog_session.n_samples - skip;
@@ -140,13 +148,17 @@ impl Preprocessor {
         }
         let car = car_matrix(n_eeg);
         let eeg = &car * filtered.rows(0, n_eeg);
-        let eog = &derivation * filtered.rows(n_eeg, n_ch - n_eeg);
-        // Least squares: eeg ~ B eog, B = eeg eog' (eog eog')^-1.
-        let gram = &eog * eog.transpose();
-        let gram_inv = gram
-            .try_inverse()
-            .ok_or_else(|| BciError::Training("the EOG derivations are collinear".into()))?;
-        let eog_weights = &eeg * eog.transpose() * gram_inv;
+        let eog_weights = if n_eog == 0 {
+            DMatrix::zeros(n_eeg, 3)
+        } else {
+            let eog = &derivation * filtered.rows(n_eeg, n_eog);
+            // Least squares: eeg ~ B eog, B = eeg eog' (eog eog')^-1.
+            let gram = &eog * eog.transpose();
+            let gram_inv = gram
+                .try_inverse()
+                .ok_or_else(|| BciError::Training("the EOG derivations are collinear".into()))?;
+            &eeg * eog.transpose() * gram_inv
+        };
 
         // Spatial matrix on raw channels: [CAR | -B D].
         let mut full = DMatrix::zeros(n_eeg, n_ch);

@@ -93,6 +93,8 @@ impl Recording {
             )));
         }
         let standard = Montage::standard();
+        // The EOG regression's six channels, all of them or none.
+        let has_eog = EOG_CHANNELS.iter().any(|n| find(labels, n).is_some());
         let mut keep = Vec::new();
         let mut rows = Vec::new();
         for (i, c) in standard.channels().iter().enumerate() {
@@ -102,11 +104,11 @@ impl Recording {
                     rows.push(row);
                 }
                 None if DECODING_CHANNELS.contains(&c.name.as_str())
-                    || c.kind == ChannelKind::Eog =>
+                    || (has_eog && c.kind == ChannelKind::Eog) =>
                 {
                     return Err(BciError::Format(format!(
-                        "no channel {:?}: the decoder needs {} and the EOG regression {}; the \
-                         recording has {}",
+                        "no channel {:?}: the decoder needs {} and the EOG regression all of {} \
+                         (or none: no regression); the recording has {}",
                         c.name,
                         DECODING_CHANNELS.join(" "),
                         EOG_CHANNELS.join(", "),

@@ -18,6 +18,7 @@ mod env;
 #[cfg(feature = "rerun")]
 mod inspect;
 mod interrupt;
+mod recorded;
 mod run;
 mod session;
 mod tasks;

@@ -72,7 +72,7 @@ impl GridTask {
     /// action's epoch) or `batch_decoder` (called once with a bank of
     /// epochs), a decoder of the caller's own replaces it in the loop.
     #[new]
-    #[pyo3(signature = (scenario=None, *, decoder=None, batch_decoder=None, seed=None, accuracy=None, overrides=None, progress=None))]
+    #[pyo3(signature = (scenario=None, *, decoder=None, batch_decoder=None, seed=None, accuracy=None, overrides=None, progress=None, eeg=None))]
     #[allow(clippy::too_many_arguments)] // Python's keywords, one each
     fn new(
         py: Python<'_>,
@@ -83,13 +83,29 @@ impl GridTask {
         accuracy: Option<f64>,
         overrides: Option<&Bound<'_, PyDict>>,
         progress: Option<&Bound<'_, PyAny>>,
+        eeg: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
+        if eeg.is_some() && accuracy.is_some() {
+            return Err(PyValueError::new_err(
+                "accuracy: with eeg=..., the decoder is calibrated on the recording's first part \
+                 and has the accuracy the recording gives (GridTask.calibration); no accuracy is \
+                 targeted: leave out accuracy",
+            ));
+        }
         let keys = Keys {
             accuracy,
             seed,
             runs: None,
         };
         let (s, text) = load_grid(scenario, keys, overrides, "errp.GridTask")?;
+        let s = match eeg {
+            Some(eeg) => {
+                let recorded =
+                    crate::recorded::supplied_recording(eeg, std::path::Path::new("eeg_options"))?;
+                s.on_recording(recorded).map_err(py_err)?
+            }
+            None => s,
+        };
         check_callable(py, "decoder", decoder.as_ref())?;
         check_callable(py, "batch_decoder", batch_decoder.as_ref())?;
         if decoder.is_some() && batch_decoder.is_some() {

@@ -8,7 +8,10 @@
 //! regular file, with an error naming what it is.
 
 use std::fs::{File, OpenOptions};
-use std::io;
+use std::io::{self, Read};
+
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
 use std::path::Path;
 
 /// Opens `path` for reading; a FIFO, socket or device is refused (an
@@ -102,6 +105,54 @@ fn not_regular(what: &str) -> io::Error {
     )
 }
 
+/// What identifies a file's content: its name as given, its size and its
+/// SHA-256.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FileDigest {
+    /// The file's name, as the scenario writes it.
+    pub name: String,
+    /// Its size in bytes.
+    pub bytes: u64,
+    /// Its SHA-256, in lower-case hex.
+    pub sha256: String,
+}
+
+/// A reader that hashes and counts what it reads.
+pub(crate) struct Hashing<R> {
+    inner: R,
+    hash: Sha256,
+    bytes: u64,
+}
+
+impl<R> Hashing<R> {
+    /// Hashes what is read from `inner`.
+    pub(crate) fn new(inner: R) -> Self {
+        Self {
+            inner,
+            hash: Sha256::new(),
+            bytes: 0,
+        }
+    }
+
+    /// What was read, as the digest of the file called `name`.
+    pub(crate) fn digest(self, name: &str) -> FileDigest {
+        FileDigest {
+            name: name.to_string(),
+            bytes: self.bytes,
+            sha256: format!("{:x}", self.hash.finalize()),
+        }
+    }
+}
+
+impl<R: Read> Read for Hashing<R> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.hash.update(&buf[..n]);
+        self.bytes += n as u64;
+        Ok(n)
+    }
+}
+
 #[cfg(all(test, unix))]
 mod tests {
     use super::*;
@@ -150,5 +201,17 @@ mod tests {
             .unwrap();
         assert_eq!(text, "text");
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn the_digest_is_sha_256() {
+        let mut r = Hashing::new(&b"abc"[..]);
+        io::copy(&mut r, &mut io::sink()).unwrap();
+        let d = r.digest("abc.edf");
+        assert_eq!((d.name.as_str(), d.bytes), ("abc.edf", 3));
+        assert_eq!(
+            d.sha256,
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
+        );
     }
 }

@@ -9,13 +9,14 @@
 
 use std::io::{self, BufReader, Read};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use errp_bci::{CalibrationPart, EdfFile, EventNames, Recording};
 use serde::{Deserialize, Serialize};
-use sha2::{Digest, Sha256};
 
 use crate::error::{Result, SimError};
-use crate::files::open_regular;
+pub use crate::files::FileDigest;
+use crate::files::{Hashing, open_regular};
 use crate::scenario_file::field_error;
 
 /// The largest recording file read (1 GiB).
@@ -67,6 +68,58 @@ pub struct RecordedEeg {
     pub names: EventNames,
     /// How held-out epochs are drawn.
     pub draw: BankDraw,
+    /// The recording itself, when it was given in memory (Python's MNE
+    /// objects) rather than as a file: used in place of reading `file`.
+    pub supplied: Option<Arc<SuppliedRecording>>,
+}
+
+/// A recording given in memory, with what identifies it.
+#[derive(Debug)]
+pub struct SuppliedRecording {
+    /// The recording, matched to the montage.
+    pub recording: Recording,
+    /// Its name, size and SHA-256 (of the file it was read from, or of the
+    /// data as given).
+    pub digest: FileDigest,
+}
+
+/// Two recordings are the same if their digests are.
+impl PartialEq for SuppliedRecording {
+    fn eq(&self, other: &Self) -> bool {
+        self.digest == other.digest
+    }
+}
+
+impl RecordedEeg {
+    /// The recording `supplied` in memory, split and drawn as `options` (an
+    /// `[eeg]` table's keys but `recording`) say; errors name the field
+    /// (`eeg.calibration`) of `who`.
+    pub fn supplied(
+        options: &toml::Table,
+        supplied: SuppliedRecording,
+        who: &Path,
+    ) -> Result<Self> {
+        if options.contains_key("recording") {
+            return Err(field_error(
+                who,
+                "eeg.recording",
+                "set".into(),
+                "nothing: the recording is the one given",
+            ));
+        }
+        let mut table = options.clone();
+        table.insert(
+            "recording".into(),
+            toml::Value::String(supplied.digest.name.clone()),
+        );
+        let file: RecordedFile = table
+            .try_into()
+            .map_err(|e| SimError::Scenario(format!("{}: eeg: {e}", who.display())))?;
+        let mut eeg = file.check(who)?;
+        eeg.file = PathBuf::from(&supplied.digest.name);
+        eeg.supplied = Some(Arc::new(supplied));
+        Ok(eeg)
+    }
 }
 
 impl RecordedFile {
@@ -148,35 +201,8 @@ impl RecordedFile {
             part,
             names,
             draw: self.draw,
+            supplied: None,
         })
-    }
-}
-
-/// What identifies a file's content: its name as given, its size and its
-/// SHA-256.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
-pub struct FileDigest {
-    /// The file's name, as the scenario writes it.
-    pub name: String,
-    /// Its size in bytes.
-    pub bytes: u64,
-    /// Its SHA-256, in lower-case hex.
-    pub sha256: String,
-}
-
-/// A reader that hashes and counts what it reads.
-struct Hashing<R> {
-    inner: R,
-    hash: Sha256,
-    bytes: u64,
-}
-
-impl<R: Read> Read for Hashing<R> {
-    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
-        let n = self.inner.read(buf)?;
-        self.hash.update(&buf[..n]);
-        self.bytes += n as u64;
-        Ok(n)
     }
 }
 
@@ -185,6 +211,15 @@ impl<R: Read> Read for Hashing<R> {
 /// [`MAX_RECORDING_BYTES`], read as EDF or BDF, every byte hashed, and
 /// matched to the montage. Errors name the file.
 pub fn load_recording(eeg: &RecordedEeg, sfreq_hz: f64) -> Result<(Recording, FileDigest)> {
+    if let Some(s) = &eeg.supplied {
+        if s.recording.sfreq_hz != sfreq_hz {
+            return Err(SimError::Scenario(format!(
+                "{}: sampled at {} Hz; the decoder reads {sfreq_hz} Hz (resample it first)",
+                s.digest.name, s.recording.sfreq_hz
+            )));
+        }
+        return Ok((s.recording.clone(), s.digest.clone()));
+    }
     let path = &eeg.file;
     let input = |source| SimError::Input {
         path: path.clone(),
@@ -199,21 +234,13 @@ pub fn load_recording(eeg: &RecordedEeg, sfreq_hz: f64) -> Result<(Recording, Fi
         )));
     }
     let named = |e: errp_bci::BciError| SimError::Scenario(format!("{}: {e}", path.display()));
-    let mut reader = Hashing {
-        inner: BufReader::new(file.take(MAX_RECORDING_BYTES)),
-        hash: Sha256::new(),
-        bytes: 0,
-    };
+    let mut reader = Hashing::new(BufReader::new(file.take(MAX_RECORDING_BYTES)));
     let edf = EdfFile::read(&mut reader, Some(len)).map_err(named)?;
     // What the records did not cover (nothing, in a well-formed file) is
     // part of the file all the same.
     io::copy(&mut reader, &mut io::sink()).map_err(input)?;
     let recording = Recording::from_edf(&edf, &eeg.names, sfreq_hz).map_err(named)?;
-    let digest = FileDigest {
-        name: eeg.written.clone(),
-        bytes: reader.bytes,
-        sha256: format!("{:x}", reader.hash.finalize()),
-    };
+    let digest = reader.digest(&eeg.written);
     Ok((recording, digest))
 }
 
@@ -264,21 +291,6 @@ mod tests {
     }
 
     #[test]
-    fn the_digest_is_sha_256() {
-        let mut r = Hashing {
-            inner: &b"abc"[..],
-            hash: Sha256::new(),
-            bytes: 0,
-        };
-        io::copy(&mut r, &mut io::sink()).unwrap();
-        assert_eq!(r.bytes, 3);
-        assert_eq!(
-            format!("{:x}", r.hash.finalize()),
-            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
-        );
-    }
-
-    #[test]
     fn a_file_is_hashed_whole_and_refused_naming_it() {
         let dir = std::env::temp_dir().join(format!("errp-recorded-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
@@ -288,6 +300,7 @@ mod tests {
             part: CalibrationPart::Fraction(0.5),
             names: EventNames::default(),
             draw: BankDraw::WithReplacement,
+            supplied: None,
         };
         std::fs::write(dir.join("text.edf"), "not EEG at all").unwrap();
         let e = load_recording(&eeg("text.edf"), 256.0)

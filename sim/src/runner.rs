@@ -173,29 +173,25 @@ pub struct RunHeadline<'a>(pub &'a AnyScenario);
 impl std::fmt::Display for RunHeadline<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self.0 {
-            AnyScenario::Grid(s) => match s.accuracy.requested() {
-                Some(a) => write!(
+            AnyScenario::Grid(s) => {
+                let decoder = match (s.accuracy.requested(), s.decoder) {
+                    (Some(a), crate::grid::DecoderChoice::Eeg) => {
+                        format!("EEG decoder at {:.2} % (", 100.0 * a.get())
+                    }
+                    (Some(a), _) => format!("oracle decoder at {:.2} % (", 100.0 * a.get()),
+                    (None, _) => "EEG decoder on the ".into(),
+                };
+                let close = if s.accuracy.requested().is_some() {
+                    ")"
+                } else {
+                    ""
+                };
+                let (name, n, user, seed) = (&s.name, s.episodes.len(), &s.user, s.seed);
+                write!(
                     f,
-                    "{}: {} episodes, {} decoder at {:.2} % ({}), seed {}",
-                    s.name,
-                    s.episodes.len(),
-                    match s.decoder {
-                        crate::grid::DecoderChoice::Eeg => "EEG",
-                        crate::grid::DecoderChoice::Oracle => "oracle",
-                    },
-                    100.0 * a.get(),
-                    s.user,
-                    s.seed
-                ),
-                None => write!(
-                    f,
-                    "{}: {} episodes, EEG decoder on the {}, seed {}",
-                    s.name,
-                    s.episodes.len(),
-                    s.user,
-                    s.seed
-                ),
-            },
+                    "{name}: {n} episodes, {decoder}{user}{close}, seed {seed}"
+                )
+            }
             AnyScenario::Epuck(s) => {
                 let start = &s.episode.start;
                 write!(

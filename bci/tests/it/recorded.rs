@@ -101,6 +101,14 @@ fn what_a_recording_lacks_is_named() {
     let mut f = file.clone();
     f.signals.retain(|s| s.label != "EOG LA");
     assert!(err(&f, &names).contains("no channel \"EOG LA\""));
+    // No EOG channel at all: no regression, CAR and the filters only.
+    let mut f = file.clone();
+    f.signals.retain(|s| !s.label.starts_with("EOG"));
+    let rec = errp_bci::Recording::from_edf(&f, &names, 256.0).unwrap();
+    assert_eq!((rec.montage.n_eog(), rec.montage.n_eeg()), (0, 34));
+    let split = split_recording(&rec, CalibrationPart::Fraction(0.5), &preprocessing()).unwrap();
+    let w = split.calibration.preprocessor.eog_weights();
+    assert!(w.iter().all(|&x| x == 0.0));
     let mut f = file.clone();
     for s in &mut f.signals {
         s.label = s.label.trim_start_matches("EOG ").to_string();

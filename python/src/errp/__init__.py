@@ -42,7 +42,7 @@ import numpy as np
 if TYPE_CHECKING:  # pragma: no cover - for the annotations only
     import pandas
 
-from . import _args, _core, _gym_plugin, _progress
+from . import _args, _core, _gym_plugin, _progress, _recording
 from ._core import HAS_RERUN, __version__
 
 __all__ = [
@@ -731,6 +731,16 @@ class GridTask(_Task):
     same user at the same seed is behind all three, so their results
     compare at the same accuracy.
 
+    With ``eeg``, a person's own recording replaces the synthetic user's
+    EEG: the testbed's decoder is calibrated on the recording's first part
+    (the same preprocessing, features, LDA, cross-validation and Platt
+    scaling as on a synthetic session) and each action decodes an epoch of
+    its class drawn from the part after it, never from the part it was
+    trained on. No accuracy is targeted: :attr:`calibration` reports the
+    one the recording gives (``cv_mean`` cross-validated on the
+    calibration part, which the shared control assumes, and
+    ``held_out_mean``). See the guide's chapter "Your own EEG in the loop".
+
     Parameters
     ----------
     scenario : path, optional
@@ -739,6 +749,23 @@ class GridTask(_Task):
     decoder, batch_decoder : callable, optional
     seed, accuracy, overrides, progress :
         As for :func:`run` (``progress`` shows the calibration's search).
+    eeg : mne.io.Raw, mne.Epochs or path, optional
+        A recording with annotations (or epochs with events) naming each
+        action "error" or "correct", or a file MNE reads (EDF, BDF, FIF,
+        BrainVision, EEGLAB, GDF, ...). Its channels are matched by name to
+        the decoder's eight (Fz FC1 FCz FC2 C1 Cz C2 CPz) and the EOG
+        regression's six (EOG LA, EOG LB, EOG RA, EOG RB, EOG LO, EOG RO);
+        another sampling rate than 256 Hz is resampled with MNE. Epochs are
+        laid end to end into one recording (the filters then see a jump at
+        each boundary). Not with ``accuracy``, ``decoder`` or
+        ``batch_decoder``.
+    eeg_options : dict, optional
+        The keys of a scenario's ``[eeg]`` table: ``calibration`` (the
+        fraction of the events that calibrates, default 0.5) or
+        ``calibration_events`` (a count), ``error`` and ``correct`` (the
+        annotations, default "error" and "correct"), ``draw``
+        ("with_replacement", the default, or "without_replacement": each
+        epoch of a class once in an episode before any repeats).
     """
 
     def __init__(
@@ -751,7 +778,17 @@ class GridTask(_Task):
         accuracy: Optional[float] = None,
         overrides: Optional[Mapping[str, Any]] = None,
         progress: Optional[bool] = None,
+        eeg: Any = None,
+        eeg_options: Optional[Mapping[str, Any]] = None,
     ) -> None:
+        if eeg is None and eeg_options is not None:
+            raise ValueError("eeg_options: set with eeg=..., a recording to split and draw from")
+        if eeg is not None and accuracy is not None:
+            raise ValueError(
+                "accuracy: with eeg=..., the decoder is calibrated on the recording's first "
+                "part and has the accuracy the recording gives (GridTask.calibration); no "
+                "accuracy is targeted: leave out accuracy"
+            )
         keywords = dict(
             decoder=decoder,
             batch_decoder=batch_decoder,
@@ -759,6 +796,8 @@ class GridTask(_Task):
             accuracy=_args.accuracy("accuracy", accuracy, optional=True),
             overrides=None if overrides is None else dict(overrides),
         )
+        if eeg is not None:
+            keywords["eeg"] = _recording.recorded(eeg, eeg_options)
         with _progress.shown(progress, "errp.GridTask") as report:
             self._core = _core.GridTask(_path(scenario, "scenario"), progress=report, **keywords)
 

@@ -131,6 +131,7 @@ class GridTask:
         accuracy: Optional[float] = None,
         overrides: Optional[Dict[str, Any]] = None,
         progress: Optional[Progress] = None,
+        eeg: Optional[Dict[str, Any]] = None,
     ) -> None: ...
     def run(self, save: Optional[str] = None, progress: Optional[Progress] = None) -> str: ...
     @property

@@ -4,14 +4,14 @@
 
 use errp_bci::{
     Accuracy, ActionInformation, Assessment, AssessmentKind, Components, EegBlock, EegGenerator,
-    EpochWindow, ErrorModel, GeneratorParams, LdaModel, Montage, PlattScaling, Preprocessor, Valid,
+    EpochWindow, ErrorModel, GeneratorParams, LdaModel, Montage, Preprocessor, Valid,
     rng::derive_seed, rng::stream,
 };
 use rand::Rng;
-use serde::{Deserialize, Serialize};
 
 use crate::calibration::CalibrationReport;
 use crate::error::{Result, SimError};
+use crate::grid::p_error::{PErrorChoice, PErrorMapping};
 use crate::grid::params::GridTaskParams;
 use crate::grid::recorded::RecordedBank;
 
@@ -340,26 +340,6 @@ impl EegDecoder {
             },
         }
     }
-}
-
-/// How the EEG decoder's decision value becomes p(error).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum PErrorChoice {
-    /// The paper's 1 / (1 + e^-y).
-    Sigmoid,
-    /// Platt scaling fitted on the calibration session (the default).
-    Platt,
-}
-
-/// How the decoder's decision value y becomes p(error).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub enum PErrorMapping {
-    /// The paper's p = 1 / (1 + e^-y) (sec. 2.2.1).
-    Sigmoid,
-    /// Platt scaling fitted on the calibration session's out-of-fold
-    /// decisions: p = 1 / (1 + e^-(a y + b)).
-    Platt(PlattScaling),
 }
 
 /// The decoder's p(error) and class for one epoch's features.

@@ -1,9 +1,11 @@
 //! The discrete grid task (sec. 3-4 of the paper): scenario files, one
 //! episode, a scenario's runs, Table 1 and the recording.
 
+pub(crate) mod builder;
 pub(crate) mod decoder;
 pub(crate) mod environment;
 pub(crate) mod episode;
+pub(crate) mod p_error;
 pub(crate) mod pairs;
 pub(crate) mod params;
 pub(crate) mod plant;
@@ -16,19 +18,21 @@ pub(crate) mod task;
 #[cfg(feature = "rerun")]
 pub(crate) mod view;
 
+pub use builder::GridScenarioBuilder;
 pub use decoder::{
     AssessmentDecoder, EegDecoder, EegSource, EpochBank, EpochBankParts, EpochBlocks,
-    INFORMATION_PER_CLASS, PErrorChoice, PErrorMapping,
+    INFORMATION_PER_CLASS,
 };
 pub use environment::{GridEnvironment, GridFeedback};
 pub use episode::{run_grid_episode, run_grid_episode_with};
+pub use p_error::{PErrorChoice, PErrorMapping};
 pub use pairs::{
     CENTRAL_RUN, PAIRS_PER_SET, PairFamily, keeps_to_the_centre, manhattan, pairs_text,
     total_length,
 };
 pub use params::GridTaskParams;
 pub use plant::{EpochDecoder, GridDecoding, GridEpisodeResult, GridStep, grid_episode_seed};
-pub use recorded::{RecordedBank, RecordedReport};
+pub use recorded::{CV_REPEATS, RecordedBank, RecordedReport};
 pub use report::{GridEpisodeHeader, GridEpisodeRow, Table1Report};
 pub use run::{
     GridRunReport, GridShared, HELD_OUT_PER_CLASS, PreparedGrid, decoder_accuracy, eeg_decoder,
@@ -36,8 +40,8 @@ pub use run::{
     run_grid_scenario_with, target_online_accuracy,
 };
 pub use scenario::{
-    DecoderChoice, EegMode, GridAccuracy, GridScenario, GridScenarioBuilder, MAX_ACTIONS,
-    MAX_BANK_PER_CLASS, MAX_EPISODES, MAX_INTERVAL_SECS, MAX_PAIRS, free_pairs,
+    DecoderChoice, EegMode, GridAccuracy, GridScenario, MAX_ACTIONS, MAX_BANK_PER_CLASS,
+    MAX_EPISODES, MAX_INTERVAL_SECS, MAX_PAIRS, free_pairs,
 };
 pub use table1::{
     CORNER_PAIRS, FIXED_PAIRS, Table1Cell, Table1Options, accuracy_time_correlation, run_table1,

@@ -13,8 +13,9 @@ use rand::Rng;
 use serde::Deserialize;
 
 use crate::error::Result;
-use crate::grid::decoder::PErrorChoice;
-use crate::grid::params::GridTaskParams;
+use crate::grid::p_error::PErrorChoice;
+use crate::grid::params::{GridTaskParams, TimingFile, set_timing};
+pub use crate::grid::params::{MAX_ACTIONS, MAX_INTERVAL_SECS};
 use crate::recorded::{RecordedEeg, RecordedFile};
 use crate::scenario_file::{
     Pair, checked_realism, field_error, parse_toml, robot_error, scenario_name, table_into, whole,
@@ -29,10 +30,6 @@ pub(crate) const DEFAULT_BANK_PER_CLASS: usize = 1000;
 pub const MAX_PAIRS: u64 = 10_000;
 /// Most episodes a scenario runs (pairs times repeats).
 pub const MAX_EPISODES: usize = 100_000;
-/// Most actions an episode may take before it gives up.
-pub const MAX_ACTIONS: u64 = 10_000;
-/// The longest inter-action interval, s.
-pub const MAX_INTERVAL_SECS: f64 = 60.0;
 
 /// Which decoder turns the user's assessments into p(error).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -188,15 +185,6 @@ struct FreeGoalsFile {
     count: f64,
 }
 
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct TimingFile {
-    interval_min_secs: Option<f64>,
-    interval_max_secs: Option<f64>,
-    epoch_secs: Option<f64>,
-    max_actions: Option<f64>,
-}
-
 /// Where a grid decoder's accuracy comes from.
 #[derive(Debug, Clone, PartialEq)]
 pub enum GridAccuracy {
@@ -348,7 +336,7 @@ impl GridScenario {
         }
         let episodes = (0..repeats).flat_map(|_| pairs.iter().copied()).collect();
         let realism = checked_realism(file.realism, path)?;
-        Ok(Self {
+        let scenario = Self {
             path: path.to_path_buf(),
             name: scenario_name(file.name, path),
             description: file.description.unwrap_or_default(),
@@ -362,7 +350,14 @@ impl GridScenario {
             episodes,
             params,
             realism,
-        })
+        };
+        match scenario.accuracy.recorded() {
+            Some(eeg) => {
+                let eeg = eeg.clone();
+                scenario.on_recording(eeg)
+            }
+            None => Ok(scenario),
+        }
     }
 }
 
@@ -410,8 +405,8 @@ fn user_accuracy(file: &ScenarioFile, path: &Path) -> Result<(RequestedAccuracy,
 
 /// Refuses what a scenario whose EEG is a recording cannot also set: a
 /// user (the recording is the user), the oracle (it has no EEG), a bank's
-/// size (the bank is the recording's held-out epochs), a simulated user's
-/// realism.
+/// size (the bank is the recording's held-out epochs). A `[realism]`
+/// table (a simulated user's) is not used: [`GridScenario::on_recording`].
 fn refuse_with_recording(file: &ScenarioFile, path: &Path) -> Result<()> {
     let bad =
         |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
@@ -444,24 +439,16 @@ fn refuse_with_recording(file: &ScenarioFile, path: &Path) -> Result<()> {
              epochs",
         ));
     }
-    if file.realism != Realism::default() {
-        return Err(bad(
-            "realism",
-            "a [realism] table".into(),
-            "nothing, with a recording (eeg.recording): the recording is the person; \
-             [realism] describes a simulated one",
-        ));
-    }
     Ok(())
 }
 
 /// The accuracies a grid decoder may have, in words.
-const ACCURACY_RANGE: &str =
+pub(crate) const ACCURACY_RANGE: &str =
     "a mean accuracy in (0.5, 1) for the EEG decoder, (0.5, 1] for the oracle";
 
 /// `accuracy` if `decoder` can have it: a real decoder is targeted at a
 /// mean accuracy; the oracle may also be perfect.
-fn checked_accuracy(accuracy: f64, decoder: DecoderChoice) -> Option<RequestedAccuracy> {
+pub(crate) fn checked_accuracy(accuracy: f64, decoder: DecoderChoice) -> Option<RequestedAccuracy> {
     match (RequestedAccuracy::new(accuracy), decoder) {
         (Ok(a @ RequestedAccuracy::Targeted(_)), _)
         | (Ok(a @ RequestedAccuracy::Perfect), DecoderChoice::Oracle) => Some(a),
@@ -469,177 +456,32 @@ fn checked_accuracy(accuracy: f64, decoder: DecoderChoice) -> Option<RequestedAc
     }
 }
 
-/// A grid scenario made in code, field by field, and checked once by
-/// [`GridScenarioBuilder::build`] as a file's values are (Table 1's cells,
-/// a fit's users, a decoder for benches).
-#[derive(Debug, Clone)]
-pub struct GridScenarioBuilder {
-    scenario: GridScenario,
-    accuracy: f64,
-}
-
 impl GridScenario {
-    /// A scenario at `path` (a label in errors and its name, until
-    /// [`GridScenarioBuilder::name`]) whose `decoder` has the mean
-    /// `accuracy`, run from `seed`; everything else as a file that sets
-    /// nothing has it
-    /// (streamed EEG, Platt-scaled p(error), 1000 epochs per class, the
-    /// paper's strategy and timing, the ideal user), with no episodes.
-    pub fn builder(
-        path: &str,
-        decoder: DecoderChoice,
-        accuracy: f64,
-        seed: u64,
-    ) -> GridScenarioBuilder {
-        GridScenarioBuilder {
-            scenario: Self {
-                path: path.into(),
-                name: path.to_string(),
-                description: String::new(),
-                seed,
-                decoder,
-                p_error: PErrorChoice::Platt,
-                eeg: EegMode::Stream,
-                bank_per_class: DEFAULT_BANK_PER_CLASS,
-                // Set by `build`, once checked.
-                accuracy: GridAccuracy::Requested(RequestedAccuracy::Perfect),
-                user: format!("accuracy {accuracy}"),
-                episodes: Vec::new(),
-                params: GridTaskParams::default(),
-                realism: Realism::default(),
-            },
-            accuracy,
-        }
-    }
-}
-
-impl GridScenarioBuilder {
-    /// The display name.
-    pub fn name(mut self, name: &str) -> Self {
-        self.scenario.name = name.to_string();
-        self
-    }
-
-    /// Streamed or banked EEG.
-    pub fn eeg(mut self, eeg: EegMode) -> Self {
-        self.scenario.eeg = eeg;
-        self
-    }
-
-    /// Epochs per class in the bank.
-    pub fn bank_per_class(mut self, n: usize) -> Self {
-        self.scenario.bank_per_class = n;
-        self
-    }
-
-    /// Strategy and timing.
-    pub fn params(mut self, params: GridTaskParams) -> Self {
-        self.scenario.params = params;
-        self
-    }
-
-    /// The simulated user's distance from the ideal one.
-    pub fn realism(mut self, realism: Realism) -> Self {
-        self.scenario.realism = realism;
-        self
-    }
-
-    /// Who the accuracy comes from, in words.
-    pub fn user(mut self, user: &str) -> Self {
-        self.scenario.user = user.to_string();
-        self
-    }
-
-    /// The (start, goal) of every episode, in order.
-    pub fn episodes(mut self, episodes: Vec<(Cell, Cell)>) -> Self {
-        self.scenario.episodes = episodes;
-        self
-    }
-
-    /// The scenario, checked as a file's values are: the accuracy against
-    /// the decoder, the bank's size, the number of episodes. The error
-    /// names the scenario and the field.
-    pub fn build(self) -> Result<GridScenario> {
-        let Self {
-            mut scenario,
-            accuracy,
-        } = self;
-        let path = scenario.path.clone();
-        let bad =
-            |field: &str, value: String, expected: &str| field_error(&path, field, value, expected);
-        scenario.accuracy = GridAccuracy::Requested(
-            checked_accuracy(accuracy, scenario.decoder)
-                .ok_or_else(|| bad("user.accuracy", accuracy.to_string(), ACCURACY_RANGE))?,
-        );
-        whole(
-            &path,
-            "bank_per_class",
-            scenario.bank_per_class as f64,
-            1,
-            MAX_BANK_PER_CLASS,
-            &format!(" (default {DEFAULT_BANK_PER_CLASS})"),
-        )?;
-        if scenario.episodes.len() > MAX_EPISODES {
+    /// This scenario on a person's recording `eeg` (given in memory, from
+    /// Python): its decoder calibrated on the recording's first part, its
+    /// user the recording (a simulated user's `[realism]` is not used, and
+    /// its user says so). Refused for the oracle, which reads no EEG.
+    pub fn on_recording(mut self, eeg: RecordedEeg) -> Result<Self> {
+        let bad = |field: &str, value: String, expected: &str| {
+            field_error(&self.path, field, value, expected)
+        };
+        if self.decoder == DecoderChoice::Oracle {
             return Err(bad(
-                "episodes",
-                scenario.episodes.len().to_string(),
-                &format!("at most {MAX_EPISODES}"),
+                "decoder",
+                "\"oracle\"".into(),
+                "\"eeg\" with a recording: the oracle reads no EEG",
             ));
         }
-        Ok(scenario)
-    }
-}
-
-/// The timing of a `[timing]` table set in `p`, on the paper's defaults:
-/// intervals, the EEG per action, the most actions.
-fn set_timing(p: &mut GridTaskParams, t: Option<&TimingFile>, path: &Path) -> Result<()> {
-    let bad =
-        |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
-    if let Some(t) = t {
-        let d = GridTaskParams::default();
-        p.interval_min_secs = t.interval_min_secs.unwrap_or(d.interval_min_secs);
-        p.interval_max_secs = t.interval_max_secs.unwrap_or(d.interval_max_secs);
-        p.epoch_secs = t.epoch_secs.unwrap_or(d.epoch_secs);
-        if let Some(n) = t.max_actions {
-            p.max_actions = whole(
-                path,
-                "timing.max_actions",
-                n,
-                1,
-                MAX_ACTIONS,
-                &format!(" (default {})", d.max_actions),
-            )?;
+        self.user = format!("recording {}", eeg.written);
+        if self.realism != Realism::default() {
+            // The recording is the person; the table describes a simulated one.
+            self.user.push_str(" ([realism] not used)");
+            self.realism = Realism::default();
         }
+        self.eeg = EegMode::Bank;
+        self.accuracy = GridAccuracy::Recorded(Box::new(eeg));
+        Ok(self)
     }
-    let (min, max) = (p.interval_min_secs, p.interval_max_secs);
-    if !(min.is_finite() && (0.8..=MAX_INTERVAL_SECS).contains(&min)) {
-        return Err(bad(
-            "timing.interval_min_secs",
-            min.to_string(),
-            &format!("a time from 0.8 s (an epoch) to {MAX_INTERVAL_SECS} s (the paper: 3)"),
-        ));
-    }
-    if !(max.is_finite() && max >= min && max <= MAX_INTERVAL_SECS) {
-        return Err(bad(
-            "timing.interval_max_secs",
-            max.to_string(),
-            &format!(
-                "a time from interval_min_secs ({min} s) to {MAX_INTERVAL_SECS} s (the \
-                 paper: 3.5)"
-            ),
-        ));
-    }
-    if !(p.epoch_secs.is_finite() && p.epoch_secs > 0.0 && p.epoch_secs <= min) {
-        return Err(bad(
-            "timing.epoch_secs",
-            p.epoch_secs.to_string(),
-            &format!(
-                "a time > 0 s and at most interval_min_secs ({min} s): the EEG counted \
-                 per action fits between two actions (the paper: 0.8)"
-            ),
-        ));
-    }
-    Ok(())
 }
 
 /// The start/goal pairs of the `[[episode]]` tables, then the free goals

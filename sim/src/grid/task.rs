@@ -7,8 +7,9 @@ use errp_robot::{Cell, Grid, GridControlParams, QTable};
 
 use crate::calibration::TargetingCache;
 use crate::error::Result;
-use crate::grid::decoder::{AssessmentDecoder, PErrorChoice};
+use crate::grid::decoder::AssessmentDecoder;
 use crate::grid::episode::run_grid_episode;
+use crate::grid::p_error::PErrorChoice;
 use crate::grid::plant::GridEpisodeResult;
 use crate::grid::run::{GridShared, prepare_grid_decoder};
 use crate::grid::scenario::{DecoderChoice, EegMode, GridAccuracy, GridScenario};

@@ -53,7 +53,7 @@ pub struct Provenance {
     /// Set when the EEG was a person's recording (`[eeg] recording =
     /// ...`): the file's name, size and SHA-256.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub eeg_recording: Option<crate::recorded::FileDigest>,
+    pub eeg_recording: Option<crate::files::FileDigest>,
 }
 
 impl Provenance {

@@ -155,7 +155,6 @@ fn a_recordings_scenario_refuses_a_simulated_users_settings() {
         ("[user]\nsubject = \"S1\"\n", "user.subject"),
         ("decoder = \"oracle\"\n", "decoder"),
         ("bank_per_class = 50\n", "bank_per_class"),
-        ("[realism]\nbackground_drift = 0.3\n", "realism"),
     ] {
         let text = format!(
             "task = \"grid\"\n{}[free_goals]\ncount = 2\n[eeg]\nrecording = \"s.edf\"\n{}",
@@ -172,5 +171,20 @@ fn a_recordings_scenario_refuses_a_simulated_users_settings() {
             "{field}: {e}"
         );
     }
+    // A simulated user's [realism] is not used, and the user says so.
+    let path = d.join("r.toml");
+    std::fs::write(
+        &path,
+        "task = \"grid\"\n[free_goals]\ncount = 2\n[eeg]\nrecording = \"s.edf\"\n[realism]\nbackground_drift = 0.3\n",
+    )
+    .unwrap();
+    let Some(s) = ScenarioInput::load_as_written(ScenarioSource::File(path))
+        .unwrap()
+        .into_grid()
+    else {
+        panic!("a grid scenario")
+    };
+    assert_eq!(s.user, "recording s.edf ([realism] not used)");
+    assert_eq!(s.realism, errp_bci::Realism::default());
     std::fs::remove_dir_all(&d).unwrap();
 }
