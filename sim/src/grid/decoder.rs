@@ -344,12 +344,7 @@ impl EegDecoder {
 
 /// The decoder's p(error) and class for one epoch's features.
 pub(crate) fn decide(d: &EegDecoder, features: &[f64]) -> (f64, bool) {
-    let y = d.model.decision(features);
-    let p = match d.p_error {
-        PErrorMapping::Sigmoid => errp_bci::sigmoid(y),
-        PErrorMapping::Platt(s) => s.p_error(y),
-    };
-    (p, y >= 0.0)
+    d.p_error.decide(&d.model, features)
 }
 
 /// What an EEG stream needs: the user's EEG model, the montage and the

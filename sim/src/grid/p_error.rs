@@ -1,7 +1,7 @@
 //! How the grid's EEG decoders map a decision value to p(error): the
 //! scenario's choice and the mapping a calibration fits.
 
-use errp_bci::PlattScaling;
+use errp_bci::{ErrorModel, PlattScaling};
 use serde::{Deserialize, Serialize};
 
 /// How the EEG decoder's decision value becomes p(error).
@@ -22,4 +22,17 @@ pub enum PErrorMapping {
     /// Platt scaling fitted on the calibration session's out-of-fold
     /// decisions: p = 1 / (1 + e^-(a y + b)).
     Platt(PlattScaling),
+}
+
+impl PErrorMapping {
+    /// `model`'s p(error) for `features` under this mapping, and its class
+    /// (decision value y >= 0, sec. 2.2.1).
+    pub(crate) fn decide(&self, model: &impl ErrorModel, features: &[f64]) -> (f64, bool) {
+        let y = model.decision(features);
+        let p = match self {
+            PErrorMapping::Sigmoid => errp_bci::sigmoid(y),
+            PErrorMapping::Platt(s) => s.p_error(y),
+        };
+        (p, y >= 0.0)
+    }
 }

@@ -149,12 +149,7 @@ impl RecordedBank {
 
     /// The decoder's p(error) and class for `features`.
     pub(crate) fn decide(&self, features: &[f64]) -> (f64, bool) {
-        let y = self.model.decision(features);
-        let p = match self.p_error {
-            PErrorMapping::Sigmoid => errp_bci::sigmoid(y),
-            PErrorMapping::Platt(s) => s.p_error(y),
-        };
-        (p, y >= 0.0)
+        self.p_error.decide(&self.model, features)
     }
 
     /// Every held-out epoch's (p(error), says error), by class.
@@ -222,16 +217,12 @@ pub(crate) fn prepare_recorded(
     let calibration_events = split.calibration.labels.len();
     let fcz_row = fcz_row(&recording, &split.calibration.preprocessor)?;
     let folds = setup.calibration.folds;
-    let (features, labels) = (
-        split.calibration.features.clone(),
-        split.calibration.labels.clone(),
-    );
     let calibrated =
         calibrate_session(&lda, split.calibration, folds, scenario.seed).map_err(named)?;
     let cv = repeated_cv(
         &lda,
-        &features,
-        &labels,
+        &calibrated.session.features,
+        &calibrated.session.labels,
         folds,
         scenario.seed,
         calibrated.accuracy,
