@@ -46,6 +46,8 @@ FIGURES=(
   "table1_seeds|slow|sh: python3 scripts/table1_seeds.py --seeds 10"
   "realism|cheap|realism --quiet"
   "grid_own_eeg|cheap|sh: d=\$(mktemp -d) && cp scenarios/recorded/own_eeg.toml \$d/ && \$ERRP calibrate --accuracy 0.78 --seed 1 --quiet --export \$d/s01.edf >/dev/null && \$ERRP run \$d/own_eeg.toml --quiet; s=\$?; rm -rf \$d; exit \$s"
+  "grid_own_eeg_split|cheap|sh: d=\$(mktemp -d) && cp scenarios/recorded/own_eeg.toml \$d/ && \$ERRP calibrate --accuracy 0.78 --seed 1 --quiet --export \$d/s01.edf >/dev/null && \$ERRP sweep --scenario \$d/own_eeg.toml --param eeg.calibration=0.3,0.5,0.7 --episodes 40 --out \$d/sw --quiet > \$d/out.txt; s=\$?; sed \"s#\$d/##g\" \$d/out.txt; rm -rf \$d; exit \$s"
+  "epuck_own_eeg|cheap|sh: d=\$(mktemp -d) && cp scenarios/recorded/own_eeg_epuck.toml \$d/ && \$ERRP calibrate --accuracy 0.78 --seed 1 --quiet --export \$d/s01.edf >/dev/null && \$ERRP run \$d/own_eeg_epuck.toml --quiet > \$d/out.txt && \$ERRP run scenarios/mexico_to_pisa.toml --accuracy 0.6857 --runs 50 --quiet > \$d/synthetic.txt; s=\$?; grep -v '^ *[0-9][0-9]* ' \$d/out.txt; echo '--- the synthetic user at the same cross-validated accuracy, T_e = 0.8:'; grep -E 'calibrated|detector:|reached' \$d/synthetic.txt; rm -rf \$d; exit \$s"
   "sweep_realism|cheap|sweep --task grid --accuracy 0.75 --param realism.lapse_rate=0,0.1,0.2 --param realism.background_drift=0,0.3 --param strategy=greedy,thompson --episodes 200 --seed 1 --out OUT_DIR --quiet"
   "python_decoders|slow|sh: \${PYTHON:-target/ci-venv/bin/python} python/examples/decoders_in_the_loop.py 2>/dev/null | sed -E 's/ +\\([0-9.]+ s\\)\$//'"
   "python_cross_validation|slow|sh: \${PYTHON:-target/ci-venv/bin/python} python/examples/cross_validate_decoders.py 2>/dev/null"

@@ -94,7 +94,10 @@ pub use error::{BciError, Result};
 pub use errp_valid::{Check, Valid, shown};
 pub use features::{EpochWindow, FeatureExtractor};
 pub use filter::{Biquad, FilterBank, FilterChain};
-pub use generator::{Assessment, Components, EegBlock, EegGenerator, GeneratorParams, Realism};
+pub use generator::{
+    Assessment, BASELINE_SECS, Components, EegBlock, EegGenerator, EegStream, ErrpTemplate,
+    GeneratorParams, HybridEeg, HybridSource, MIN_HYBRID_PART_SECS, Realism, TEMPLATE_SECS,
+};
 pub use information::{
     ActionInformation, INFORMATION_BINS, binary_channel_bits, binary_entropy,
     binary_symmetric_bits, erasure_bits,
@@ -106,14 +109,15 @@ pub use online::{
     Decision, Detector, DetectorMode, DetectorParams, OnlineRecording, OnlineRecordingParams,
     OnlineStep, OnlineTarget, OnlineTargeting, OperatingPoint, ResponseSpan, SPAN_ALPHA,
     SlidingWindow, WARM_UP_SECS, WINDOW_STEP_SECS, binomial_upper_tail, detector_span, firings,
-    operating_point, record_online, response_span, target_online, threshold_for_false_alarms,
+    operating_point, record_online, record_online_from, response_span, target_online,
+    threshold_for_false_alarms,
 };
 pub use platt::PlattScaling;
 pub use preprocess::{PreprocessParams, Preprocessing, Preprocessor};
 pub use psd::ThetaPsd;
 pub use recorded::{
     CalibrationPart, EOG_CHANNELS, EventNames, MIN_CALIBRATION_PER_CLASS, RecordedEpoch,
-    RecordedSession, Recording, split_recording,
+    RecordedSession, Recording, calibration_events, split_recording,
 };
 pub use subjects::{GoalSet, Subject, subject, subjects};
 pub use svm::{SvmDecoder, SvmModel, SvmParts};

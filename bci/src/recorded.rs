@@ -370,7 +370,7 @@ pub fn split_recording(
 
 /// The number of calibration events `part` asks of `n`: at least one, and
 /// one fewer than all.
-fn calibration_events(part: CalibrationPart, n: usize) -> Result<usize> {
+pub fn calibration_events(part: CalibrationPart, n: usize) -> Result<usize> {
     let k = match part {
         CalibrationPart::Fraction(f) if f > 0.0 && f < 1.0 => (f * n as f64).round() as usize,
         CalibrationPart::Fraction(f) => {

@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use errp_bci::{Assessment, AssessmentKind, EegBlock, Recording};
-use errp_sim::recorded::{FileDigest, RecordedEeg, SuppliedRecording};
+use errp_sim::recorded::{FileDigest, RecordedEeg, RecordedTask, SuppliedRecording};
 use numpy::PyReadonlyArray2;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -26,8 +26,12 @@ fn item<'py>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<Bound<'py, PyAny>> {
 /// The recording in `eeg` (keys `ch_names`, `data` `(n_channels,
 /// n_samples)` in uV, `sfreq`, `onsets` s, `errors` (true for an error
 /// event), `name`, `bytes`, `sha256`, `options`), checked and matched to the
-/// montage, for the scenario at `who`.
-pub(crate) fn supplied_recording(eeg: &Bound<'_, PyDict>, who: &Path) -> PyResult<RecordedEeg> {
+/// montage, for the scenario of `task` at `who`.
+pub(crate) fn supplied_recording(
+    eeg: &Bound<'_, PyDict>,
+    who: &Path,
+    task: RecordedTask,
+) -> PyResult<RecordedEeg> {
     let names: Vec<String> = item(eeg, "ch_names")?.extract()?;
     let data: PyReadonlyArray2<'_, f64> = item(eeg, "data")?.extract()?;
     let sfreq: f64 = item(eeg, "sfreq")?.extract()?;
@@ -77,6 +81,6 @@ pub(crate) fn supplied_recording(eeg: &Bound<'_, PyDict>, who: &Path) -> PyResul
         },
         _ => toml::Table::new(),
     };
-    RecordedEeg::supplied(&options, SuppliedRecording { recording, digest }, who)
+    RecordedEeg::supplied(&options, SuppliedRecording { recording, digest }, who, task)
         .map_err(crate::convert::py_err)
 }

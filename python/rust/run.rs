@@ -317,13 +317,23 @@ pub(crate) fn epuck_summary(
 ) -> DecoderSummary {
     let a = report.calibrated.accuracy;
     let mut info = vec![
-        ("accuracy", s.accuracy.get()),
-        ("errp_to_noise", report.generator.errp_to_noise),
+        // On a recording, the accuracy the control assumes: its own.
+        (
+            "accuracy",
+            decoder
+                .recorded
+                .as_ref()
+                .map_or(s.accuracy.get(), |r| r.accuracy),
+        ),
         ("cv_correct", a.correct),
         ("cv_error", a.error),
         ("cv_mean", a.mean()),
         ("t_e", decoder.detector_t_e(&s.params, false)),
     ];
+    if decoder.recorded.is_none() {
+        // A hybrid's response has the amplitude it has: no ratio.
+        info.insert(1, ("errp_to_noise", report.generator.errp_to_noise));
+    }
     if let Some(o) = &decoder.online {
         info.extend([
             ("online_hit_rate", o.point.hit_rate),
@@ -338,7 +348,7 @@ pub(crate) fn epuck_summary(
 #[derive(FromPyObject)]
 #[pyo3(from_item_all)]
 pub(crate) struct SweepKeywords {
-    accuracy: String,
+    accuracy: Option<String>,
     task: Option<String>,
     scenario: Option<PathBuf>,
     episodes: usize,
@@ -361,6 +371,53 @@ fn sweep_task(task: Option<&str>) -> PyResult<Option<SweepTask>> {
             "\"grid\" or \"epuck\"",
         )),
     }
+}
+
+/// The sweep `errp.sweep`'s keywords ask for, on the scenario `text` of
+/// `task` at `path`.
+#[allow(clippy::too_many_arguments)] // Python's keywords, one each
+fn sweep_spec(
+    task: SweepTask,
+    text: String,
+    path: PathBuf,
+    accuracy: Option<String>,
+    params: Option<Vec<String>>,
+    stream: Option<bool>,
+    episodes: usize,
+    seed: u64,
+) -> PyResult<SweepSpec> {
+    let mut spec = SweepSpec {
+        task,
+        scenario_path: path,
+        scenario_toml: text,
+        accuracies: Vec::new(),
+        axes: params
+            .unwrap_or_default()
+            .iter()
+            .map(|p| parse_axis(task, p, &NAMES))
+            .collect::<errp_sim::Result<_>>()
+            .map_err(py_err)?,
+        fixed: Vec::new(),
+        episodes,
+        seed,
+    };
+    // On recordings no accuracy is targeted and the EEG is theirs: the
+    // sweep's check refuses either keyword, saying why.
+    let recordings = spec.on_recordings();
+    match (accuracy, recordings) {
+        (Some(a), _) => spec.accuracies = parse_accuracies(&a, &NAMES).map_err(py_err)?,
+        (None, false) => {
+            return Err(PyValueError::new_err(
+                "accuracy: give the decoder accuracy levels (e.g. \"0.6:0.9:0.05\" or \
+                 [0.7, 0.8]); only a sweep over recordings (eeg.recording) has none",
+            ));
+        }
+        (None, true) => {}
+    }
+    if !recordings || stream.is_some() {
+        spec.fixed = sweep_fixed(task, stream, NAMES).map_err(py_err)?;
+    }
+    Ok(spec)
 }
 
 /// Runs a Monte Carlo sweep as `errp sweep` does, into `out`, and returns
@@ -405,21 +462,7 @@ pub(crate) fn sweep<'py>(
         None => rayon::current_num_threads(),
     };
     let (task, text, path) = sweep_scenario(scenario.as_deref(), want, NAMES).map_err(py_err)?;
-    let spec = SweepSpec {
-        task,
-        scenario_path: path,
-        scenario_toml: text,
-        accuracies: parse_accuracies(&accuracy, &NAMES).map_err(py_err)?,
-        axes: params
-            .unwrap_or_default()
-            .iter()
-            .map(|p| parse_axis(task, p, &NAMES))
-            .collect::<errp_sim::Result<_>>()
-            .map_err(py_err)?,
-        fixed: sweep_fixed(task, stream, NAMES).map_err(py_err)?,
-        episodes,
-        seed,
-    };
+    let spec = sweep_spec(task, text, path, accuracy, params, stream, episodes, seed)?;
     let sweep = spec.checked(&NAMES).map_err(py_err)?;
     let opts = SweepOptions {
         out: out.clone(),

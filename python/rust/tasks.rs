@@ -11,6 +11,7 @@ use errp_sim::epuck::{ContinuousDecoder, EpuckScenario};
 use errp_sim::grid::{
     AssessmentDecoder, EegDecoder, EpochBlocks, GridDecoding, GridScenario, prepare_decoder,
 };
+use errp_sim::recorded::RecordedTask;
 use errp_sim::{
     BatchRecord, PendingRecording, RunProvenance, run_epuck_batch_recorded, run_grid_batch,
 };
@@ -100,8 +101,11 @@ impl GridTask {
         let (s, text) = load_grid(scenario, keys, overrides, "errp.GridTask")?;
         let s = match eeg {
             Some(eeg) => {
-                let recorded =
-                    crate::recorded::supplied_recording(eeg, std::path::Path::new("eeg_options"))?;
+                let recorded = crate::recorded::supplied_recording(
+                    eeg,
+                    std::path::Path::new("eeg_options"),
+                    RecordedTask::Grid,
+                )?;
                 s.on_recording(recorded).map_err(py_err)?
             }
             None => s,
@@ -318,7 +322,8 @@ impl EpuckTask {
     /// Calibrates the scenario's continuous decoder; with `decoder`, a
     /// decoder of the caller's own replaces it in the loop.
     #[new]
-    #[pyo3(signature = (scenario=None, *, decoder=None, seed=None, accuracy=None, overrides=None, progress=None))]
+    #[pyo3(signature = (scenario=None, *, decoder=None, seed=None, accuracy=None, overrides=None, progress=None, eeg=None))]
+    #[allow(clippy::too_many_arguments)] // Python's keywords, one each
     fn new(
         py: Python<'_>,
         scenario: Option<PathBuf>,
@@ -327,13 +332,29 @@ impl EpuckTask {
         accuracy: Option<f64>,
         overrides: Option<&Bound<'_, PyDict>>,
         progress: Option<&Bound<'_, PyAny>>,
+        eeg: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
+        if eeg.is_some() && (accuracy.is_some() || decoder.is_some()) {
+            return Err(PyValueError::new_err(
+                "accuracy and decoder: with eeg=..., the runs stream a hybrid of the recording, \
+                 decoded by the SVM calibrated on its first part, which has the accuracy the \
+                 recording gives; no accuracy is targeted: leave out accuracy and decoder",
+            ));
+        }
         let keys = Keys {
             accuracy,
             seed,
             runs: None,
         };
         let (s, text) = load_epuck(scenario, keys, overrides, "errp.EpuckTask")?;
+        let s = match eeg {
+            Some(eeg) => s.on_recording(crate::recorded::supplied_recording(
+                eeg,
+                std::path::Path::new("eeg_options"),
+                RecordedTask::Epuck,
+            )?),
+            None => s,
+        };
         check_callable(py, "decoder", decoder.as_ref())?;
         let meter = Meter::default();
         let (builtin, report) = long_shown(py, &meter, progress, || {

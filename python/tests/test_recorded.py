@@ -1,6 +1,7 @@
-"""A person's recording in the grid's closed loop from Python: an exported
-session read by MNE gives the decoder the accuracy it was made at, resampled
-and reordered too, and what cannot be used is refused naming it."""
+"""A person's recording in the closed loop from Python: an exported session
+read by MNE gives the grid's decoder the accuracy it was made at, resampled
+and reordered too; the e-puck runs on a hybrid of it; and what cannot be
+used is refused naming it."""
 
 import hashlib
 
@@ -59,6 +60,48 @@ def test_the_recording_is_named_with_its_digest_in_the_recording(exported, tmp_p
     digest = rec.provenance["eeg_recording"]
     want = hashlib.sha256(exported.read_bytes()).hexdigest()
     assert digest == {"name": "s.edf", "bytes": exported.stat().st_size, "sha256": want}
+
+
+def test_the_epuck_reaches_pisa_on_a_hybrid_read_by_mne(exported, tmp_path):
+    task = errp.EpuckTask(eeg=exported, progress=False)
+    info = task.calibration
+    # T_e set on the held-out hybrid for the paper-fitted user's rate; the
+    # control assumes the recording's own cross-validated accuracy.
+    assert abs(info["online_false_alarms_per_min"] - 5.37) < 0.3, info
+    assert info["accuracy"] == info["cv_mean"] and 0.6 < info["cv_mean"] < 0.8, info
+    df = task.run(50, progress=False)
+    # As `errp run scenarios/recorded/own_eeg_epuck.toml` on the same file:
+    # the data are the file's, so the hybrid and its runs are the same.
+    assert df["success"].sum() >= 25, df["success"].sum()
+    if errp.HAS_RERUN:
+        task.run(1, save=tmp_path / "h.rrd", progress=False)
+        digest = errp.read_recording(tmp_path / "h.rrd").provenance["eeg_recording"]
+        assert digest["name"] == "s.edf" and digest["bytes"] == exported.stat().st_size
+    raw = mne.io.read_raw_edf(exported, preload=True, verbose="error")
+    with pytest.raises(ValueError, match="accuracy"):
+        errp.EpuckTask(eeg=raw, accuracy=0.9, progress=False)
+    with pytest.raises(ValueError, match="eeg_options"):
+        errp.EpuckTask(eeg=raw, eeg_options={"draw": "with_replacement"}, progress=False)
+    with pytest.raises(ValueError, match="false_alarms_per_min"):
+        errp.EpuckTask(eeg=raw, eeg_options={"false_alarms_per_min": 0}, progress=False)
+
+
+def test_a_sweep_over_recordings_has_one_level_per_file(exported, tmp_path):
+    scenario = exported.parent / "own.toml"
+    scenario.write_text(
+        'task = "grid"\n[free_goals]\ncount = 3\n[eeg]\nrecording = "s.edf"\n'
+    )
+    result = errp.sweep(
+        scenario=scenario, params={"eeg.recording": ["s.edf"]}, episodes=3, progress=False
+    )
+    assert len(result.summary) == 1
+    # The level's accuracy is the one the recording gives.
+    assert abs(result.summary["accuracy"][0] - 0.78) <= 0.03, result.summary
+    assert set(result.episodes["accuracy"]) == {result.summary["accuracy"][0]}
+    with pytest.raises(ValueError, match="accuracy"):
+        errp.sweep(scenario=scenario, accuracy=0.8, episodes=3, progress=False)
+    with pytest.raises(ValueError, match="accuracy"):
+        errp.sweep(task="grid", episodes=3, progress=False)
 
 
 def test_an_in_memory_session_and_its_epochs_run():

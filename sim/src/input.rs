@@ -247,7 +247,7 @@ impl ScenarioInput {
             .and_then(toml::Value::as_table)
             .and_then(|t| t.get("recording"))
             .and_then(toml::Value::as_str);
-        if let (false, Some(recording)) = (epuck, recording) {
+        if let Some(recording) = recording {
             let why = format!(
                 "the EEG of {} is a recording (eeg.recording = {recording:?})",
                 self.source.path().display()

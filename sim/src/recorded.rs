@@ -26,6 +26,17 @@ pub const MAX_RECORDING_BYTES: u64 = 1 << 30;
 /// events.
 pub const DEFAULT_CALIBRATION: f64 = 0.5;
 
+/// The false alarms a minute of the shipped e-puck user (accuracy 95 %,
+/// fitted to the paper's two runs by `errp fit epuck`) at the paper's
+/// T_e = 0.8 with the default detector, on its held-out recording:
+/// `docs/figures/epuck_mexico_default.txt` (a test reads it there). An
+/// e-puck hybrid's T_e is set to give this rate unless its `[eeg]` table
+/// says `false_alarms_per_min`.
+pub const FITTED_FALSE_ALARMS_PER_MIN: f64 = 5.37;
+
+/// The largest false-alarm rate an e-puck hybrid's T_e may be set for.
+pub const MAX_FALSE_ALARMS_PER_MIN: f64 = 60.0;
+
 /// How the closed loop draws held-out epochs of a class.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -51,7 +62,45 @@ pub(crate) struct RecordedFile {
     #[serde(default)]
     correct: Option<String>,
     #[serde(default)]
-    draw: BankDraw,
+    draw: Option<BankDraw>,
+    #[serde(default)]
+    false_alarms_per_min: Option<f64>,
+}
+
+/// The `[eeg]` table of an e-puck scenario: a table naming a recording
+/// (a grid's `eeg` may also be a mode).
+#[derive(Debug, Clone)]
+pub(crate) struct RecordedTable(pub(crate) RecordedFile);
+
+impl<'de> Deserialize<'de> for RecordedTable {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        struct Visitor;
+        impl<'de> serde::de::Visitor<'de> for Visitor {
+            type Value = RecordedTable;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a table naming a recording ([eeg] recording = \"s01.edf\")")
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                map: A,
+            ) -> std::result::Result<RecordedTable, A::Error> {
+                RecordedFile::deserialize(serde::de::value::MapAccessDeserializer::new(map))
+                    .map(RecordedTable)
+            }
+        }
+        d.deserialize_map(Visitor)
+    }
+}
+
+/// The task a recording's `[eeg]` table is read for: each has a key of its
+/// own.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RecordedTask {
+    /// The grid: held-out epochs drawn (`draw`).
+    Grid,
+    /// The e-puck: a hybrid, T_e set for a false-alarm rate
+    /// (`false_alarms_per_min`).
+    Epuck,
 }
 
 /// A scenario's recorded EEG, checked (the file itself is read when the
@@ -66,8 +115,11 @@ pub struct RecordedEeg {
     pub part: CalibrationPart,
     /// The annotations that mark each class.
     pub names: EventNames,
-    /// How held-out epochs are drawn.
+    /// How held-out epochs are drawn (the grid).
     pub draw: BankDraw,
+    /// The false alarms a minute the hybrid's T_e is set for (the e-puck;
+    /// none: [`FITTED_FALSE_ALARMS_PER_MIN`]).
+    pub false_alarms_per_min: Option<f64>,
     /// The recording itself, when it was given in memory (Python's MNE
     /// objects) rather than as a file: used in place of reading `file`.
     pub supplied: Option<Arc<SuppliedRecording>>,
@@ -98,6 +150,7 @@ impl RecordedEeg {
         options: &toml::Table,
         supplied: SuppliedRecording,
         who: &Path,
+        task: RecordedTask,
     ) -> Result<Self> {
         if options.contains_key("recording") {
             return Err(field_error(
@@ -115,7 +168,7 @@ impl RecordedEeg {
         let file: RecordedFile = table
             .try_into()
             .map_err(|e| SimError::Scenario(format!("{}: eeg: {e}", who.display())))?;
-        let mut eeg = file.check(who)?;
+        let mut eeg = file.check(who, task)?;
         eeg.file = PathBuf::from(&supplied.digest.name);
         eeg.supplied = Some(Arc::new(supplied));
         Ok(eeg)
@@ -125,10 +178,11 @@ impl RecordedEeg {
 impl RecordedFile {
     /// Checks the table of the scenario at `scenario`; errors name the
     /// field (`eeg.calibration`).
-    pub(crate) fn check(self, scenario: &Path) -> Result<RecordedEeg> {
+    pub(crate) fn check(self, scenario: &Path, task: RecordedTask) -> Result<RecordedEeg> {
         let bad = |field: &str, value: String, expected: &str| {
             field_error(scenario, &format!("eeg.{field}"), value, expected)
         };
+        self.check_task_keys(scenario, task)?;
         if self.recording.trim().is_empty() {
             return Err(bad(
                 "recording",
@@ -200,9 +254,51 @@ impl RecordedFile {
             file,
             part,
             names,
-            draw: self.draw,
+            draw: self.draw.unwrap_or_default(),
+            false_alarms_per_min: self.false_alarms_per_min,
             supplied: None,
         })
+    }
+
+    /// Refuses the other task's key: the grid's `draw`, the e-puck's
+    /// `false_alarms_per_min`; checks the latter's range.
+    fn check_task_keys(&self, scenario: &Path, task: RecordedTask) -> Result<()> {
+        let bad = |field: &str, value: String, expected: &str| {
+            field_error(scenario, &format!("eeg.{field}"), value, expected)
+        };
+        match (task, self.draw, self.false_alarms_per_min) {
+            (RecordedTask::Epuck, Some(d), _) => {
+                return Err(bad(
+                    "draw",
+                    match d {
+                        BankDraw::WithReplacement => "\"with_replacement\"".into(),
+                        BankDraw::WithoutReplacement => "\"without_replacement\"".into(),
+                    },
+                    "nothing in an e-puck scenario: its ErrPs are the subject's response added \
+                     to the recording's background, not drawn epochs",
+                ));
+            }
+            (RecordedTask::Grid, _, Some(f)) => {
+                return Err(bad(
+                    "false_alarms_per_min",
+                    f.to_string(),
+                    "nothing in a grid scenario: its decoder reads one epoch per action, with \
+                     no threshold to set (the e-puck's T_e)",
+                ));
+            }
+            (_, _, Some(f)) if !(f > 0.0 && f <= MAX_FALSE_ALARMS_PER_MIN) => {
+                return Err(bad(
+                    "false_alarms_per_min",
+                    f.to_string(),
+                    &format!(
+                        "false alarms a minute in (0, {}] (default {}, the paper-fitted user's)",
+                        MAX_FALSE_ALARMS_PER_MIN, FITTED_FALSE_ALARMS_PER_MIN
+                    ),
+                ));
+            }
+            _ => {}
+        }
+        Ok(())
     }
 }
 
@@ -250,7 +346,7 @@ mod tests {
 
     fn checked(text: &str) -> Result<RecordedEeg> {
         let f: RecordedFile = toml::from_str(text).expect("a table");
-        f.check(Path::new("scenarios/s.toml"))
+        f.check(Path::new("scenarios/s.toml"), RecordedTask::Grid)
     }
 
     #[test]
@@ -295,6 +391,7 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("errp-recorded-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let eeg = |name: &str| RecordedEeg {
+            false_alarms_per_min: None,
             written: name.into(),
             file: dir.join(name),
             part: CalibrationPart::Fraction(0.5),

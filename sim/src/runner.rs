@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use errp_bci::{OnlineStep, TargetingStep};
 
 use crate::calibration::CalibrationReport;
+pub use crate::epuck::epuck_decoder_summary;
 use crate::epuck::{
     ContinuousDecoder, ContinuousReport, EpuckEpisodeResult, EpuckScenario, WindowDecoder,
     prepare_continuous_decoder_with, run_epuck_runs,
@@ -286,26 +287,6 @@ pub fn grid_decoder_summary(
     }
 }
 
-/// What the continuous decoder's calibration found, as `errp run` prints
-/// it, with its operating point on the held-out recording.
-pub fn epuck_decoder_summary(decoder: &ContinuousDecoder, report: &ContinuousReport) -> String {
-    let acc = report.calibrated.accuracy;
-    let mut text = format!(
-        "SVM decoder calibrated on {} error + {} correct button-locked examples: correct {:.2} %, \
-         error {:.2} %, mean {:.2} % (cross-validated); {} support vectors\n",
-        acc.n_error,
-        acc.n_correct,
-        100.0 * acc.correct,
-        100.0 * acc.error,
-        100.0 * acc.mean(),
-        decoder.model.n_support()
-    );
-    if let Some(online) = &decoder.online {
-        text.push_str(&online.to_string());
-    }
-    text
-}
-
 /// A batch's recording, created before its work so that an unwritable
 /// path fails first; nothing without a path.
 pub struct PendingRecording {
@@ -549,7 +530,8 @@ mod recording {
         of: &BatchRecord<'_>,
         on_run: &(dyn Fn(usize) + Sync),
     ) -> Result<Vec<EpuckEpisodeResult>> {
-        let p = provenance("epuck", &scenario.name, scenario.seed, of);
+        let mut p = provenance("epuck", &scenario.name, scenario.seed, of);
+        p.eeg_recording = decoder.recorded.as_ref().map(|r| r.file.clone());
         crate::epuck::record_epuck_runs_with(
             file,
             scenario,

@@ -132,7 +132,8 @@ impl ColumnKind {
 /// `sweep.json` lists it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DecoderInfo {
-    /// Requested accuracy.
+    /// Requested accuracy (on a recording: the cross-validated one it
+    /// gives, which the control assumes).
     pub accuracy: f64,
     /// `lda` (grid EEG), `svm` (e-puck) or `oracle`.
     pub kind: String,
@@ -152,6 +153,11 @@ pub struct DecoderInfo {
     /// E-puck: its false alarms per minute of error-free time there.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub online_false_alarms_per_min: Option<f64>,
+    /// A person's recording, when the decoder was calibrated on one: its
+    /// name, size and SHA-256 (a sweep resumed on another file is refused
+    /// by it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub recording: Option<crate::files::FileDigest>,
     /// True if the targeting came from the cache (not written to disk).
     #[serde(skip)]
     pub cached: bool,

@@ -49,9 +49,10 @@ pub struct SweepArgs {
     #[arg(long, value_name = "FILE.toml")]
     scenario: Option<PathBuf>,
     /// Decoder accuracy levels: start:stop:step (stop included), a list
-    /// a,b,c, or one value; each in (0.5, 1).
-    #[arg(long, default_value = "0.55:0.95:0.05", allow_negative_numbers = true)]
-    accuracy: String,
+    /// a,b,c, or one value; each in (0.5, 1) [default: 0.55:0.95:0.05; none
+    /// on recordings, whose decoders have the accuracy they give].
+    #[arg(long, allow_negative_numbers = true)]
+    accuracy: Option<String>,
     /// Also sweep a scenario parameter, NAME=start:stop:step or NAME=a,b,c
     /// (repeatable; every combination runs). Grid: tau, epsilon, p_c,
     /// strategy, max_actions, ...; e-puck: t_e, p_c, k_n, sigma_deg,
@@ -210,9 +211,12 @@ impl SweepObserver for Progress {
         let reached = info.cv_mean.map_or("exact (oracle)".to_string(), |m| {
             format!("{:.2} % cross-validated", 100.0 * m)
         });
+        let what = match &info.recording {
+            Some(r) => format!("recording {}", r.name),
+            None => format!("accuracy {}", info.accuracy),
+        };
         self.line(&format!(
-            "  decoder {done}/{total}: accuracy {} -> {reached}{} [{:.1} s]",
-            info.accuracy,
+            "  decoder {done}/{total}: {what} -> {reached}{} [{:.1} s]",
             if info.cached {
                 " (targeting cached)"
             } else {
@@ -273,22 +277,39 @@ fn sweep_spec(args: &SweepArgs, names: InputNames) -> Result<SweepSpec> {
         TaskArg::Epuck => SweepTask::Epuck,
     });
     let (task, text, path) = sweep_scenario(args.scenario.as_deref(), want, names)?;
-    let fixed = sweep_fixed(task, args.eeg.map(|e| e == SweepEeg::Stream), names)?;
-    Ok(SweepSpec {
+    let mut spec = SweepSpec {
         task,
         scenario_path: path,
         scenario_toml: text,
-        accuracies: parse_accuracies(&args.accuracy, &names)?,
+        accuracies: Vec::new(),
         axes: args
             .params
             .iter()
             .map(|p| parse_axis(task, p, &names))
             .collect::<errp_sim::Result<_>>()?,
-        fixed,
+        fixed: Vec::new(),
         episodes: args.episodes as usize,
         seed: args.seed,
-    })
+    };
+    // On recordings no accuracy is targeted and the EEG is theirs: the
+    // sweep's check refuses either flag, saying why.
+    let recordings = spec.on_recordings();
+    let accuracy = match (&args.accuracy, recordings) {
+        (Some(a), _) => Some(a.as_str()),
+        (None, false) => Some(DEFAULT_ACCURACIES),
+        (None, true) => None,
+    };
+    if let Some(a) = accuracy {
+        spec.accuracies = parse_accuracies(a, &names)?;
+    }
+    if !recordings || args.eeg.is_some() {
+        spec.fixed = sweep_fixed(task, args.eeg.map(|e| e == SweepEeg::Stream), names)?;
+    }
+    Ok(spec)
 }
+
+/// The accuracy levels of `errp sweep` without `--accuracy`.
+const DEFAULT_ACCURACIES: &str = "0.55:0.95:0.05";
 
 /// Runs `errp sweep`. Returns false if interrupted (exit code 130).
 pub fn sweep(args: &SweepArgs) -> Result<bool> {

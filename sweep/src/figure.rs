@@ -43,9 +43,13 @@ pub fn sweep_plot(spec: &SweepSpec, report: &SweepReport, scenario: &AnyScenario
     };
     SweepPlot {
         title: format!(
-            "{}: {} accuracies{} x {} episodes, {}, seed {}",
+            "{}: {}{} x {} episodes, {}, seed {}",
             text.task,
-            spec.accuracies.len(),
+            if spec.accuracies.is_empty() {
+                "recorded EEG".to_string()
+            } else {
+                format!("{} accuracies", spec.accuracies.len())
+            },
             if series.len() > 1 {
                 format!(" x {} settings", series.len())
             } else {

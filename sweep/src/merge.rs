@@ -15,7 +15,7 @@ use crate::finish::finish_dir;
 use crate::lock::DirLock;
 use crate::manifest::{EPISODES, MANIFEST, Manifest};
 use crate::rows::{RowCheck, episodes_header};
-use crate::run::foreign_files;
+use crate::run::{foreign_files, measured_levels};
 use crate::spec::{InputNames, Level, SweepSpec, SweepTask};
 use crate::summary::SweepReport;
 use crate::writer::read_row;
@@ -133,7 +133,7 @@ pub fn merge_sweeps(dirs: &[PathBuf], out: &Path) -> Result<SweepReport> {
             )));
         }
     }
-    let levels = spec.levels(&InputNames::CLI)?;
+    let levels = measured_levels(&spec, &spec.levels(&InputNames::CLI)?, &first.decoders)?;
     let created = create_dirs(out)?;
     // Go if the merge is interrupted before it is written.
     created.remove_if_interrupted();

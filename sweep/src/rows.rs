@@ -41,7 +41,7 @@ pub(crate) fn run_row<T: Task>(
     runner: &T::Runner,
     k: usize,
 ) -> Result<String> {
-    let seed = spec.episode_seed(level.accuracy, k);
+    let seed = spec.level_episode_seed(level, k);
     let mut f = vec![level.index.to_string(), format_number(level.accuracy)];
     f.extend(level.values.iter().map(value_text));
     f.extend([k.to_string(), seed.to_string()]);
@@ -148,7 +148,7 @@ impl<'a, T: Task> RowCheck<'a, T> {
         let mut want = vec![level.index.to_string(), format_number(level.accuracy)];
         want.extend(level.values.iter().map(value_text));
         want.push(k.to_string());
-        want.push(self.spec.episode_seed(level.accuracy, k).to_string());
+        want.push(self.spec.level_episode_seed(level, k).to_string());
         for (i, w) in want.iter().enumerate() {
             if f[i] != w {
                 let why = match i {

@@ -241,6 +241,31 @@ impl<'a, T: Task> Plan<'a, T> {
         })
     }
 
+    /// The levels, on recordings each with the accuracy its decoder gives
+    /// (`infos`, one per distinct decoder in the order of their first
+    /// levels); otherwise as they are.
+    fn measured(&self, spec: &SweepSpec, infos: &[DecoderInfo]) -> Result<Vec<Level>> {
+        if infos.len() != self.first.len() {
+            return Err(SimError::Sweep(format!(
+                "the sweep's {MANIFEST} lists {} decoders; its levels have {}",
+                infos.len(),
+                self.first.len()
+            )));
+        }
+        Ok(self
+            .levels
+            .iter()
+            .zip(&self.key_of)
+            .map(|(level, &d)| {
+                let mut level = level.clone();
+                if spec.accuracies.is_empty() {
+                    level.accuracy = infos[d].accuracy;
+                }
+                level
+            })
+            .collect())
+    }
+
     /// Prepares each distinct decoder (in parallel, with `cache` for the
     /// targeting), in the order of their first levels.
     fn prepare(
@@ -297,6 +322,20 @@ pub fn prepare_sweep(
     }
 }
 
+/// `levels` of `spec`, on recordings each with the accuracy its decoder
+/// gave (`infos`, from `sweep.json`): the levels its rows were written
+/// with.
+pub(crate) fn measured_levels(
+    spec: &SweepSpec,
+    levels: &[Level],
+    infos: &[DecoderInfo],
+) -> Result<Vec<Level>> {
+    match spec.task {
+        SweepTask::Grid => Plan::<GridTask>::new(spec, levels)?.measured(spec, infos),
+        SweepTask::Epuck => Plan::<EpuckTask>::new(spec, levels)?.measured(spec, infos),
+    }
+}
+
 /// Refuses to resume rows made with decoders (`made_with`, from
 /// `sweep.json`) other than the ones this run prepared (`infos`): a cache
 /// that changed between the runs, another version. The file would mix two
@@ -312,19 +351,23 @@ fn check_made_with(out: &Path, made_with: &[DecoderInfo], infos: &[DecoderInfo])
         })
     {
         let show = |d: Option<&DecoderInfo>| {
-            d.map_or("none".to_string(), |d| {
-                format!(
+            d.map_or("none".to_string(), |d| match &d.recording {
+                Some(r) => format!(
+                    "recording {} ({} bytes, SHA-256 {})",
+                    r.name, r.bytes, r.sha256
+                ),
+                None => format!(
                     "accuracy {} at ErrP-to-noise {}",
                     d.accuracy,
                     d.errp_to_noise.map_or("-".into(), |r| r.to_string())
-                )
+                ),
             })
         };
         return Err(SimError::Sweep(format!(
             "{} holds rows made with other decoders than this run prepared (decoder {}: {} \
-             then, {} now; was the targeting cache changed between the runs?): resuming \
-             would mix them. Resume with the cache the sweep started with, or choose another \
-             --out",
+             then, {} now; was the targeting cache or a recording changed between the \
+             runs?): resuming would mix them. Resume with the cache and the recordings the \
+             sweep started with, or choose another --out",
             out.display(),
             i + 1,
             show(made_with.get(i)),
@@ -389,6 +432,8 @@ fn run_levels<T: Task>(
     if episodes_path.exists() {
         check_made_with(out, made_with, &infos)?;
     }
+    let measured = plan.measured(spec, &infos)?;
+    let levels = measured.as_slice();
     let manifest = Manifest {
         decoders: infos,
         ..fresh

@@ -134,7 +134,10 @@ pub fn summarise_dir(dir: &Path, spec: &SweepSpec) -> Result<SweepReport> {
         if current.as_ref().is_some_and(|c| c.level != level) {
             levels.push(current.take().expect("checked").finish(spec, &mut series));
         }
-        let acc = current.get_or_insert_with(|| Acc::new(level));
+        // On recordings, the level's accuracy is the one its rows carry
+        // (its decoder's, checked as they were written).
+        let measured = parse(1)?;
+        let acc = current.get_or_insert_with(|| Acc::new(level, measured));
         let success = parse(cols.success)? == 1.0;
         acc.n += 1;
         if success {
@@ -184,6 +187,8 @@ pub fn summarise_dir(dir: &Path, spec: &SweepSpec) -> Result<SweepReport> {
 /// One level's rows while they are read.
 struct Acc {
     level: usize,
+    /// The accuracy column of the level's rows.
+    measured: f64,
     n: usize,
     wrong: usize,
     no_commit: usize,
@@ -196,9 +201,10 @@ struct Acc {
 }
 
 impl Acc {
-    fn new(level: usize) -> Self {
+    fn new(level: usize, measured: f64) -> Self {
         Self {
             level,
+            measured,
             n: 0,
             wrong: 0,
             no_commit: 0,
@@ -215,7 +221,10 @@ impl Acc {
         spec: &SweepSpec,
         series: &mut Vec<(String, StreamingPearson)>,
     ) -> LevelSummary {
-        let (accuracy, values) = spec.level_values(self.level);
+        let (mut accuracy, values) = spec.level_values(self.level);
+        if spec.accuracies.is_empty() {
+            accuracy = self.measured;
+        }
         let label = spec.series_label(&values);
         let (mean, sd) = mean_sd(&self.cost);
         // Pairs with an undefined online accuracy are left out of r.

@@ -121,7 +121,10 @@ impl fmt::Display for SweepReport {
             write!(
                 f,
                 "{:>8} {:>6} {:>7.1}% {:>15} {:>17} {:>7} {:>7} {:>6} {:>7}",
-                format_number(l.accuracy),
+                // A recording's accuracy is measured: four places.
+                Some(format_number(l.accuracy))
+                    .filter(|a| a.len() <= 8)
+                    .unwrap_or_else(|| format!("{:.4}", l.accuracy)),
                 l.episodes,
                 100.0 * l.success_rate(),
                 format!("[{:.1}, {:.1}]", 100.0 * lo, 100.0 * hi),

@@ -80,7 +80,89 @@ fn an_exported_session_runs_the_grid_at_the_accuracy_it_was_made_at() {
             && e.contains("no accuracy is targeted"),
         "{e}"
     );
+    // A sweep over the recording: one level, at the accuracy it gives.
+    let out = d.join("sweep");
+    let o = errp(&[
+        "sweep",
+        "--scenario",
+        &s,
+        "--param",
+        "eeg.recording=s.edf",
+        "--episodes",
+        "4",
+        "--out",
+        out.to_str().unwrap(),
+        "--no-cache",
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let summary = std::fs::read_to_string(out.join("summary.csv")).unwrap();
+    let level: f64 = summary
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .nth(1)
+        .unwrap()
+        .parse()
+        .unwrap();
+    // (The sweep's seed draws the cross-validation's folds: not the run's.)
+    assert!((100.0 * level - cv).abs() < 2.0, "{summary} against {cv}");
+    the_epuck_reaches_pisa_on_a_hybrid_of(&d);
     std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// The e-puck on a hybrid of `dir/s.edf` (the session exported at 78 %):
+/// the shipped example, Mexico to Pisa over 50 runs, reaches Pisa in at
+/// least half of them, with the hybrid named in the output and the
+/// recording's provenance.
+fn the_epuck_reaches_pisa_on_a_hybrid_of(dir: &Path) {
+    let example = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/recorded/own_eeg_epuck.toml"),
+    )
+    .unwrap()
+    .replace("\"s01.edf\"", "\"s.edf\"");
+    let s = dir.join("epuck.toml");
+    std::fs::write(&s, &example).unwrap();
+    let s = s.to_str().unwrap();
+    let o = errp(&["run", s]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains(
+            "EEG: hybrid: recorded background, recorded ErrP template, from recording \
+                      s.edf"
+        ) && out.contains("SHA-256"),
+        "{out}"
+    );
+    // The paper-fitted user's false alarms a minute, met on the held-out
+    // hybrid.
+    assert!(
+        out.contains(": 5.37 false alarms a minute on the held-out hybrid"),
+        "{out}"
+    );
+    let reached = number_after(&out, "reached Pisa");
+    assert!(reached >= 25.0, "{out}");
+    // A recording's e-puck takes no accuracy, no T_e and no draw.
+    let e = refused(&["run", s, "--accuracy", "0.9"]);
+    assert!(
+        e.contains("--accuracy") && e.contains("no accuracy is targeted"),
+        "{e}"
+    );
+    for (extra, field) in [
+        ("[control]\nt_e = 0.7\n", "control.t_e"),
+        ("draw = \"with_replacement\"\n", "eeg.draw"),
+    ] {
+        let bad = dir.join("bad.toml");
+        let text = if extra.starts_with('[') {
+            format!("{example}{extra}")
+        } else {
+            example.replace("[eeg]\n", &format!("[eeg]\n{extra}"))
+        };
+        std::fs::write(&bad, text).unwrap();
+        let e = refused(&["run", bad.to_str().unwrap()]);
+        assert!(e.contains(field), "{e}");
+    }
 }
 
 /// `bytes` with the first EDF channel label `from` renamed `to`.
@@ -156,24 +238,50 @@ fn a_recording_that_cannot_calibrate_is_refused_naming_what_is_missing() {
             rrd.display()
         );
     }
-    // A sweep targets synthetic users at its accuracies: a recording's
-    // scenario is refused, and so is a swept recording.
+    // A sweep over recordings targets no accuracy and sets no EEG mode:
+    // --accuracy and --eeg are refused, saying why; a swept recording that
+    // cannot calibrate is named; nothing is written.
     let s = scenario(&d, "sweep", "s.edf", "");
     let out = d.join("sweep");
     let o_ = out.to_str().unwrap();
-    let e = refused(&["sweep", "--scenario", &s, "--out", o_, "--no-cache"]);
-    assert!(e.contains("eeg.recording") && e.contains("errp run"), "{e}");
     let e = refused(&[
         "sweep",
-        "--task",
-        "grid",
-        "--param",
-        "eeg.recording=s.edf",
+        "--scenario",
+        &s,
+        "--accuracy",
+        "0.8",
         "--out",
         o_,
         "--no-cache",
     ]);
-    assert!(e.contains("eeg.recording") && e.contains("errp run"), "{e}");
+    assert!(
+        e.contains("--accuracy") && e.contains("no accuracy is targeted"),
+        "{e}"
+    );
+    let e = refused(&[
+        "sweep",
+        "--scenario",
+        &s,
+        "--eeg",
+        "stream",
+        "--out",
+        o_,
+        "--no-cache",
+    ]);
+    assert!(e.contains("--eeg stream") && e.contains("recording"), "{e}");
+    let e = refused(&[
+        "sweep",
+        "--scenario",
+        &s,
+        "--param",
+        "eeg.recording=s.edf,no_fcz.edf",
+        "--episodes",
+        "2",
+        "--out",
+        o_,
+        "--no-cache",
+    ]);
+    assert!(e.contains("no_fcz.edf") && e.contains("FCz"), "{e}");
     assert!(!out.exists());
     let mut left = files_in(&d);
     left.retain(|f| !f.ends_with(".toml") && !f.ends_with(".edf"));

@@ -10,7 +10,9 @@ use crate::classify::Features;
 use crate::erp::AssessmentKind;
 use crate::error::{Result, check};
 use crate::features::{EpochWindow, FeatureExtractor};
-use crate::generator::{Assessment, Components, EegBlock, EegGenerator, GeneratorParams};
+use crate::generator::{
+    Assessment, Components, EegBlock, EegGenerator, EegStream, GeneratorParams, HybridSource,
+};
 use crate::montage::Montage;
 use crate::preprocess::Preprocessor;
 use crate::rng::{derive_seed, stream};
@@ -45,6 +47,10 @@ pub struct SessionOptions<'a> {
     /// Called with each raw block (all channels) and the assessments whose
     /// onsets fall in it, e.g. to export the raw EEG.
     pub raw_sink: Option<RawSink<'a>>,
+    /// A person's recording in place of the synthetic user's EEG: its
+    /// background looped, the subject's response at the errors, the
+    /// preprocessing fitted on its calibration part (no EOG session).
+    pub hybrid: Option<&'a HybridSource>,
 }
 
 /// The EOG recording that precedes a session: the same user and montage,
@@ -201,10 +207,14 @@ pub fn simulate_session_with(
     mut options: SessionOptions<'_>,
 ) -> Result<CalibrationSession> {
     check_schedule(assessments, window_onsets_secs)?;
-    let (params, calib, montage) = (&setup.generator, &setup.calibration, &setup.montage);
+    let (params, calib) = (&setup.generator, &setup.calibration);
+    let montage = options.hybrid.map_or(&setup.montage, |h| &h.montage);
     let preprocess = &preprocessing(setup);
     let fs = params.sfreq_hz;
-    let eog = eog_session(params, calib, montage, seed)?;
+    let eog = match options.hybrid {
+        Some(h) => (*h.calibration).clone(),
+        None => eog_session(params, calib, montage, seed)?,
+    };
     let decoding = montage.decoding_indices();
     let mut pre = Preprocessor::fit(montage, preprocess, &eog, &decoding)?;
     let preprocessor = pre.clone();
@@ -223,8 +233,12 @@ pub fn simulate_session_with(
         .fold(0.0, f64::max);
     let total = ((last_onset * fs).ceil() as usize + features.span().max(ga_len) + 1).max(1);
 
-    let mut generator =
-        EegGenerator::new(params, montage, seed)?.with_components(options.components);
+    let mut generator: EegStream = match options.hybrid {
+        Some(h) => h.calibration_stream(params, seed)?.into(),
+        None => EegGenerator::new(params, montage, seed)?
+            .with_components(options.components)
+            .into(),
+    };
     for a in assessments {
         generator.schedule(*a);
     }

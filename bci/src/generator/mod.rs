@@ -7,8 +7,14 @@ use crate::erp::AssessmentKind;
 use crate::error::{BciError, Result, check};
 
 mod effects;
+mod hybrid;
 mod realism;
 mod stream;
+
+pub use hybrid::{
+    BASELINE_SECS, EegStream, ErrpTemplate, HybridEeg, HybridSource, MIN_HYBRID_PART_SECS,
+    TEMPLATE_SECS,
+};
 
 pub use realism::Realism;
 pub use stream::*;

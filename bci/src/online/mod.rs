@@ -17,7 +17,7 @@ use crate::classify::ErrorModel;
 use crate::continuous::ContinuousFeatures;
 use crate::erp::AssessmentKind;
 use crate::error::Result;
-use crate::generator::{Assessment, EegBlock, EegGenerator};
+use crate::generator::{Assessment, EegBlock, EegStream};
 use crate::montage::Montage;
 use crate::preprocess::Preprocessor;
 use crate::svm::SvmModel;
@@ -40,7 +40,7 @@ pub const WARM_UP_SECS: f64 = 2.0;
 /// channels, one hop of 62.5 ms at a time.
 #[derive(Debug)]
 pub struct SlidingWindow {
-    generator: EegGenerator,
+    generator: EegStream,
     preprocessor: Preprocessor,
     features: ContinuousFeatures,
     window: EegBlock,
@@ -55,12 +55,13 @@ impl SlidingWindow {
     /// reset copy of `preprocessor`, and lets the filters settle for
     /// [`WARM_UP_SECS`]: recording time 0 is generator time `WARM_UP_SECS`.
     pub fn start(
-        mut generator: EegGenerator,
+        generator: impl Into<EegStream>,
         preprocessor: &Preprocessor,
         features: &ContinuousFeatures,
         montage: &Montage,
     ) -> Result<Self> {
-        let fs = generator.params().sfreq_hz;
+        let mut generator = generator.into();
+        let fs = generator.sfreq_hz();
         let mut preprocessor = preprocessor.clone();
         preprocessor.reset();
         let warm = preprocessor.process(&generator.generate((WARM_UP_SECS * fs) as usize));

@@ -11,7 +11,7 @@ use super::{SlidingWindow, WINDOW_STEP_SECS};
 use crate::continuous::ContinuousFeatures;
 use crate::erp::AssessmentKind;
 use crate::error::{BciError, Result, check};
-use crate::generator::{EegGenerator, GeneratorParams};
+use crate::generator::{EegGenerator, EegStream, GeneratorParams, HybridSource};
 use crate::montage::Montage;
 use crate::preprocess::Preprocessor;
 use crate::rng::stream;
@@ -111,8 +111,25 @@ pub fn record_online(
     params: &Valid<OnlineRecordingParams>,
     seed: u64,
 ) -> Result<OnlineRecording> {
+    record_online_from(generator, None, montage, preprocessor, model, params, seed)
+}
+
+/// [`record_online`] on a person's recording (`hybrid`: its background,
+/// the subject's response), or on the synthetic user without it.
+pub fn record_online_from(
+    generator: &Valid<GeneratorParams>,
+    hybrid: Option<&HybridSource>,
+    montage: &Montage,
+    preprocessor: &Preprocessor,
+    model: &SvmModel,
+    params: &Valid<OnlineRecordingParams>,
+    seed: u64,
+) -> Result<OnlineRecording> {
     let gen_seed = crate::rng::derive_seed(seed, "online/eeg", 0);
-    let eeg = EegGenerator::new(generator, montage, gen_seed)?;
+    let eeg: EegStream = match hybrid {
+        Some(h) => h.online_stream(generator, gen_seed)?.into(),
+        None => EegGenerator::new(generator, montage, gen_seed)?.into(),
+    };
     let features = ContinuousFeatures::paper(generator.sfreq_hz);
     let mut window = SlidingWindow::start(eeg, preprocessor, &features, montage)?;
     let mut gaps = stream(seed, "online/schedule");

@@ -158,3 +158,41 @@ fn arrays_are_matched_and_checked_as_files_are() {
     let e = new(&labels[1..], vec![]).unwrap_err().to_string();
     assert!(e.contains("names for 40 rows"), "{e}");
 }
+
+#[test]
+fn a_hybrid_continuous_calibration_decodes_the_subjects_own_response() {
+    use errp_bci::{
+        ContinuousSetup, ErrpTemplate, HybridSource, SessionOptions, SvmDecoder,
+        calibrate_continuous_with,
+    };
+    let (_, bytes) = exported(400, 0.94, 1);
+    let rec = read(&bytes);
+    let k = 200;
+    let end = ((rec.events[k - 1].onset_secs + 1.0) * 256.0) as usize;
+    let template = ErrpTemplate::from_raw(&rec.raw, 256.0, &rec.events[..k]).unwrap();
+    let fcz = rec.montage.index("FCz").unwrap();
+    // The subject's response at FCz: the ErrP's negativity and positivity.
+    let r = template.response.channel(fcz);
+    let (min, max) = r
+        .iter()
+        .fold((0.0f64, 0.0f64), |(a, b), &x| (a.min(x), b.max(x)));
+    assert!(min < -1.0 && max > 1.0, "{min} {max}");
+    let hybrid =
+        HybridSource::from_recording(&rec.montage, &rec.raw, 256.0, &rec.events, k).unwrap();
+    // The calibration part and the rest: the recording, split where the
+    // part's last epoch ends, nothing shared.
+    assert_eq!(hybrid.calibration.n_samples, end);
+    assert_eq!(
+        hybrid.calibration.n_samples + hybrid.held_out.n_samples,
+        rec.raw.n_samples
+    );
+    let setup = Valid::new(ContinuousSetup::default()).unwrap();
+    let options = SessionOptions {
+        hybrid: Some(&hybrid),
+        ..SessionOptions::default()
+    };
+    let c = calibrate_continuous_with(&SvmDecoder::default(), &setup, 3, options).unwrap();
+    let acc = c.accuracy.mean();
+    eprintln!("hybrid continuous calibration: {acc:.4} (template peak {min:.2} / {max:.2} uV)");
+    assert!(acc > 0.6, "hybrid continuous calibration at {acc}");
+}

@@ -551,7 +551,7 @@ class SweepWarning(UserWarning):
 def sweep(
     out: Optional[PathLike] = None,
     *,
-    accuracy: Union[str, float, Sequence[float]],
+    accuracy: Union[str, float, Sequence[float], None] = None,
     task: Optional[str] = None,
     scenario: Optional[PathLike] = None,
     episodes: int = 100,
@@ -572,6 +572,11 @@ def sweep(
         By default a temporary directory, removed once read.
     accuracy : str, float or list of float
         Decoder accuracies: ``"0.6:0.9:0.05"`` (a range), ``[0.7, 0.8]``.
+        Required, but for a sweep over recordings
+        (``params={"eeg.recording": ["s01.edf", "s02.edf"]}``, paths relative
+        to the scenario's directory, or a scenario with an ``[eeg]``
+        table), which has none: each level's decoder has the accuracy its
+        recording gives (the ``accuracy`` column).
     task : {"grid", "epuck"}, optional
         The task, for its built-in scenario when ``scenario`` is not given.
     scenario : path, optional
@@ -599,7 +604,9 @@ def sweep(
     episodes = _args.whole("episodes", episodes, 1, _core.MAX_EPISODES)
     seed = _args.seed("seed", seed)
     threads = _args.whole("threads", threads, 1, _core.MAX_THREADS, optional=True)
-    if isinstance(accuracy, str):
+    if accuracy is None:
+        acc = None
+    elif isinstance(accuracy, str):
         acc = accuracy
     elif isinstance(accuracy, numbers.Real) and not isinstance(accuracy, bool):
         acc = repr(_args.accuracy("accuracy", accuracy))
@@ -829,6 +836,17 @@ class EpuckTask(_Task):
     ``control.t_e`` (:attr:`t_e`), and is scored over the response spans
     measured for the testbed's decoder.
 
+    With ``eeg``, the runs stream a labelled hybrid of a person's own
+    recording ("hybrid: recorded background, recorded ErrP template"): the
+    recording's continuous EEG as the background (its first part for the
+    calibration, the rest online, looped) and the subject's
+    error-minus-correct response from the first part, added at the
+    simulated user's assessments with the generator's single-trial
+    variability. The SVM is calibrated on it with no accuracy targeted, and
+    T_e is set on the held-out hybrid for the false alarms a minute of the
+    paper-fitted user (5.37). See the guide's chapter "Your own EEG in the
+    loop".
+
     Parameters
     ----------
     scenario : path, optional
@@ -836,6 +854,14 @@ class EpuckTask(_Task):
     decoder : callable, optional
     seed, accuracy, overrides, progress :
         As for :func:`run` (``progress`` shows the calibration's search).
+    eeg : mne.io.Raw, mne.Epochs or path, optional
+        A recording, as for :class:`GridTask`. Not with ``accuracy`` or
+        ``decoder``.
+    eeg_options : dict, optional
+        The keys of an e-puck scenario's ``[eeg]`` table: ``calibration``
+        (default 0.5) or ``calibration_events``, ``error`` and ``correct``,
+        and ``false_alarms_per_min`` (the rate T_e is set for, in (0, 60],
+        default 5.37).
     """
 
     def __init__(
@@ -847,13 +873,26 @@ class EpuckTask(_Task):
         accuracy: Optional[float] = None,
         overrides: Optional[Mapping[str, Any]] = None,
         progress: Optional[bool] = None,
+        eeg: Any = None,
+        eeg_options: Optional[Mapping[str, Any]] = None,
     ) -> None:
+        if eeg is None and eeg_options is not None:
+            raise ValueError("eeg_options: set with eeg=..., a recording to run a hybrid of")
+        if eeg is not None and (accuracy is not None or decoder is not None):
+            raise ValueError(
+                "accuracy and decoder: with eeg=..., the runs stream a hybrid of the "
+                "recording, decoded by the SVM calibrated on its first part, which has the "
+                "accuracy the recording gives (EpuckTask.calibration); no accuracy is "
+                "targeted: leave out accuracy and decoder"
+            )
         keywords = dict(
             decoder=decoder,
             seed=_args.seed("seed", seed, optional=True),
             accuracy=_args.accuracy("accuracy", accuracy, optional=True),
             overrides=None if overrides is None else dict(overrides),
         )
+        if eeg is not None:
+            keywords["eeg"] = _recording.recorded(eeg, eeg_options)
         with _progress.shown(progress, "errp.EpuckTask") as report:
             self._core = _core.EpuckTask(_path(scenario, "scenario"), progress=report, **keywords)
 

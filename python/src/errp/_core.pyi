@@ -159,6 +159,7 @@ class EpuckTask:
         accuracy: Optional[float] = None,
         overrides: Optional[Dict[str, Any]] = None,
         progress: Optional[Progress] = None,
+        eeg: Optional[Dict[str, Any]] = None,
     ) -> None: ...
     def run(
         self,

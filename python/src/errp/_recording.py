@@ -162,12 +162,14 @@ def _from_epochs(epochs, error: str, correct: str) -> dict:
 
 
 def recorded(eeg: Any, options: Optional[Mapping[str, Any]]) -> dict:
-    """What ``_core.GridTask(eeg=...)`` takes from ``eeg``, with
+    """What ``_core.GridTask(eeg=...)`` and ``_core.EpuckTask(eeg=...)``
+    take from ``eeg``, with
     ``options`` (an ``[eeg]`` table's keys but ``recording``)."""
     if options is not None and not isinstance(options, Mapping):
         raise TypeError(
             f"eeg_options: expected a dict of the [eeg] table's keys (calibration, "
-            f"calibration_events, error, correct, draw), got {type(options).__name__}"
+            f"calibration_events, error, correct, draw or false_alarms_per_min), got "
+            f"{type(options).__name__}"
         )
     options = dict(options or {})
     error, correct = _names(options)

@@ -4,12 +4,15 @@
 
 use errp_bci::{
     Accuracy, ContinuousCalibrationParams, ContinuousFeatures, ContinuousSetup, Detector,
-    DetectorMode, DetectorParams, EegGenerator, GeneratorParams, Montage, OnlineRecording,
-    OnlineRecordingParams, OnlineStep, OnlineTarget, OnlineTargeting, OperatingPoint, Preprocessor,
-    ResponseSpan, SlidingWindow, SvmDecoder, SvmModel, TargetingParams, TargetingResult,
-    TargetingStep, Valid, calibrate_continuous, detector_span, operating_point, record_online,
-    rng::derive_seed, target_continuous_accuracy, target_online,
+    DetectorMode, DetectorParams, EegGenerator, EegStream, GeneratorParams, HybridSource, Montage,
+    OnlineRecording, OnlineRecordingParams, OnlineStep, OnlineTarget, OnlineTargeting,
+    OperatingPoint, Preprocessor, ResponseSpan, SlidingWindow, SvmDecoder, SvmModel,
+    TargetingParams, TargetingResult, TargetingStep, Valid, calibrate_continuous, detector_span,
+    operating_point, record_online_from, rng::derive_seed, target_continuous_accuracy,
+    target_online,
 };
+
+use std::sync::Arc;
 
 use crate::calibration::{Report, Request};
 use crate::epuck::params::EpuckTaskParams;
@@ -242,6 +245,13 @@ pub struct ContinuousDecoder {
     /// The operating point on a held-out recording (set by
     /// [`measure_online`](Self::measure_online)).
     pub online: Option<OnlineReport>,
+    /// A person's recording in place of the synthetic user's EEG: the
+    /// held-out recording and the episodes stream its background with the
+    /// subject's response (a hybrid).
+    pub hybrid: Option<Arc<HybridSource>>,
+    /// What the hybrid was made of, and the accuracy the shared control
+    /// assumes (its cross-validated accuracy).
+    pub recorded: Option<Box<crate::epuck::hybrid_report::HybridReport>>,
 }
 
 impl ContinuousDecoder {
@@ -255,6 +265,8 @@ impl ContinuousDecoder {
             model: report.calibrated.model.clone(),
             features: ContinuousFeatures::paper(report.generator.sfreq_hz),
             online: None,
+            hybrid: None,
+            recorded: None,
         }
     }
 
@@ -273,8 +285,9 @@ impl ContinuousDecoder {
     /// The held-out continuous recording of this pipeline for a calibration
     /// seeded `seed`: [`OnlineRecordingParams::default`] of fresh EEG.
     pub fn record_held_out(&self, seed: u64) -> Result<OnlineRecording> {
-        Ok(record_online(
+        Ok(record_online_from(
             &self.generator,
+            self.hybrid.as_deref(),
             &self.montage,
             &self.preprocessor,
             &self.model,
@@ -330,7 +343,10 @@ impl ContinuousDecoder {
     /// filters settled; episode time 0 is generator time
     /// [`WARM_UP_SECS`](errp_bci::WARM_UP_SECS).
     pub fn start_stream(&self, seed: u64) -> Result<SlidingWindow> {
-        let generator = EegGenerator::new(&self.closed_loop, &self.montage, seed)?;
+        let generator: EegStream = match &self.hybrid {
+            Some(h) => h.online_stream(&self.closed_loop, seed)?.into(),
+            None => EegGenerator::new(&self.closed_loop, &self.montage, seed)?.into(),
+        };
         Ok(SlidingWindow::start(
             generator,
             &self.preprocessor,

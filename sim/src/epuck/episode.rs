@@ -203,7 +203,8 @@ pub fn run_epuck_episode_with(
 /// The shared control of an episode of `scenario` with `decoder`. Left
 /// open by the scenario: the stop on a goal, long enough for the user's
 /// verdict on the arrival to reach the detector, and the veto window, the
-/// end of the detector's response span.
+/// end of the detector's response span. On a recording, the control assumes
+/// the recording's cross-validated accuracy.
 pub fn shared_control(
     scenario: &EpuckScenario,
     decoder: &ContinuousDecoder,
@@ -212,6 +213,9 @@ pub fn shared_control(
     let span = decoder.detection_span();
     // A changed copy of the scenario's checked parameters, checked again.
     let control = params.control.with(|c| {
+        if let Some(r) = &decoder.recorded {
+            c.assumed_accuracy = r.accuracy;
+        }
         c.goal_hold_secs = Some(params.goal_hold_secs(&span));
         c.veto_window_secs = Some(c.veto_window_secs.unwrap_or(span.to_secs));
     })?;

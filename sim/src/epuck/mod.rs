@@ -5,6 +5,8 @@
 pub(crate) mod decoder;
 pub(crate) mod environment;
 pub(crate) mod episode;
+pub(crate) mod hybrid;
+pub(crate) mod hybrid_report;
 pub(crate) mod observer;
 pub(crate) mod params;
 pub(crate) mod plant;
@@ -19,6 +21,7 @@ pub(crate) mod user;
 pub(crate) mod view;
 pub(crate) mod world;
 
+pub use crate::recorded::{FITTED_FALSE_ALARMS_PER_MIN, MAX_FALSE_ALARMS_PER_MIN};
 pub use decoder::{
     ContinuousDecoder, ContinuousReport, ContinuousRequest, OnlineReport, calibrate_continuous_at,
     run_continuous_calibration, run_online_calibration, target_continuous,
@@ -26,6 +29,8 @@ pub use decoder::{
 pub use environment::{EpuckAction, EpuckEnvironment, EpuckFeedback, MAX_WINDOWS_PER_ACTION};
 pub use episode::{EpuckEpisodeResult, run_epuck_episode, run_epuck_episode_with, shared_control};
 pub use errp_robot::AvoidanceParams;
+pub use hybrid::{calibrate_on_recording, epuck_decoder_summary, prepare_hybrid};
+pub use hybrid_report::{HYBRID_LABEL, HybridReport};
 pub use observer::{
     EpisodeStart, EpuckObserver, PHASE_NAMES, PhysicsFrame, STEP_NAMES, WindowFrame,
 };

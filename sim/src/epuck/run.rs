@@ -66,13 +66,22 @@ fn continuous_request(scenario: &EpuckScenario) -> Result<ContinuousRequest> {
 /// `progress` sees the search), the calibration session at it, then the
 /// operating point measured on a held-out recording. With an online target
 /// (`[user] hit_rate`), the search that `online_progress` sees, which
-/// measures the operating point at every step and is not cached.
+/// measures the operating point at every step and is not cached. With a
+/// person's recording, the hybrid ([`crate::epuck::prepare_hybrid`]).
 pub fn prepare_epuck_decoder(
     scenario: &EpuckScenario,
     cache: &dyn TargetingCache,
     mut progress: impl FnMut(&TargetingStep),
     online_progress: impl FnMut(&OnlineStep),
 ) -> Result<PreparedEpuck> {
+    if let Some(eeg) = &scenario.recording {
+        let (decoder, report) = crate::epuck::hybrid::prepare_hybrid(scenario, eeg)?;
+        return Ok(PreparedEpuck {
+            decoder,
+            report,
+            cached: false,
+        });
+    }
     let request = continuous_request(scenario)?;
     match scenario.online_target {
         None => {

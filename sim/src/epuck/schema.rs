@@ -29,7 +29,12 @@ pub(crate) struct EpuckFile {
     pub(crate) runs: Option<f64>,
     #[serde(default = "default_max_secs")]
     pub(crate) max_secs: f64,
+    /// Required but with a recording (`[eeg]`), whose user is the person.
+    #[serde(default)]
     pub(crate) user: UserFile,
+    /// A person's recording in place of the synthetic user's EEG.
+    #[serde(default)]
+    pub(crate) eeg: Option<crate::recorded::RecordedTable>,
     /// Straight into the robot's type: its field names are the file's.
     #[serde(default)]
     pub(crate) control: ContinuousControlParams,
@@ -101,7 +106,7 @@ impl<'de> Deserialize<'de> for StartFile {
     }
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct UserFile {
     pub(crate) seed: Option<u64>,

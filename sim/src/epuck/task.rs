@@ -106,8 +106,20 @@ impl Task for EpuckTask {
     /// The held-out operating point, and with an online target the
     /// calibration itself, depend on the detector and T_e too.
     fn decoder_key(s: &EpuckScenario) -> String {
-        StableKey::new("epuck-decoder", 1)
-            .float("accuracy", s.accuracy.get())
+        let key = StableKey::new("epuck-decoder", 1);
+        let key = match &s.recording {
+            None => key,
+            Some(r) => key
+                .text("recording", &r.file.display().to_string())
+                .text("calibration", &format!("{:?}", r.part))
+                .text("error", &r.names.error)
+                .text("correct", &r.names.correct)
+                .text(
+                    "false_alarms_per_min",
+                    &format!("{:?}", r.false_alarms_per_min),
+                ),
+        };
+        key.float("accuracy", s.accuracy.get())
             .int("user_seed", s.user_seed)
             .value("online_target", &s.online_target)
             .value("detector", &s.params.detector)
@@ -128,16 +140,25 @@ impl Task for EpuckTask {
         let prepared = prepare_epuck_decoder(s, cache, |_| {}, |_| {})?;
         let a = prepared.report.calibrated.accuracy;
         let point = prepared.decoder.online.as_ref().map(|o| o.point);
+        let recorded = prepared.decoder.recorded.as_deref();
         let info = DecoderInfo {
-            accuracy: s.accuracy.get(),
-            kind: "svm".into(),
+            // On a recording, the accuracy it gives (the control assumes it).
+            accuracy: recorded.map_or(s.accuracy.get(), |r| r.accuracy),
+            kind: if s.recording.is_some() {
+                "svm-hybrid".into()
+            } else {
+                "svm".into()
+            },
             calibration_seed: s.user_seed,
-            errp_to_noise: Some(prepared.report.targeting.ratio),
+            errp_to_noise: recorded
+                .is_none()
+                .then_some(prepared.report.targeting.ratio),
             cv_correct: Some(a.correct),
             cv_error: Some(a.error),
             cv_mean: Some(a.mean()),
             online_hit_rate: point.map(|p| p.hit_rate),
             online_false_alarms_per_min: point.map(|p| p.false_alarms_per_min),
+            recording: recorded.map(|r| r.file.clone()),
             cached: prepared.cached,
         };
         Ok((prepared.decoder, info))

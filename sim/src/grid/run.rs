@@ -109,6 +109,7 @@ impl PreparedGrid {
             cv_mean: accuracy.map(|a| a.mean()),
             online_hit_rate: None,
             online_false_alarms_per_min: None,
+            recording: recorded.map(|r| r.file.clone()),
             cached: self.cached,
         }
     }

@@ -16,7 +16,7 @@ use crate::error::Result;
 use crate::grid::p_error::PErrorChoice;
 use crate::grid::params::{GridTaskParams, TimingFile, set_timing};
 pub use crate::grid::params::{MAX_ACTIONS, MAX_INTERVAL_SECS};
-use crate::recorded::{RecordedEeg, RecordedFile};
+use crate::recorded::{RecordedEeg, RecordedFile, RecordedTask};
 use crate::scenario_file::{
     Pair, checked_realism, field_error, parse_toml, robot_error, scenario_name, table_into, whole,
 };
@@ -275,7 +275,10 @@ impl GridScenario {
         let (eeg, recorded) = match &file.eeg {
             None => (EegMode::Stream, None),
             Some(EegFile::Mode(mode)) => (*mode, None),
-            Some(EegFile::Recorded(r)) => (EegMode::Bank, Some(r.clone().check(path)?)),
+            Some(EegFile::Recorded(r)) => (
+                EegMode::Bank,
+                Some(r.clone().check(path, RecordedTask::Grid)?),
+            ),
         };
         let (accuracy, user) = match recorded {
             Some(r) => {

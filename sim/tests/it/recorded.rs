@@ -171,6 +171,20 @@ fn a_recordings_scenario_refuses_a_simulated_users_settings() {
             "{field}: {e}"
         );
     }
+    // The e-puck's T_e key is not the grid's.
+    let path = d.join("fa.toml");
+    std::fs::write(
+        &path,
+        "task = \"grid\"\n[free_goals]\ncount = 2\n[eeg]\nrecording = \"s.edf\"\nfalse_alarms_per_min = 2\n",
+    )
+    .unwrap();
+    let e = ScenarioInput::load_as_written(ScenarioSource::File(path))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("field `eeg.false_alarms_per_min`") && e.contains("grid"),
+        "{e}"
+    );
     // A simulated user's [realism] is not used, and the user says so.
     let path = d.join("r.toml");
     std::fs::write(
@@ -187,4 +201,29 @@ fn a_recordings_scenario_refuses_a_simulated_users_settings() {
     assert_eq!(s.user, "recording s.edf ([realism] not used)");
     assert_eq!(s.realism, errp_bci::Realism::default());
     std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// The false-alarm rate a recording's T_e is set for by default is the
+/// paper-fitted user's, as its committed figure prints it.
+#[test]
+fn the_hybrids_false_alarm_rate_is_the_fitted_users() {
+    let figure = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../docs/figures/epuck_mexico_default.txt"),
+    )
+    .unwrap();
+    let line = figure
+        .lines()
+        .find(|l| {
+            l.trim_start()
+                .starts_with("detector: mean of 4 windows >= 0.8")
+        })
+        .expect("the detector's operating point in the figure");
+    let rate: f64 = line
+        .split("false alarms")
+        .nth(1)
+        .and_then(|r| r.trim().split('/').next())
+        .and_then(|r| r.trim().parse().ok())
+        .expect("a false-alarm rate");
+    assert_eq!(rate, errp_sim::epuck::FITTED_FALSE_ALARMS_PER_MIN, "{line}");
 }

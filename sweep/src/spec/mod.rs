@@ -158,7 +158,8 @@ impl CheckedSweep {
 pub struct Level {
     /// Position in the sweep (accuracy varies fastest).
     pub index: usize,
-    /// The decoder's accuracy.
+    /// The decoder's accuracy: the level's, or on recordings the one its
+    /// recording gives, set once its decoder is prepared (0 before).
     pub accuracy: f64,
     /// One value per axis.
     pub values: Vec<Value>,
@@ -180,6 +181,10 @@ pub const MAX_EPISODES: usize = 1_000_000;
 
 /// Most levels in a sweep (accuracies times every swept value).
 pub const MAX_LEVELS: usize = 1000;
+
+/// The key of a recording in a scenario, and the axis that sweeps
+/// recordings (`--param eeg.recording=a.edf,b.edf`).
+pub const RECORDING_KEY: &str = "eeg.recording";
 
 impl SweepSpec {
     /// True if `self` and `other` are one sweep: the same scenario text
@@ -204,15 +209,44 @@ impl SweepSpec {
 
     /// Levels: every combination of the axes' values, at every accuracy.
     pub fn n_levels(&self) -> usize {
-        self.accuracies.len() * self.axes.iter().map(|a| a.values.len()).product::<usize>()
+        self.accuracies.len().max(1) * self.axes.iter().map(|a| a.values.len()).product::<usize>()
+    }
+
+    /// True if the sweep's EEG is a person's recording, in the scenario
+    /// (`[eeg] recording = ...`) or swept (`--param eeg.recording=a.edf,b.edf`):
+    /// its levels then have no accuracy set, each decoder the accuracy its
+    /// recording gives.
+    pub fn on_recordings(&self) -> bool {
+        let written = toml::from_str::<Table>(&self.scenario_toml).is_ok_and(|t| {
+            t.get("eeg")
+                .and_then(Value::as_table)
+                .is_some_and(|e| e.contains_key("recording"))
+        });
+        written || self.axes.iter().any(|a| a.key == RECORDING_KEY)
+    }
+
+    /// The seed of episode `k` of `level`: at its accuracy
+    /// ([`episode_seed`](Self::episode_seed)), or on recordings one sequence
+    /// for every level (common random numbers: the subjects face the same
+    /// goals and noise).
+    pub fn level_episode_seed(&self, level: &Level, k: usize) -> u64 {
+        if self.accuracies.is_empty() {
+            let base = errp_bci::rng::derive_seed(self.seed, "sweep/recordings", 0);
+            errp_bci::rng::derive_seed(base, "sweep/episode", k as u64)
+        } else {
+            self.episode_seed(level.accuracy, k)
+        }
     }
 
     /// The accuracy and axis values of level `index` (accuracy fastest, then
     /// the last axis).
     pub fn level_values(&self, index: usize) -> (f64, Vec<Value>) {
         let mut rest = index;
-        let accuracy = self.accuracies[rest % self.accuracies.len()];
-        rest /= self.accuracies.len();
+        // On recordings, no accuracy is set: 0 until each level's decoder
+        // is prepared (`Level::accuracy`).
+        let n = self.accuracies.len().max(1);
+        let accuracy = self.accuracies.get(rest % n).copied().unwrap_or(0.0);
+        rest /= n;
         let mut values = vec![Value::Boolean(false); self.axes.len()];
         for (i, axis) in self.axes.iter().enumerate().rev() {
             values[i] = axis.values[rest % axis.values.len()].clone();
@@ -260,15 +294,17 @@ impl SweepSpec {
                 names.episodes, self.episodes
             )));
         }
-        if self.accuracies.is_empty() {
+        if self.accuracies.is_empty() && !self.on_recordings() {
             return Err(SimError::Sweep(format!("{accuracy} gives no level")));
         }
         let levels = self
             .axes
             .iter()
-            .try_fold(self.accuracies.len(), |n, a| n.checked_mul(a.values.len()));
+            .try_fold(self.accuracies.len().max(1), |n, a| {
+                n.checked_mul(a.values.len())
+            });
         if levels.is_none_or(|n| n > MAX_LEVELS) {
-            let sizes: Vec<String> = std::iter::once(self.accuracies.len())
+            let sizes: Vec<String> = std::iter::once(self.accuracies.len().max(1))
                 .chain(self.axes.iter().map(|a| a.values.len()))
                 .map(|n| n.to_string())
                 .collect();
@@ -327,34 +363,38 @@ impl SweepSpec {
         Ok(CheckedSweep { spec: self, levels })
     }
 
-    /// Refuses a person's recording as the EEG (`[eeg] recording = ...`,
-    /// in the file or swept): a sweep's levels are synthetic users targeted
-    /// at its accuracies, and a recording has the accuracy it gives.
-    fn refuse_recordings(&self, table: &Table) -> Result<()> {
-        let written = table
-            .get("eeg")
-            .and_then(Value::as_table)
-            .and_then(|t| t.get("recording"))
-            .map(|r| {
-                format!(
-                    "{}: its EEG is a recording (eeg.recording = {r})",
-                    self.scenario_path.display()
-                )
-            });
-        let swept = self
-            .axes
-            .iter()
-            .find(|a| a.key.starts_with("eeg."))
-            .map(|a| format!("the swept {}", a.key));
-        match written.or(swept) {
-            Some(what) => Err(SimError::Sweep(format!(
-                "{what}: a sweep runs synthetic users targeted at its accuracies, and a \
-                 recording's decoder has the accuracy the recording gives; run a recording \
-                 with `errp run` (its [free_goals] or [[episode]] tables and `repeats` set \
-                 how many episodes)"
-            ))),
-            None => Ok(()),
+    /// Checks a sweep over a person's recordings (`[eeg] recording = ...`
+    /// in the file, or `eeg.recording` swept): no accuracy levels (a
+    /// recording's decoder has the accuracy it gives) and no EEG mode set
+    /// for every level (the `[eeg]` table is the recording's).
+    fn check_recordings(&self, names: &InputNames) -> Result<()> {
+        if !self.on_recordings() {
+            return Ok(());
         }
+        let what = if self.axes.iter().any(|a| a.key == RECORDING_KEY) {
+            format!("the swept {RECORDING_KEY}")
+        } else {
+            format!(
+                "{}: its EEG is a recording ({RECORDING_KEY})",
+                self.scenario_path.display()
+            )
+        };
+        if !self.accuracies.is_empty() {
+            return Err(SimError::Sweep(format!(
+                "{} with {what}: a recording's decoder is calibrated on its first part and has \
+                 the accuracy the recording gives (the sweep reports it per level); no accuracy \
+                 is targeted: leave out {}",
+                names.accuracy, names.accuracy
+            )));
+        }
+        if let Some((_, v)) = self.fixed.iter().find(|(k, _)| k == "eeg") {
+            return Err(SimError::Sweep(format!(
+                "{} {} with {what}: the recording is the EEG; leave it out",
+                names.eeg,
+                value_text(v)
+            )));
+        }
+        Ok(())
     }
 
     /// Builds and validates every level's scenario. An invalid swept value
@@ -362,14 +402,17 @@ impl SweepSpec {
     pub(crate) fn levels(&self, names: &InputNames) -> Result<Vec<Level>> {
         self.check(names)?;
         // The file's own errors quote its lines.
-        let table: Table = parse_toml(&self.scenario_toml, &self.scenario_path)?;
-        self.refuse_recordings(&table)?;
+        let _: Table = parse_toml(&self.scenario_toml, &self.scenario_path)?;
+        self.check_recordings(names)?;
+        let recordings = self.accuracies.is_empty();
         (0..self.n_levels())
             .map(|index| {
                 let (accuracy, values) = self.level_values(index);
                 let context = |why: String| {
                     let mut label = format!("accuracy={}", format_number(accuracy));
-                    if !self.axes.is_empty() {
+                    if recordings {
+                        label = self.series_label(&values);
+                    } else if !self.axes.is_empty() {
                         label = format!("{label}, {}", self.series_label(&values));
                     }
                     SimError::Sweep(format!("sweep level {label}: {why}"))
@@ -377,13 +420,13 @@ impl SweepSpec {
                 // The level's accuracy replaces the file's decoder (an online
                 // target included); the sweep's seed gives the user (the
                 // calibration).
-                let mut keys: Vec<(String, Value)> = vec![
-                    ("user.accuracy".into(), Value::Float(accuracy)),
-                    (
-                        "seed".into(),
-                        Value::Integer(self.calibration_seed() as i64),
-                    ),
-                ];
+                let mut keys: Vec<(String, Value)> = vec![(
+                    "seed".into(),
+                    Value::Integer(self.calibration_seed() as i64),
+                )];
+                if !recordings {
+                    keys.insert(0, ("user.accuracy".into(), Value::Float(accuracy)));
+                }
                 keys.extend(self.fixed.iter().cloned());
                 for (a, v) in self.axes.iter().zip(&values) {
                     keys.push((a.key.clone(), v.clone()));

@@ -7,6 +7,7 @@
 
 mod fit;
 mod integrity;
+mod recorded;
 mod results;
 
 use std::path::{Path, PathBuf};

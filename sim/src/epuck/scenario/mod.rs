@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use errp_bci::{DetectorMode, DetectorParams, MeanAccuracy, OnlineTarget, Realism};
 use errp_robot::{ContinuousControlParams, GoalLayout, Pose, Valid};
 
+use crate::epuck::hybrid_report::HYBRID_LABEL;
 use crate::epuck::params::{EpuckEpisode, EpuckTaskParams};
 use crate::epuck::schema::{
     DetectorFile, EpuckFile, ObstacleFile, StartFile, TrackerFile, UserFile,
@@ -16,6 +17,7 @@ use crate::epuck::tracker::TrackerParams;
 use crate::epuck::user::UserParams;
 use crate::epuck::world::{ArenaSpec, Obstacle};
 use crate::error::{Result, SimError};
+use crate::recorded::{RecordedEeg, RecordedTask};
 use crate::scenario_file::{
     checked_realism, field_error, parse_toml, robot_error, scenario_name, table_into, whole,
 };
@@ -87,8 +89,12 @@ pub struct EpuckScenario {
     pub layout: GoalLayout,
     /// Robot, control, user, tracker, avoidance, time-out.
     pub params: EpuckTaskParams,
-    /// How far the simulated user is from the ideal one (`[realism]`).
+    /// How far the simulated user is from the ideal one (`[realism]`; the
+    /// ideal one with a recording).
     pub realism: Realism,
+    /// A person's recording in place of the synthetic user's EEG (`[eeg]`):
+    /// the decoder is calibrated and run on a hybrid of it.
+    pub recording: Option<Box<RecordedEeg>>,
 }
 
 impl EpuckScenario {
@@ -102,6 +108,9 @@ impl EpuckScenario {
     /// The decoder in words, as `errp run` prints it and its recording
     /// shows it: "decoder accuracy 75.00 %", or the online target.
     pub fn decoder_text(&self) -> String {
+        if let Some(r) = &self.recording {
+            return format!("{HYBRID_LABEL} (recording {})", r.written);
+        }
         match self.online_target {
             None => format!("decoder accuracy {:.2} %", 100.0 * self.accuracy.get()),
             Some(t) => format!(
@@ -112,6 +121,18 @@ impl EpuckScenario {
                     .unwrap_or_default()
             ),
         }
+    }
+
+    /// This scenario on a person's recording `eeg` (given in memory, from
+    /// Python): its runs on a hybrid of it, its decoder calibrated on the
+    /// recording's first part with no accuracy targeted and T_e set for a
+    /// false-alarm rate (a simulated user's `[realism]` and decoder target
+    /// are not used).
+    pub fn on_recording(mut self, eeg: RecordedEeg) -> Self {
+        self.realism = Realism::default();
+        self.online_target = None;
+        self.recording = Some(Box::new(eeg));
+        self
     }
 
     /// Validates scenario text; `path` names it in errors.
@@ -156,7 +177,19 @@ impl EpuckScenario {
                 "a goal away from the start",
             ));
         }
-        let (online_target, accuracy) = decoder_target(&file.user, given("control", "t_e"), path)?;
+        let recording = match file.eeg.clone() {
+            Some(r) => Some(Box::new(r.0.check(path, RecordedTask::Epuck)?)),
+            None => None,
+        };
+        let (online_target, accuracy) = match &recording {
+            Some(_) => {
+                refuse_with_recording(&file.user, given("control", "t_e"), path)?;
+                // Not targeted: the accuracy the control assumes is the
+                // recording's, set once it is calibrated.
+                (None, MeanAccuracy::new(RECORDING_PLACEHOLDER_ACCURACY)?)
+            }
+            None => decoder_target(&file.user, given("control", "t_e"), path)?,
+        };
         params.user = user_params(&file.user, path)?;
         if let Some(d) = &file.detector {
             params.detector = detector_params(d, path)?;
@@ -187,7 +220,11 @@ impl EpuckScenario {
             None => 1,
         };
         let arena = arena(&file, &layout, start, radius_m, path)?;
-        let realism = checked_realism(file.realism.clone(), path)?;
+        let mut realism = checked_realism(file.realism.clone(), path)?;
+        if recording.is_some() {
+            // The recording is the person; [realism] describes a simulated one.
+            realism = Realism::default();
+        }
 
         Ok(Self {
             path: path.to_path_buf(),
@@ -203,8 +240,42 @@ impl EpuckScenario {
             layout,
             params,
             realism,
+            recording,
         })
     }
+}
+
+/// The accuracy an e-puck scenario on a recording holds until its decoder
+/// is calibrated (nothing reads it: the control assumes the recording's).
+const RECORDING_PLACEHOLDER_ACCURACY: f64 = 0.75;
+
+/// Refuses what a scenario whose EEG is a recording cannot also set: a
+/// decoder target (the recording has the accuracy it gives) and T_e (set
+/// for a false-alarm rate on the recording).
+fn refuse_with_recording(u: &UserFile, t_e_given: bool, path: &Path) -> Result<()> {
+    let bad =
+        |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
+    const WHY: &str = "nothing, with a recording (eeg.recording): the decoder is calibrated on \
+                       the recording's first part and has the accuracy the recording gives; no \
+                       accuracy is targeted";
+    for (field, value) in [
+        ("user.accuracy", u.accuracy),
+        ("user.hit_rate", u.hit_rate),
+        ("user.false_alarms_per_min", u.false_alarms_per_min),
+    ] {
+        if let Some(v) = value {
+            return Err(bad(field, v.to_string(), WHY));
+        }
+    }
+    if t_e_given {
+        return Err(bad(
+            "control.t_e",
+            "given".into(),
+            "no t_e with a recording (eeg.recording): T_e is set on the recording for \
+             eeg.false_alarms_per_min",
+        ));
+    }
+    Ok(())
 }
 
 /// Where the e-puck starts: a city or a position inside the arena (the
