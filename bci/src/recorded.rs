@@ -306,12 +306,7 @@ pub fn split_recording(
     }
     let calibration = &recording.events[..k];
     count_classes(calibration, "calibration part", MIN_CALIBRATION_PER_CLASS)?;
-    let mut fit_on = EegBlock::zeros(recording.raw.n_channels, end);
-    for ch in 0..fit_on.n_channels {
-        fit_on
-            .channel_mut(ch)
-            .copy_from_slice(&recording.raw.channel(ch)[..end]);
-    }
+    let fit_on = recording.raw.samples(0..end);
     let decoding = recording.montage.decoding_indices();
     let preprocessor = Preprocessor::fit(&recording.montage, preprocessing, &fit_on, &decoding)
         .map_err(|e| match e {
@@ -335,12 +330,7 @@ pub fn split_recording(
             dropped += 1;
             continue;
         }
-        let mut block = EegBlock::zeros(decoded.n_channels, span);
-        for ch in 0..decoded.n_channels {
-            block
-                .channel_mut(ch)
-                .copy_from_slice(&decoded.channel(ch)[at..at + span]);
-        }
+        let block = decoded.samples(at..at + span);
         held_out.push(RecordedEpoch {
             event: i,
             onset_secs: e.onset_secs,

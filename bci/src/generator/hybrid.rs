@@ -279,8 +279,8 @@ impl HybridSource {
         }
         Ok(Self {
             montage: montage.clone(),
-            calibration: Arc::new(columns(&background, 0, end)),
-            held_out: Arc::new(columns(&background, end, raw.n_samples)),
+            calibration: Arc::new(background.samples(0..end)),
+            held_out: Arc::new(background.samples(end..raw.n_samples)),
             template: Arc::new(template),
         })
     }
@@ -311,16 +311,6 @@ impl HybridSource {
             seed,
         )
     }
-}
-
-/// Samples `from..to` of every channel of `block`.
-fn columns(block: &EegBlock, from: usize, to: usize) -> EegBlock {
-    let mut out = EegBlock::zeros(block.n_channels, to - from);
-    for ch in 0..out.n_channels {
-        out.channel_mut(ch)
-            .copy_from_slice(&block.channel(ch)[from..to]);
-    }
-    out
 }
 
 #[cfg(test)]

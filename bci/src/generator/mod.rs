@@ -215,6 +215,20 @@ impl EegBlock {
         &mut self.data[ch * self.n_samples..(ch + 1) * self.n_samples]
     }
 
+    /// Samples `range` of every channel, as a block of their own.
+    pub fn samples(&self, range: std::ops::Range<usize>) -> EegBlock {
+        let n_samples = range.len();
+        let mut data = Vec::with_capacity(self.n_channels * n_samples);
+        for ch in 0..self.n_channels {
+            data.extend_from_slice(&self.channel(ch)[range.clone()]);
+        }
+        EegBlock {
+            n_channels: self.n_channels,
+            n_samples,
+            data,
+        }
+    }
+
     /// The blocks one after another (all with the same channel count), in
     /// one allocation: for many blocks, where repeated [`append`]s would
     /// copy the growing block each time.

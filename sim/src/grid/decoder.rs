@@ -415,12 +415,7 @@ impl OnlineEeg {
     pub(crate) fn epoch_block(&mut self, error: bool, interval_secs: f64) -> (EegBlock, Vec<f64>) {
         let clean = self.interval(error, interval_secs);
         let span = self.window.span();
-        let mut epoch = EegBlock::zeros(clean.n_channels, span);
-        for ch in 0..clean.n_channels {
-            epoch
-                .channel_mut(ch)
-                .copy_from_slice(&clean.channel(ch)[..span]);
-        }
+        let epoch = clean.samples(0..span);
         let fcz = epoch.channel(self.fcz_row).to_vec();
         (epoch, fcz)
     }
