@@ -108,6 +108,17 @@ FLAG_CASES = [
     ["run", "/dev/zero"], ["run", "SCEN_GRID", "--save", "/proc/x.rrd"],
     ["table1", "--episodes", "0"], ["table1", "--episodes", "1001"], ["table1", "--seed", "-5"],
 ] + [
+    ["stream", "SCEN_GRID"] + extra for extra in [
+        ["--speed", "0"], ["--speed", "nan"], ["--speed", "101"], ["--speed", "x"],
+        ["--timeout", "-1"], ["--timeout", "inf"], ["--timeout", "3601"],
+        ["--calibration-actions", "39"], ["--calibration-actions", "4001"],
+        ["--calibration-actions", "-1"], ["--decisions", "x"], ["--decisions", "name="],
+        ["--decisions", "host=a"], ["--runs", "0"], ["--accuracy", "0.4"],
+        ["--liblsl", "/dev/zero"], ["--liblsl", "OUT/missing.so"],
+    ]
+] + [
+    ["stream", "OUT/nothing.toml"], ["stream", "/dev/zero"], ["stream", "OUT"],
+] + [
     ["sweep", "--task", "grid", "--no-cache", "--out", "OUT/s"] + extra for extra in [
         ["--accuracy", "0.7,0.7"], ["--accuracy", "0.4"], ["--accuracy", "0.9:0.5:0.1"],
         ["--accuracy", "0.5:1:0.000001"], ["--param", "tau=0.3,0.3"],

@@ -44,6 +44,8 @@ ELSEWHERE = {
     "python3 -m venv .venv": ".ci/run, step 'the Python package' (a venv, pip install "
                              "\"./python[examples,test]\")",
     "scripts/slurm/submit.sh": ".ci/run, step 'Slurm' (scripts/slurm/test.sh submits with it)",
+    "errp stream ": ".ci/run, step 'your online BCI in the loop' (beside the reference client)",
+    "python python/examples/lsl_decoder.py": ".ci/run, step 'your online BCI in the loop'",
 }
 # Lines that only set the shell up: kept for the variables, not commands.
 ASSIGNMENT = re.compile(r"^(?:export\s+)?([A-Za-z_][A-Za-z0-9_]*=\S.*)$")

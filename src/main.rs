@@ -68,6 +68,11 @@ enum Command {
     /// each run recomputed from it (the table `errp run` printed), tidy CSV
     /// tables, and the paper's Fig. 5 (e-puck) or Fig. 4 (grid).
     Inspect(InspectArgs),
+    /// Run a grid scenario on the wall clock over Lab Streaming Layer, with
+    /// your own online decoder in the loop: the simulated user's EEG (40
+    /// channels, 256 Hz, µV), markers and state out, p(error) per action
+    /// back from your decoder's stream; the calibration session first.
+    Stream(commands::stream::StreamArgs),
 }
 
 fn main() -> ExitCode {
@@ -78,6 +83,7 @@ fn main() -> ExitCode {
         Command::Run(args) => run::run(&args),
         Command::Table1(args) => table1::table1(&args),
         Command::Subjects => calibrate::print_subjects(),
+        Command::Stream(args) => commands::stream::stream(&args),
         Command::Realism(args) => commands::realism::realism(&args),
         Command::Merge(args) => sweep::merge(&args),
         #[cfg(feature = "rerun")]

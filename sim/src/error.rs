@@ -20,6 +20,10 @@ pub enum SimError {
     /// match, shards that do not merge).
     #[error("{0}")]
     Sweep(String),
+    /// A live loop stopped: its decoder did not appear, went silent or
+    /// sent what is not a decision.
+    #[error("{0}")]
+    Live(String),
     /// An input file cannot be read.
     #[error("cannot read {path}: {source}")]
     Input {

@@ -14,6 +14,8 @@
 //! - [`record`]: `.rrd` files, the timelines they share, and the data
 //!   tables and provenance every recording carries;
 //! - [`inspect`]: recordings read back, each run recomputed from them;
+//! - [`live`]: the loop on the wall clock with a decoder outside the
+//!   process (`errp stream`);
 //! - [`task`]: what a Monte Carlo driver (the sweep) needs of a task;
 //! - at the top: scenario files of either task, the paper's numbers,
 //!   statistics, atomic output files, the host and process behind files
@@ -71,6 +73,7 @@ mod input;
 #[cfg(feature = "rerun")]
 pub mod inspect;
 mod key;
+pub mod live;
 mod output;
 mod paper;
 pub mod realism;

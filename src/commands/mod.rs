@@ -6,6 +6,7 @@ pub(crate) mod fit;
 pub(crate) mod inspect;
 pub(crate) mod realism;
 pub(crate) mod run;
+pub(crate) mod stream;
 pub(crate) mod sweep;
 pub(crate) mod table1;
 

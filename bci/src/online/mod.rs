@@ -46,6 +46,8 @@ pub struct SlidingWindow {
     window: EegBlock,
     scratch: Vec<f64>,
     raw: EegBlock,
+    /// The raw samples of the warm-up, all channels.
+    warm_up: EegBlock,
     /// Rows of FCz and Cz among the preprocessed channels.
     fcz_cz: [usize; 2],
 }
@@ -64,7 +66,8 @@ impl SlidingWindow {
         let fs = generator.sfreq_hz();
         let mut preprocessor = preprocessor.clone();
         preprocessor.reset();
-        let warm = preprocessor.process(&generator.generate((WARM_UP_SECS * fs) as usize));
+        let warm_up = generator.generate((WARM_UP_SECS * fs) as usize);
+        let warm = preprocessor.process(&warm_up);
         let span = features.span();
         let mut window = EegBlock::zeros(warm.n_channels, span);
         for ch in 0..warm.n_channels {
@@ -90,6 +93,7 @@ impl SlidingWindow {
             window,
             scratch: Vec::with_capacity(features.n_features(warm.n_channels)),
             raw: EegBlock::zeros(montage.len(), hop),
+            warm_up,
             fcz_cz,
         })
     }
@@ -116,6 +120,18 @@ impl SlidingWindow {
             w[n - hop..].copy_from_slice(fresh.channel(ch));
         }
         fresh
+    }
+
+    /// The raw samples of the warm-up ([`WARM_UP_SECS`] before recording
+    /// time 0), all channels.
+    pub fn warm_up_raw(&self) -> &EegBlock {
+        &self.warm_up
+    }
+
+    /// The raw samples of the last hop, all channels `(n_channels, hop)`:
+    /// what an amplifier would have delivered.
+    pub fn raw(&self) -> &EegBlock {
+        &self.raw
     }
 
     /// p(error) of the current window.

@@ -12,7 +12,7 @@ use errp_robot::{Pose, WheelSpeeds};
 
 use crate::epuck::decoder::ContinuousDecoder;
 use crate::epuck::observer::{EpisodeStart, EpuckObserver};
-use crate::epuck::plant::{EpuckDriver, EpuckPlant, PlantWindow};
+use crate::epuck::plant::{EpuckDriver, EpuckPlant, PlantWindow, WindowDecoding};
 use crate::epuck::scenario::EpuckScenario;
 use crate::error::{Result, SimError};
 
@@ -278,7 +278,8 @@ impl EpuckEnvironment {
         driver: &mut impl EpuckDriver,
         observer: &mut impl EpuckObserver,
     ) -> Result<PlantWindow> {
-        self.plant.window(driver, &self.decoder, None, observer)
+        self.plant
+            .window(driver, &self.decoder, WindowDecoding::Builtin, observer)
     }
 
     /// The wheel command of `action` at the scenario's speeds.

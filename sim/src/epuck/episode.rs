@@ -11,7 +11,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::epuck::decoder::ContinuousDecoder;
 use crate::epuck::observer::EpuckObserver;
-use crate::epuck::plant::{EpuckPlant, WINDOW_STEP_SECS, WindowDecoder};
+use crate::epuck::plant::{
+    EpuckPlant, LiveWindowDecoder, WINDOW_STEP_SECS, WindowDecoder, WindowDecoding,
+};
 use crate::epuck::scenario::EpuckScenario;
 use crate::error::Result;
 
@@ -105,9 +107,45 @@ pub fn run_epuck_episode_with(
     observer: &mut impl EpuckObserver,
     mut window_decoder: Option<WindowDecoder<'_>>,
 ) -> Result<EpuckEpisodeResult> {
+    let mode = match window_decoder.as_mut() {
+        Some(d) => Mode::Own(d),
+        None => Mode::Builtin,
+    };
+    run_episode(scenario, decoder, seed, observer, mode)
+}
+
+/// [`run_epuck_episode`] with a decoder outside the process, live
+/// (`errp stream`): `live` streams each window's raw EEG and returns the
+/// p(error)s that came for it. The detector runs at the scenario's
+/// `control.t_e`, as for a decoder of the user's own.
+pub fn run_epuck_episode_live(
+    scenario: &EpuckScenario,
+    decoder: &ContinuousDecoder,
+    seed: u64,
+    live: LiveWindowDecoder<'_>,
+) -> Result<EpuckEpisodeResult> {
+    run_episode(scenario, decoder, seed, &mut (), Mode::Live(live))
+}
+
+/// Which decoder reads the windows of an episode.
+enum Mode<'d, 'a> {
+    Builtin,
+    Own(&'d mut WindowDecoder<'a>),
+    Live(LiveWindowDecoder<'a>),
+}
+
+/// The one episode loop of every [`Mode`].
+fn run_episode(
+    scenario: &EpuckScenario,
+    decoder: &ContinuousDecoder,
+    seed: u64,
+    observer: &mut impl EpuckObserver,
+    mut mode: Mode<'_, '_>,
+) -> Result<EpuckEpisodeResult> {
     let goal = scenario.episode.goal;
     let names = scenario.layout.goals();
-    let mut plant = EpuckPlant::new(scenario, goal, decoder, window_decoder.is_some(), seed)?;
+    let own = !matches!(mode, Mode::Builtin);
+    let mut plant = EpuckPlant::new(scenario, goal, decoder, own, seed)?;
     let mut controller = shared_control(scenario, decoder)?;
     let mut score = Score::new(decoder.detection_span(), decoder.window_span(), plant.t_e());
     let watching = observer.watches();
@@ -125,7 +163,14 @@ pub fn run_epuck_episode_with(
         if k % 16 == 0 {
             errp_bci::stop::check()?;
         }
-        let w = plant.window(&mut controller, decoder, window_decoder.as_mut(), observer)?;
+        let live = matches!(mode, Mode::Live(_));
+        let belief = live.then(|| controller.belief().probabilities());
+        let decoding = match &mut mode {
+            Mode::Builtin => WindowDecoding::Builtin,
+            Mode::Own(d) => WindowDecoding::Own(&mut **d),
+            Mode::Live(d) => WindowDecoding::Live(d, belief.as_deref().unwrap_or_default()),
+        };
+        let w = plant.window(&mut controller, decoder, decoding, observer)?;
         let time_secs = plant.time_secs();
         let obs = controller.observe(w.decision.detected, &plant.tracked(), time_secs)?;
         let used = obs.step != StepKind::Idle;

@@ -27,7 +27,10 @@ pub use decoder::{
     run_continuous_calibration, run_online_calibration, target_continuous,
 };
 pub use environment::{EpuckAction, EpuckEnvironment, EpuckFeedback, MAX_WINDOWS_PER_ACTION};
-pub use episode::{EpuckEpisodeResult, run_epuck_episode, run_epuck_episode_with, shared_control};
+pub use episode::{
+    EpuckEpisodeResult, run_epuck_episode, run_epuck_episode_live, run_epuck_episode_with,
+    shared_control,
+};
 pub use errp_robot::AvoidanceParams;
 pub use hybrid::{calibrate_on_recording, epuck_decoder_summary, prepare_hybrid};
 pub use hybrid_report::{HYBRID_LABEL, HybridReport};
@@ -36,8 +39,8 @@ pub use observer::{
 };
 pub use params::{EpuckEpisode, EpuckTaskParams};
 pub use plant::{
-    EpuckDriver, EpuckPlant, PHYSICS_DT_SECS, PlantWindow, STEPS_PER_WINDOW, WINDOW_STEP_SECS,
-    WindowDecoder,
+    EpuckDriver, EpuckPlant, LiveWindow, LiveWindowDecoder, PHYSICS_DT_SECS, PlantWindow,
+    STEPS_PER_WINDOW, WINDOW_STEP_SECS, WindowDecoder, WindowDecoding,
 };
 pub use report::{EpuckRunHeader, EpuckRunRow, EpuckRunsTable, EpuckSummaryReport};
 pub use run::{

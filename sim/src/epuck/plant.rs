@@ -50,6 +50,43 @@ pub(crate) fn step_motion(from: Pose, to: Pose) -> (f64, f64) {
 /// n_samples)`), it returns p(error), a number from 0 to 1.
 pub type WindowDecoder<'a> = &'a mut (dyn FnMut(&EegBlock) -> Result<f64> + Send);
 
+/// One window of a live episode, as the live decoder is told of it: the
+/// raw EEG of its last 62.5 ms (to stream) and what the device is doing.
+#[derive(Debug, Clone, Copy)]
+pub struct LiveWindow<'b> {
+    /// The raw samples of the hop, all channels `(n_channels, 16)`.
+    pub raw: &'b EegBlock,
+    /// The episode time at the window's end (s).
+    pub time_secs: f64,
+    /// What the robot is doing ([`crate::epuck::PHASE_NAMES`]).
+    pub phase: usize,
+    /// The goal it heads for.
+    pub target: usize,
+    /// The pose the camera sees.
+    pub tracked: Pose,
+    /// The belief over the goals before the window.
+    pub belief: &'b [f64],
+    /// On the episode's first window: the raw EEG of the 2 s before time 0
+    /// (the filters' warm-up), to stream first.
+    pub warm_up: Option<&'b EegBlock>,
+}
+
+/// A live window decoder: streams the window's raw EEG in real time and
+/// returns the p(error)s a decoder outside sent in time for it, in order
+/// (none, one or several), each read by the detector.
+pub type LiveWindowDecoder<'a> = &'a mut (dyn FnMut(&LiveWindow<'_>) -> Result<Vec<f64>> + Send);
+
+/// How a window's p(error) is found.
+pub enum WindowDecoding<'d, 'a> {
+    /// The calibrated SVM of the decoder.
+    Builtin,
+    /// A decoder of the user's own, given the preprocessed window.
+    Own(&'d mut WindowDecoder<'a>),
+    /// A decoder outside the process, live, told `belief` (the belief
+    /// before the window).
+    Live(&'d mut LiveWindowDecoder<'a>, &'d [f64]),
+}
+
 /// What moves the e-puck, physics step by physics step: the shared control
 /// in an episode, an agent's motion primitive in the environment.
 pub trait EpuckDriver {
@@ -165,16 +202,17 @@ impl EpuckPlant {
     }
 
     /// Runs one decoder window: [`STEPS_PER_WINDOW`] physics steps driven
-    /// by `driver`, then p(error) of the new window from `window_decoder`
-    /// (a decoder of the user's own) or else the calibrated SVM of
-    /// `decoder`, and the detector's verdict. `observer` sees the user's
+    /// by `driver`, then p(error) of the new window as `decoding` says (a
+    /// decoder of the user's own, one outside, or the calibrated SVM of
+    /// `decoder`), and the detector's verdict. A live decoder's window
+    /// without a p(error) has none (not a number) and detects nothing. `observer` sees the user's
     /// ErrPs and every physics step; the window is the caller's to report
     /// ([`EpuckPlant::window_frame`]), with what the driver made of it.
     pub fn window(
         &mut self,
         driver: &mut impl EpuckDriver,
         decoder: &ContinuousDecoder,
-        window_decoder: Option<&mut WindowDecoder<'_>>,
+        decoding: WindowDecoding<'_, '_>,
         observer: &mut impl EpuckObserver,
     ) -> Result<PlantWindow> {
         let watching = observer.watches();
@@ -205,11 +243,52 @@ impl EpuckPlant {
             }
         }
         let fresh = self.eeg.advance();
-        let p_error = match window_decoder {
-            Some(decode) => check_p_error(decode(self.eeg.window())?)?,
-            None => self.eeg.p_error(&decoder.model),
+        let p_error = match decoding {
+            WindowDecoding::Own(decode) => check_p_error(decode(self.eeg.window())?)?,
+            WindowDecoding::Builtin => self.eeg.p_error(&decoder.model),
+            WindowDecoding::Live(decide, belief) => {
+                let got = decide(&LiveWindow {
+                    raw: self.eeg.raw(),
+                    time_secs: self.time_secs,
+                    phase: driver.phase(),
+                    target: driver.target(),
+                    tracked: self.tracked,
+                    belief,
+                    warm_up: (self.time_secs <= WINDOW_STEP_SECS + 1e-9)
+                        .then(|| self.eeg.warm_up_raw()),
+                })?;
+                return self.live_window(&got, errps, fresh);
+            }
         };
         let decision = self.detector.push(p_error, self.time_secs);
+        Ok(PlantWindow {
+            p_error,
+            decision,
+            errps,
+            fresh,
+        })
+    }
+
+    /// The window of a live decoder that sent the p(error)s `got` for it:
+    /// the detector reads each; the window detects if any detection fired.
+    fn live_window(
+        &mut self,
+        got: &[f64],
+        errps: Vec<(f64, usize)>,
+        fresh: EegBlock,
+    ) -> Result<PlantWindow> {
+        let mut decision = Decision {
+            evidence: f64::NAN,
+            detected: false,
+        };
+        let mut p_error = f64::NAN;
+        for &p in got {
+            p_error = check_p_error(p)?;
+            let d = self.detector.push(p, self.time_secs);
+            if !decision.detected {
+                decision = d;
+            }
+        }
         Ok(PlantWindow {
             p_error,
             decision,

@@ -53,7 +53,7 @@ pub struct PreparedEpuck {
 
 /// The calibration of a scenario's continuous decoder: the paper's
 /// protocol and EEG model, with the scenario's user (`[realism]`).
-fn continuous_request(scenario: &EpuckScenario) -> Result<ContinuousRequest> {
+pub(crate) fn continuous_request(scenario: &EpuckScenario) -> Result<ContinuousRequest> {
     let base = ContinuousRequest::new(scenario.accuracy, scenario.user_seed);
     Ok(ContinuousRequest {
         setup: Valid::new(base.setup.with_realism(&scenario.realism)?)?,

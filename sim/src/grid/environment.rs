@@ -162,8 +162,8 @@ impl GridEnvironment {
             &mut GridDecoding::Builtin(&self.decoder),
             action,
             &self.params,
-            false,
-            keep_epoch,
+            (false, keep_epoch),
+            &[],
         )?;
         let n_cells = self.plant.grid().n_cells();
         self.plant.keep(&mut judged, || vec![f64::NAN; n_cells]);

@@ -65,10 +65,26 @@ pub fn run_grid_episode_with(
         plant.keep_steps();
     }
     let mut committed = None;
+    let live = matches!(decoding, GridDecoding::Live(_));
     for _ in 0..params.max_actions {
         let action = controller.choose(plant.cell(), &mut rng_policy);
-        let mut judged = plant.act(&mut decoding, action, params, record_steps, false)?;
-        controller.observe(judged.from, action, judged.decoded.p_error)?;
+        // A live decoder shows the belief; the others need none.
+        let belief = if live {
+            controller.belief().probabilities()
+        } else {
+            Vec::new()
+        };
+        let mut judged = plant.act(
+            &mut decoding,
+            action,
+            params,
+            (record_steps, false),
+            &belief,
+        )?;
+        // A decision missed leaves the belief as it was.
+        if !judged.decoded.missed {
+            controller.observe(judged.from, action, judged.decoded.p_error)?;
+        }
         plant.keep(&mut judged, || controller.belief().probabilities());
         if let Some(found) = controller.converged() {
             committed = Some(found);

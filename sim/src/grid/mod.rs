@@ -31,7 +31,10 @@ pub use pairs::{
     total_length,
 };
 pub use params::GridTaskParams;
-pub use plant::{EpochDecoder, GridDecoding, GridEpisodeResult, GridStep, grid_episode_seed};
+pub use plant::{
+    EpochDecoder, GridDecoding, GridEpisodeResult, GridStep, LiveAction, LiveDecoder,
+    grid_episode_seed,
+};
 pub use recorded::{CV_REPEATS, RecordedBank, RecordedReport};
 pub use report::{GridEpisodeHeader, GridEpisodeRow, Table1Report};
 pub use run::{

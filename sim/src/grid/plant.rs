@@ -75,6 +75,30 @@ impl GridEpisodeResult {
 /// gives back as p(error).
 pub type EpochDecoder<'a> = &'a mut (dyn FnMut(&EegBlock) -> Result<f64> + Send);
 
+/// An action of a live episode, as the live decoder is told of it before
+/// it decides: the device's action, the user's verdict (for the EEG the
+/// live loop streams; never for the decision) and the belief before it.
+#[derive(Debug, Clone, Copy)]
+pub struct LiveAction<'b> {
+    /// The cursor before the action.
+    pub from: Cell,
+    /// The action.
+    pub action: GridAction,
+    /// The cursor after it.
+    pub to: Cell,
+    /// The user's verdict: true if it is an error to them.
+    pub error: bool,
+    /// The interval to the next action (s, simulated time).
+    pub interval_secs: f64,
+    /// The belief over the goals before the action (cell index order).
+    pub belief: &'b [f64],
+}
+
+/// A live decoder: streams the action's EEG in real time and returns the
+/// p(error) a decoder outside sent back for it in time, or none (a missed
+/// decision: the belief is not updated).
+pub type LiveDecoder<'a> = &'a mut (dyn FnMut(&LiveAction<'_>) -> Result<Option<f64>> + Send);
+
 /// What decodes each action of an episode.
 pub enum GridDecoding<'a> {
     /// One of the testbed's decoders.
@@ -99,6 +123,10 @@ pub enum GridDecoding<'a> {
         /// p(error) of the correct epochs.
         correct: &'a [f64],
     },
+    /// A decoder outside the process, in real time (`errp stream`): the
+    /// EEG is its to stream, and a decision it misses leaves the belief as
+    /// it was.
+    Live(LiveDecoder<'a>),
 }
 
 impl GridDecoding<'_> {
@@ -111,6 +139,7 @@ impl GridDecoding<'_> {
                 decode: &mut **decode,
             },
             GridDecoding::Scores { error, correct } => GridDecoding::Scores { error, correct },
+            GridDecoding::Live(decide) => GridDecoding::Live(&mut **decide),
         }
     }
 }
@@ -205,27 +234,47 @@ impl GridPlant {
     /// goal), the interval to the next action is drawn, the EEG of the
     /// judgement is decoded with `decoding` (the one the plant started
     /// with; `keep_fcz` returns the FCz trace, `keep_epoch` the
-    /// preprocessed epoch), the cursor moves (a move against a border
+    /// preprocessed epoch; a live decoder is told `belief`, the belief
+    /// before the action), the cursor moves (a move against a border
     /// leaves it in place) and the action is scored.
     pub(crate) fn act(
         &mut self,
         decoding: &mut GridDecoding<'_>,
         action: GridAction,
         params: &GridTaskParams,
-        keep_fcz: bool,
-        keep_epoch: bool,
+        keep: (bool, bool),
+        belief: &[f64],
     ) -> Result<Judged> {
+        let (keep_fcz, keep_epoch) = keep;
         let from = self.cell;
         let error = !self.grid.is_correct(from, action, self.goal);
         let interval_secs = self
             .rng_user
             .random_range(params.interval_min_secs..=params.interval_max_secs);
-        let decoded = self
-            .decoder
-            .decode(decoding, error, interval_secs, keep_fcz, keep_epoch)?;
         let to = self.grid.step(from, action);
+        let decoded = match decoding {
+            GridDecoding::Live(decide) => {
+                let p = decide(&LiveAction {
+                    from,
+                    action,
+                    to,
+                    error,
+                    interval_secs,
+                    belief,
+                })?;
+                Decoded::live(p)?
+            }
+            _ => self
+                .decoder
+                .decode(decoding, error, interval_secs, keep_fcz, keep_epoch)?,
+        };
         self.cell = to;
-        self.tally.action(&self.grid, to, error, decoded.says_error);
+        self.tally.action(
+            &self.grid,
+            to,
+            error,
+            (!decoded.missed).then_some(decoded.says_error),
+        );
         let onset_secs = self.total_secs;
         self.total_secs += interval_secs;
         Ok(Judged {
@@ -291,6 +340,8 @@ pub(crate) struct GridTally {
     visits: Vec<u32>,
     labels: Vec<bool>,
     decoded: Vec<bool>,
+    /// Actions whose decision was missed (a live decoder's): not scored.
+    missed: usize,
 }
 
 impl GridTally {
@@ -303,20 +354,27 @@ impl GridTally {
             visits,
             labels: Vec::new(),
             decoded: Vec::new(),
+            missed: 0,
         }
     }
 
     /// An action that moved the cursor `to`, an error to the user
-    /// (`error`), decoded as one (`decoded`) or not.
-    pub(crate) fn action(&mut self, grid: &Grid, to: Cell, error: bool, decoded: bool) {
+    /// (`error`), decoded as one (`decoded`), not, or not decoded in time
+    /// (none: not scored).
+    pub(crate) fn action(&mut self, grid: &Grid, to: Cell, error: bool, decoded: Option<bool>) {
         self.visits[grid.index(to)] += 1;
-        self.labels.push(error);
-        self.decoded.push(decoded);
+        match decoded {
+            Some(d) => {
+                self.labels.push(error);
+                self.decoded.push(d);
+            }
+            None => self.missed += 1,
+        }
     }
 
     /// Actions so far.
     pub(crate) fn actions(&self) -> usize {
-        self.labels.len()
+        self.labels.len() + self.missed
     }
 
     /// The result of the episode towards `goal` that ended `committed` (or
@@ -347,12 +405,27 @@ impl GridTally {
 
 /// What a decoded action gives: p(error), the decoder's class, the FCz
 /// trace (when asked) and the preprocessed epoch (when asked, and the EEG
-/// is streamed).
+/// is streamed); a live decision missed has no p(error) (not a number).
 pub(crate) struct Decoded {
     pub(crate) p_error: f64,
     pub(crate) says_error: bool,
     pub(crate) fcz: Vec<f64>,
     pub(crate) epoch: Option<EegBlock>,
+    pub(crate) missed: bool,
+}
+
+impl Decoded {
+    /// A live decoder's decision: p(error), or none when it missed.
+    fn live(p: Option<f64>) -> Result<Self> {
+        let p = p.map(check_p_error).transpose()?;
+        Ok(Self {
+            p_error: p.unwrap_or(f64::NAN),
+            says_error: p.is_some_and(|p| p >= 0.5),
+            fcz: Vec::new(),
+            epoch: None,
+            missed: p.is_none(),
+        })
+    }
 }
 
 /// A [`GridDecoding`] with its EEG stream and random draws, decoding one
@@ -462,6 +535,11 @@ impl ActionDecoder {
                 };
                 (p, says, fcz)
             }
+            (GridDecoding::Live(_), _) => {
+                return Err(SimError::Scenario(
+                    "a live decoder decides in the plant's action, not here".into(),
+                ));
+            }
             (GridDecoding::Builtin(AssessmentDecoder::EegBank(bank)), _) => {
                 let pool = if error { &bank.error } else { &bank.correct };
                 let (x, fcz) = &pool[self.rng_bank.random_range(0..pool.len())];
@@ -482,6 +560,7 @@ impl ActionDecoder {
             says_error,
             fcz,
             epoch,
+            missed: false,
         })
     }
 }

@@ -49,7 +49,7 @@ pub fn pooled_accuracy(episodes: &[GridEpisodeResult]) -> Accuracy {
 
 /// The calibration setup of a grid scenario: the paper's protocol and the
 /// default EEG model, with the scenario's user (`[realism]`).
-fn grid_setup(s: &GridScenario) -> Result<Valid<CalibrationSetup>> {
+pub(crate) fn grid_setup(s: &GridScenario) -> Result<Valid<CalibrationSetup>> {
     Ok(Valid::new(
         CalibrationSetup::default().with_realism(&s.realism)?,
     )?)

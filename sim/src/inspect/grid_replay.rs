@@ -51,7 +51,7 @@ pub(super) fn grid_results(
         let mut steps = Vec::new();
         for i in run_rows(a_run, k) {
             let to = cell(a.to_x[i], a.to_y[i])?;
-            tally.action(&grid, to, a.error[i], a.decoded_error[i]);
+            tally.action(&grid, to, a.error[i], Some(a.decoded_error[i]));
             let name = &a.action[i];
             let action = GridAction::ALL
                 .into_iter()

@@ -7,6 +7,7 @@ mod determinism;
 mod epuck;
 mod grid;
 mod hooks;
+mod live;
 mod realism;
 mod recorded;
 #[cfg(feature = "rerun")]

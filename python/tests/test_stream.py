@@ -1,0 +1,180 @@
+"""`errp stream` with a decoder in another process, over Lab Streaming Layer
+on this machine: the loop closes with the reference client, the EEG
+stream's metadata read by MNE-LSL, and the timing rules (no reader, no
+decoder, a decoder that stops, a wrong stream, late decisions).
+
+The streams have fixed names, so these tests run one after another."""
+
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from conftest import ROOT, errp_bin
+
+pylsl = pytest.importorskip("pylsl")
+
+CLIENT = ROOT / "python" / "examples" / "lsl_decoder.py"
+GRID = str(ROOT / "scenarios" / "grid_fixed_goals.toml")
+
+
+def liblsl() -> str:
+    lib = Path(pylsl.lib.__file__).parent
+    for name in ("liblsl.so", "liblsl.dylib", "lsl.dll"):
+        if (lib / name).is_file():
+            return str(lib / name)
+    pytest.skip("pylsl without its bundled liblsl")
+
+
+def bridge(*args: str) -> subprocess.Popen:
+    """`errp stream ARGS` in the background."""
+    env = dict(os.environ, ERRP_LIBLSL=liblsl())
+    return subprocess.Popen(
+        [str(errp_bin()), "stream", *args],
+        cwd=ROOT,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+
+
+def python(*args: str) -> subprocess.Popen:
+    return subprocess.Popen(
+        [sys.executable, *args], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
+    )
+
+
+def finish(p: subprocess.Popen, timeout: float = 240) -> tuple[int, str, str]:
+    out, err = p.communicate(timeout=timeout)
+    return p.returncode, out, err
+
+
+# A program that reads the EEG and markers and never decides; with
+# `channels`, it publishes a decoder stream of that many channels.
+READER = """
+import sys, time, pylsl
+eeg = pylsl.resolve_byprop("name", "errp-eeg", 1, 30)[0]
+inlet = pylsl.StreamInlet(eeg)
+inlet.open_stream(10)
+outlet = None
+if len(sys.argv) > 1:
+    info = pylsl.StreamInfo("errp-decoder", "Decisions", int(sys.argv[1]), 0.0, "double64", "x")
+    outlet = pylsl.StreamOutlet(info)
+end = time.time() + 60
+while time.time() < end:
+    inlet.pull_chunk(timeout=0.05)
+"""
+
+
+def test_the_loop_closes_with_the_reference_client():
+    b = bridge(GRID, "--speed", "60", "--runs", "2", "--timeout", "60")
+    c = python(str(CLIENT), "--timeout", "60")
+    code, out, err = finish(b)
+    client = c.communicate(timeout=60)[0]
+    assert code == 0, err + client
+    assert "2 of 2 runs reached their goal" in out, out
+    assert "trained on 400 epochs" in client
+    # Latencies, median and 95th percentile, per run and over all.
+    assert out.count("latency from the action's onset median") == 3, out
+    assert "0 stray" in out
+    assert "cost at speed 60" in out
+
+
+def test_the_epuck_loop_runs_with_the_reference_client():
+    b = bridge(
+        str(ROOT / "scenarios" / "mexico_to_pisa.toml"), "--speed", "10", "--runs", "1",
+        "--timeout", "60",
+    )
+    c = python(str(CLIENT), "--timeout", "60")
+    code, out, err = finish(b)
+    client = c.communicate(timeout=60)[0]
+    assert code == 0, err + client
+    assert "trained on 140 epochs" in client
+    assert "calibration: 140 examples" in err
+    assert out.count("latency from the window's end median") == 2, out
+    assert "of 1 runs reached their goal" in out
+    assert "0 stray" in out
+
+
+def test_the_eeg_metadata_reads_in_mne_lsl():
+    from mne_lsl.stream import StreamLSL
+
+
+    b = bridge(GRID, "--timeout", "30", "--calibration-actions", "40", "--speed", "20")
+    try:
+        stream = StreamLSL(bufsize=2, name="errp-eeg").connect(timeout=20)
+        info = stream.info
+        assert info["sfreq"] == 256 * 20
+        names = info.ch_names
+        assert len(names) == 40 and "FCz" in names and names[-1] == "EOG RO"
+        types = stream.get_channel_types()
+        assert types.count("eeg") == 34 and types.count("eog") == 6
+        units = {u for u in stream.get_channel_units()}
+        assert len(units) == 1 and "FIFF_UNITM_MU" in str(units), units
+        stream.disconnect()
+    finally:
+        b.kill()
+        b.communicate()
+
+
+def test_no_reader_within_the_timeout_is_refused():
+    code, out, err = finish(bridge(GRID, "--timeout", "1"))
+    assert code == 2
+    assert "no program opened the EEG stream errp-eeg within 1 s (--timeout)" in err
+
+
+def test_no_decoder_within_the_timeout_is_refused():
+    r = python("-c", READER)
+    code, out, err = finish(
+        bridge(GRID, "--timeout", "2", "--speed", "100", "--calibration-actions", "40")
+    )
+    r.kill()
+    r.communicate()
+    assert code == 2, err
+    assert 'no decoder stream "errp-decoder" appeared within 2 s after the calibration' in err
+
+
+def test_a_decoder_stream_of_the_wrong_shape_is_refused():
+    r = python("-c", READER, "3")
+    code, out, err = finish(
+        bridge(GRID, "--timeout", "10", "--speed", "100", "--calibration-actions", "40")
+    )
+    r.kill()
+    r.communicate()
+    assert code == 2, err
+    assert 'the decoder stream "errp-decoder" (name=errp-decoder) has 3 channels' in err
+    assert "expected 2 numeric channels (action, p(error))" in err
+
+
+def test_a_decoder_that_stops_mid_run_is_reported():
+    c = python(str(CLIENT), "--stop-after", "3")
+    code, out, err = finish(
+        bridge(GRID, "--timeout", "5", "--speed", "100", "--calibration-actions", "80")
+    )
+    c.communicate(timeout=30)
+    assert code == 2, err
+    assert "errp-decoder" in err
+    assert "was lost" in err or "sent nothing for" in err, err
+
+
+def test_late_decisions_are_counted_not_applied():
+    c = python(str(CLIENT), "--delay", "0.05")
+    code, out, err = finish(
+        bridge(
+            GRID, "--timeout", "10", "--speed", "100", "--calibration-actions", "80",
+            "--runs", "1",
+        )
+    )
+    c.kill()
+    c.communicate()
+    assert code == 0, err
+    last = out.strip().splitlines()
+    summary = [line for line in last if "runs reached their goal" in line][0]
+    assert summary.startswith("0 of 1 runs"), summary
+    assert "decisions: 0 applied" in summary, summary
+    late = int(summary.split(" missed, ")[1].split(" late")[0])
+    assert late > 0, summary

@@ -1,0 +1,322 @@
+//! The grid live, on a link with a virtual clock and a decoder that answers
+//! from the markers alone: what is published, which decisions apply, and
+//! the replay of the decisions applied.
+
+use errp_bci::EegBlock;
+use errp_sim::grid::GridScenario;
+use errp_sim::live::LiveObserver;
+use errp_sim::live::grid::{GridLiveRun, replay_grid, run_grid_live};
+use errp_sim::live::{LiveLink, LiveOptions, Received};
+use errp_sim::{Result, SimError};
+use serde_json::Value;
+
+/// A link on a virtual clock: waiting moves the clock; the decoder answers
+/// every action marker `latency` later with a p(error) from the action's
+/// id, except every `late_every`-th action, whose answer comes 0.2 s late
+/// (three actions later at speed 50).
+struct VirtualLink {
+    clock: f64,
+    connected: bool,
+    markers: Vec<(f64, Value)>,
+    states: usize,
+    samples: u64,
+    last_stamp: Option<f64>,
+    spacing: Option<f64>,
+    queue: Vec<Received>,
+    late_every: u64,
+    latency: f64,
+    answers: bool,
+}
+
+impl VirtualLink {
+    fn new(late_every: u64) -> Self {
+        Self {
+            clock: 1000.0,
+            connected: false,
+            markers: Vec::new(),
+            states: 0,
+            samples: 0,
+            last_stamp: None,
+            spacing: None,
+            queue: Vec::new(),
+            late_every,
+            latency: 0.011,
+            answers: true,
+        }
+    }
+}
+
+impl LiveLink for VirtualLink {
+    fn clock(&self) -> f64 {
+        self.clock
+    }
+
+    fn eeg(&mut self, block: &EegBlock, first: f64, period: f64) -> Result<()> {
+        assert_eq!(block.n_channels, 40);
+        if let Some(last) = self.last_stamp {
+            assert!(
+                (first - last - period).abs() < 1e-9,
+                "samples are evenly spaced"
+            );
+        }
+        self.spacing = Some(period);
+        self.last_stamp = Some(first + (block.n_samples - 1) as f64 * period);
+        self.samples += block.n_samples as u64;
+        Ok(())
+    }
+
+    fn marker(&mut self, text: &str, stamp: f64) -> Result<()> {
+        let v: Value = serde_json::from_str(text).unwrap();
+        if v["event"] == "action" && self.connected && self.answers {
+            let id = v["action"].as_u64().unwrap();
+            let late = self.late_every > 0 && id % self.late_every == self.late_every - 1;
+            self.queue.push(Received {
+                id: id as f64,
+                p_error: if id.is_multiple_of(3) { 0.8 } else { 0.25 },
+                arrived: stamp + if late { 0.2 } else { self.latency },
+            });
+        }
+        self.markers.push((stamp, v));
+        Ok(())
+    }
+
+    fn state(&mut self, text: &str, _stamp: f64) -> Result<()> {
+        let v: Value = serde_json::from_str(text).unwrap();
+        assert_eq!(v["belief"].as_array().unwrap().len(), 25);
+        self.states += 1;
+        Ok(())
+    }
+
+    fn wait_for_readers(&mut self, _timeout_secs: f64) -> Result<()> {
+        Ok(())
+    }
+
+    fn connect(&mut self, _timeout_secs: f64) -> Result<bool> {
+        self.connected = true;
+        Ok(true)
+    }
+
+    fn disconnect(&mut self) {
+        self.connected = false;
+    }
+
+    fn wait(&mut self, until: f64) -> Result<Vec<Received>> {
+        self.clock = self.clock.max(until);
+        let now = self.clock;
+        let (due, later): (Vec<_>, Vec<_>) = self.queue.drain(..).partition(|r| r.arrived <= now);
+        self.queue = later;
+        Ok(due)
+    }
+}
+
+struct Quiet;
+
+impl LiveObserver<GridLiveRun> for Quiet {
+    fn note(&mut self, _text: &str) {}
+    fn run(&mut self, _k: usize, _run: &GridLiveRun) {}
+}
+
+fn scenario() -> GridScenario {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/grid_fixed_goals.toml");
+    GridScenario::parse(&std::fs::read_to_string(&path).unwrap(), &path).unwrap()
+}
+
+#[test]
+fn the_decisions_applied_replay_to_the_same_runs() {
+    let s = scenario();
+    let mut link = VirtualLink::new(7);
+    let options = LiveOptions {
+        speed: 50.0,
+        ..LiveOptions::default()
+    };
+    let runs = run_grid_live(&s, &mut link, options, 2, "virtual", &mut Quiet).unwrap();
+    assert_eq!(runs.len(), 2);
+    // The calibration: 400 labelled actions, then the control's actions
+    // with no label; the EEG at 256 Hz x 50.
+    let labelled = link
+        .markers
+        .iter()
+        .filter(|(_, m)| m["event"] == "calibration_action")
+        .count();
+    assert_eq!(labelled, 400);
+    assert!(
+        link.markers
+            .iter()
+            .filter(|(_, m)| m["event"] == "action")
+            .all(|(_, m)| m.get("label").is_none() && m.get("error").is_none()),
+        "the control's markers never tell the user's verdict"
+    );
+    assert_eq!(link.spacing, Some(1.0 / (256.0 * 50.0)));
+    let actions: usize = runs.iter().map(|r| r.result.actions).sum();
+    assert_eq!(link.states, actions, "one state per action");
+    // Every 7th action's decision came late: missed, counted, not applied.
+    for r in &runs {
+        let missed = r.decisions.iter().filter(|d| d.is_none()).count();
+        assert_eq!(r.stats.missed, missed);
+        assert_eq!(r.stats.latencies_secs.len(), r.result.actions - missed);
+        for l in &r.stats.latencies_secs {
+            assert!((l - 0.011).abs() < 1e-9, "latency {l}");
+        }
+    }
+    let missed: usize = runs.iter().map(|r| r.stats.missed).sum();
+    assert_eq!(missed, actions / 7, "{actions} actions");
+    // The late ones are counted when they come (the last few may not have).
+    let late: usize = runs.iter().map(|r| r.stats.late).sum();
+    assert!(
+        late + 3 >= missed && late <= missed,
+        "{late} late of {missed}"
+    );
+    // The same decisions, offline: the same runs.
+    let decisions: Vec<_> = runs.iter().map(|r| r.decisions.clone()).collect();
+    let again = replay_grid(&s, &decisions).unwrap();
+    for (live, offline) in runs.iter().zip(&again) {
+        assert_eq!(&live.result, offline);
+    }
+    // A replay with fewer decisions than a run needs says so.
+    let short = vec![decisions[0][..1].to_vec()];
+    let e = replay_grid(&s, &short).unwrap_err().to_string();
+    assert!(e.contains("more decisions than the 1 recorded"), "{e}");
+}
+
+#[test]
+fn a_decoder_that_never_answers_stops_the_loop() {
+    let s = scenario();
+    let mut link = VirtualLink::new(0);
+    link.answers = false;
+    let options = LiveOptions {
+        speed: 50.0,
+        timeout_secs: 2.0,
+        ..LiveOptions::default()
+    };
+    let e = run_grid_live(&s, &mut link, options, 1, "virtual", &mut Quiet).unwrap_err();
+    assert!(matches!(e, SimError::Live(_)), "{e}");
+    assert!(
+        e.to_string().contains("\"virtual\" sent nothing for"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_decoder_always_late_decides_nothing() {
+    let s = scenario();
+    let mut link = VirtualLink::new(1);
+    let options = LiveOptions {
+        speed: 50.0,
+        ..LiveOptions::default()
+    };
+    let runs = run_grid_live(&s, &mut link, options, 1, "virtual", &mut Quiet).unwrap();
+    let r = &runs[0];
+    // Never applied: the belief never moves and the run fails.
+    assert!(r.decisions.iter().all(Option::is_none));
+    assert_eq!(r.result.committed, None);
+    assert_eq!(r.stats.missed, r.result.actions);
+    assert!(r.stats.late + 3 >= r.stats.missed, "{:?}", r.stats);
+}
+
+/// The e-puck on a virtual link: the decoder answers each block of EEG
+/// (the window ending at its last sample) 20 ms later, with a p(error) that
+/// is high for 6 blocks in every 60.
+struct WindowLink {
+    clock: f64,
+    connected: bool,
+    queue: Vec<Received>,
+    blocks: u64,
+    phases: usize,
+}
+
+impl LiveLink for WindowLink {
+    fn clock(&self) -> f64 {
+        self.clock
+    }
+
+    fn eeg(&mut self, block: &EegBlock, first: f64, period: f64) -> Result<()> {
+        let last = first + (block.n_samples - 1) as f64 * period;
+        if self.connected {
+            self.blocks += 1;
+            self.queue.push(Received {
+                id: last,
+                p_error: if self.blocks % 60 < 6 { 0.97 } else { 0.1 },
+                arrived: last + 0.02,
+            });
+        }
+        Ok(())
+    }
+
+    fn marker(&mut self, text: &str, _stamp: f64) -> Result<()> {
+        let v: Value = serde_json::from_str(text).unwrap();
+        if v["event"] == "phase" {
+            self.phases += 1;
+        }
+        Ok(())
+    }
+
+    fn state(&mut self, _text: &str, _stamp: f64) -> Result<()> {
+        Ok(())
+    }
+
+    fn wait_for_readers(&mut self, _timeout_secs: f64) -> Result<()> {
+        Ok(())
+    }
+
+    fn connect(&mut self, _timeout_secs: f64) -> Result<bool> {
+        self.connected = true;
+        Ok(true)
+    }
+
+    fn disconnect(&mut self) {
+        self.connected = false;
+    }
+
+    fn wait(&mut self, until: f64) -> Result<Vec<Received>> {
+        self.clock = self.clock.max(until);
+        let now = self.clock;
+        let (due, later): (Vec<_>, Vec<_>) = self.queue.drain(..).partition(|r| r.arrived <= now);
+        self.queue = later;
+        Ok(due)
+    }
+}
+
+struct QuietEpuck;
+
+impl LiveObserver<errp_sim::live::epuck::EpuckLiveRun> for QuietEpuck {
+    fn note(&mut self, _text: &str) {}
+    fn run(&mut self, _k: usize, _run: &errp_sim::live::epuck::EpuckLiveRun) {}
+}
+
+#[test]
+fn the_epuck_windows_applied_replay_to_the_same_runs() {
+    use errp_sim::epuck::EpuckScenario;
+    use errp_sim::live::epuck::{prepare_live_epuck, replay_epuck, run_epuck_live};
+
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/mexico_to_pisa.toml");
+    let s = EpuckScenario::parse(&std::fs::read_to_string(&path).unwrap(), &path).unwrap();
+    let mut link = WindowLink {
+        clock: 50.0,
+        connected: false,
+        queue: Vec::new(),
+        blocks: 0,
+        phases: 0,
+    };
+    let options = LiveOptions {
+        speed: 10.0,
+        calibration_actions: Some(40),
+        ..LiveOptions::default()
+    };
+    let runs = run_epuck_live(&s, &mut link, options, 1, "virtual", &mut QuietEpuck).unwrap();
+    let r = &runs[0];
+    assert!(link.phases >= 2, "{} phase markers", link.phases);
+    // Each decision came 20 ms after its window: applied at the next
+    // window, 0.2 s of simulated time later at speed 10.
+    assert!(!r.stats.latencies_secs.is_empty());
+    for l in &r.stats.latencies_secs {
+        assert!((l - 0.02).abs() < 1e-9, "latency {l}");
+    }
+    let applied: usize = r.decisions.iter().map(Vec::len).sum();
+    assert_eq!(applied, r.stats.latencies_secs.len());
+    assert!(r.result.detected_errors > 0, "{:?}", r.result);
+    let decoder = prepare_live_epuck(&s).unwrap();
+    let again = replay_epuck(&s, &decoder, std::slice::from_ref(&r.decisions)).unwrap();
+    assert_eq!(again[0], r.result);
+}
