@@ -106,6 +106,9 @@ def main() -> int:
     pre = Preprocess(labels, types, fs)
     n_keep = len(DECODING)
     span = int(round(EPOCH_SECS * fs))
+    # A marker's sample: the first stamped at most half a period before it
+    # (stamps are sums of floating-point periods, not exact).
+    half = 0.5 / (fs * speed)
     print(f"EEG: {len(labels)} channels at {fs:g} Hz x speed {speed:g}", file=sys.stderr)
 
     parts = [np.zeros((0, n_keep + len(pre.eog)), np.float32)]
@@ -150,7 +153,7 @@ def main() -> int:
             data, stamps = data[-keep:], stamps[-keep:]
         parts, times = [data], [stamps]
         if model is None and stamps.size and stamps[-1] >= t_ready:
-            model, weights = train(data, stamps, calibration, span, n_keep, windows)
+            model, weights = train(data, stamps, calibration, t_ready, span, n_keep, windows)
             info = StreamInfo(args.name, "Decisions", 2, 0.0, "double64", f"{args.name}-1")
             outlet = StreamOutlet(info)
             print(f"trained on {len(calibration)} epochs; publishing {args.name}", file=sys.stderr)
@@ -169,7 +172,7 @@ def main() -> int:
                 next_end = int(ends[-1]) + 16
         while model is not None and actions:
             t, action = actions[0]
-            start = int(np.searchsorted(stamps, t))
+            start = int(np.searchsorted(stamps, t - half))
             if start + span > len(stamps):
                 break
             actions.pop(0)
@@ -190,16 +193,19 @@ def clean(x: np.ndarray, weights: np.ndarray, n_keep: int) -> np.ndarray:
     return (eeg - eog @ weights).T
 
 
-def train(data, stamps, calibration, span, n_keep, windows):
-    """EOG regression weights (least squares over the calibration) and the
-    decoder fitted on its epochs: the continuous one on the e-puck's
-    windows, the discrete one on the grid's epochs."""
-    first = int(np.searchsorted(stamps, calibration[0][0]))
-    eeg, eog = data[first:, :n_keep].astype(float), data[first:, n_keep:].astype(float)
+def train(data, stamps, calibration, end, span, n_keep, windows):
+    """EOG regression weights (least squares over the calibration, from its
+    first marker to ``end``, so that they do not depend on when training
+    starts) and the decoder fitted on its epochs: the continuous one on the
+    e-puck's windows, the discrete one on the grid's epochs."""
+    half = 0.5 * (stamps[1] - stamps[0])
+    first = int(np.searchsorted(stamps, calibration[0][0] - half))
+    last = int(np.searchsorted(stamps, end - half))
+    eeg, eog = data[first:last, :n_keep].astype(float), data[first:last, n_keep:].astype(float)
     weights = np.linalg.lstsq(eog, eeg, rcond=None)[0] if eog.shape[1] else np.zeros((0, n_keep))
     X, y = [], []
     for t, label in calibration:
-        start = int(np.searchsorted(stamps, t))
+        start = int(np.searchsorted(stamps, t - half))
         if start + span <= len(stamps):
             X.append(clean(data[start:start + span], weights, n_keep))
             y.append(label)

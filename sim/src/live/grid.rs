@@ -91,13 +91,19 @@ pub fn run_grid_live(
 
     stream_grid_calibration(&mut s, &setup, seed, options.speed, observer)?;
 
-    // Rest until the decoder's stream appears.
+    // Rest until the decoder's stream appears, from a generator of its
+    // own: however long the wait, the control's EEG is the same.
+    let mut rest = EegGenerator::new(
+        &closed_loop,
+        &setup.montage,
+        derive_seed(seed, "live/rest", 0),
+    )?;
+    wait_for_decoder(&mut s, &mut rest, options, decoder, observer)?;
     let mut eeg = EegGenerator::new(
         &closed_loop,
         &setup.montage,
         derive_seed(seed, "live/control", 0),
     )?;
-    wait_for_decoder(&mut s, &mut eeg, options, decoder, observer)?;
     begin_control(&mut s, runs)?;
 
     let table = QTable::compute(
