@@ -115,6 +115,7 @@ FLAG_CASES = [
         ["--calibration-actions", "-1"], ["--decisions", "x"], ["--decisions", "name="],
         ["--decisions", "host=a"], ["--runs", "0"], ["--accuracy", "0.4"],
         ["--liblsl", "/dev/zero"], ["--liblsl", "OUT/missing.so"],
+        ["--save", "OUT/x.txt"], ["--save", "/proc/x.rrd"], ["--save", "OUT/missing/x.rrd"],
     ]
 ] + [
     ["stream", "OUT/nothing.toml"], ["stream", "/dev/zero"], ["stream", "OUT"],

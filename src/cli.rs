@@ -223,4 +223,9 @@ pub(crate) struct InspectArgs {
     /// Print the provenance document (JSON) and nothing else.
     #[arg(long, conflicts_with_all = ["csv", "parquet", "figure"])]
     pub(crate) provenance: bool,
+    /// A live session's recording (`errp stream --save`): run its runs
+    /// again offline, each decided by the decisions it applied, and check
+    /// that the per-run table is the one recorded (an error if not).
+    #[arg(long, conflicts_with_all = ["scenario", "provenance"])]
+    pub(crate) replay: bool,
 }

@@ -1,8 +1,9 @@
 """`errp stream` with a decoder in another process, over Lab Streaming Layer
 on this machine: the grid's loop closes with the reference client (the
-e-puck's closes in .ci/run's step with five runs), the EEG
-stream's metadata read by MNE-LSL, and the timing rules (no reader, no
-decoder, a decoder that stops, a wrong stream, late decisions).
+e-puck's closes in .ci/run's step with five runs) and its recording
+replays to the same table, the EEG stream's metadata read by MNE-LSL, and
+the timing rules (no reader, no decoder, a decoder that stops, a wrong
+stream, late decisions).
 
 The streams have fixed names, so these tests run one after another."""
 
@@ -71,8 +72,20 @@ while time.time() < end:
 """
 
 
-def test_the_loop_closes_with_the_reference_client():
-    b = bridge(GRID, "--speed", "60", "--runs", "2", "--timeout", "60")
+def inspect(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [str(errp_bin()), "inspect", *args], capture_output=True, text=True, timeout=120
+    )
+
+
+def rows(text: str) -> list[str]:
+    """The rows of a grid table: lines that start with a run number."""
+    return [line for line in text.splitlines() if line[:3].strip().isdigit()]
+
+
+def test_the_loop_closes_and_its_recording_replays(tmp_path):
+    saved = tmp_path / "live.rrd"
+    b = bridge(GRID, "--speed", "60", "--runs", "2", "--timeout", "60", "--save", str(saved))
     c = python(str(CLIENT), "--timeout", "60")
     code, out, err = finish(b)
     client = c.communicate(timeout=60)[0]
@@ -83,6 +96,45 @@ def test_the_loop_closes_with_the_reference_client():
     assert out.count("latency from the action's onset median") == 3, out
     assert "0 stray" in out
     assert "cost at speed 60" in out
+    assert f"Wrote {saved}" in out
+    # The recording holds the decisions as received; the runs replayed
+    # offline with them give the table the stream printed.
+    r = inspect(str(saved), "--replay")
+    assert r.returncode == 0, r.stderr
+    printed = rows(out)
+    assert len(printed) == 2, out
+    recomputed, replayed = r.stdout.split("Replayed offline")
+    assert rows(recomputed.split("Decisions from the online decoder")[0]) == printed
+    assert rows(replayed) == printed, r.stdout
+    assert "the same per-run table as recorded (2 runs)" in r.stdout
+    assert "live:     errp stream at speed 60, decisions from name=errp-decoder" in r.stdout
+    # Its decisions, one line per run: as many applied as the run's actions.
+    decided = [line for line in recomputed.splitlines() if " applied, latency" in line]
+    assert len(decided) == 3, recomputed
+    # A recording of `errp run` has no decisions to replay.
+    plain = tmp_path / "plain.rrd"
+    made = subprocess.run(
+        [str(errp_bin()), "run", GRID, "--decoder", "oracle", "--save", str(plain)],
+        capture_output=True, text=True, timeout=300,
+    )
+    assert made.returncode == 0, made.stderr
+    r = inspect(str(plain), "--replay")
+    assert r.returncode == 2
+    assert "not a live session's recording" in r.stderr, r.stderr
+
+
+def test_a_bad_save_path_is_refused_before_streaming(tmp_path):
+    foreign = tmp_path / "notes.rrd"
+    foreign.write_text("mine")
+    for path, says in [
+        (tmp_path / "x.txt", "--save"),
+        (foreign, "is not a Rerun recording"),
+    ]:
+        code, _, err = finish(bridge(GRID, "--save", str(path)), timeout=30)
+        assert code == 2, err
+        assert says in err, err
+    assert foreign.read_text() == "mine"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.rrd"]
 
 
 def test_the_eeg_metadata_reads_in_mne_lsl():
@@ -106,10 +158,12 @@ def test_the_eeg_metadata_reads_in_mne_lsl():
         b.communicate()
 
 
-def test_no_reader_within_the_timeout_is_refused():
-    code, out, err = finish(bridge(GRID, "--timeout", "1"))
+def test_no_reader_within_the_timeout_is_refused(tmp_path):
+    code, out, err = finish(bridge(GRID, "--timeout", "1", "--save", str(tmp_path / "a.rrd")))
     assert code == 2
     assert "no program opened the EEG stream errp-eeg within 1 s (--timeout)" in err
+    # A session that stops leaves no recording, whole or partial.
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_no_decoder_within_the_timeout_is_refused():

@@ -75,6 +75,9 @@ pub(crate) fn inspect(args: &InspectArgs) -> Result<()> {
     for f in &args.files {
         check_extension(f, "rrd", "FILE")?;
     }
+    if args.replay && args.files.len() != 1 {
+        bail!("--replay replays one recording's runs; give one file");
+    }
     let figure_kind = check_figure(args)?;
     let started = crate::commands::sweep::wall_clock();
     let recs: Vec<Recording> = args
@@ -117,6 +120,9 @@ pub(crate) fn inspect(args: &InspectArgs) -> Result<()> {
     }
     if recs.len() == 1 {
         out!("{}", RecordingReport(&recs[0]))?;
+        if args.replay {
+            replay(&recs[0])?;
+        }
     } else {
         for r in &recs {
             outln!("{}", RecordingHeadline(r))?;
@@ -409,4 +415,33 @@ fn draw(rec: &Recording, highlight: usize, kind: FigureKind) -> Result<Vec<u8>> 
         }
     };
     Ok(bytes)
+}
+
+/// Runs a live session's runs again with the decisions it applied, prints
+/// their table and checks it against the recorded one.
+fn replay(rec: &Recording) -> Result<()> {
+    let replay = rec.replay_live().context("--replay")?;
+    outln!()?;
+    outln!("Replayed offline, each run decided by the decisions it applied:")?;
+    match rec.runs {
+        Runs::Grid { .. } => outln!("{}", errp_sim::grid::GridEpisodeHeader)?,
+        Runs::Epuck { .. } => outln!("{}", errp_sim::epuck::EpuckRunHeader)?,
+    }
+    for row in &replay.replayed {
+        outln!("{row}")?;
+    }
+    if let Some(k) = replay.first_difference() {
+        let none = String::from("(none)");
+        bail!(
+            "--replay: run {} differs from the recording:\n  recorded: {}\n  replayed: {}",
+            k + 1,
+            replay.recorded.get(k).unwrap_or(&none).trim(),
+            replay.replayed.get(k).unwrap_or(&none).trim()
+        );
+    }
+    outln!(
+        "the same per-run table as recorded ({} runs)",
+        replay.replayed.len()
+    )?;
+    Ok(())
 }

@@ -116,15 +116,17 @@ pub fn run_epuck_episode_with(
 
 /// [`run_epuck_episode`] with a decoder outside the process, live
 /// (`errp stream`): `live` streams each window's raw EEG and returns the
-/// p(error)s that came for it. The detector runs at the scenario's
-/// `control.t_e`, as for a decoder of the user's own.
+/// p(error)s that came for it, and `observer` watches (a recording). The
+/// detector runs at the scenario's `control.t_e`, as for a decoder of the
+/// user's own.
 pub fn run_epuck_episode_live(
     scenario: &EpuckScenario,
     decoder: &ContinuousDecoder,
     seed: u64,
     live: LiveWindowDecoder<'_>,
+    observer: &mut impl EpuckObserver,
 ) -> Result<EpuckEpisodeResult> {
-    run_episode(scenario, decoder, seed, &mut (), Mode::Live(live))
+    run_episode(scenario, decoder, seed, observer, Mode::Live(live))
 }
 
 /// Which decoder reads the windows of an episode.

@@ -99,3 +99,40 @@ impl EpuckObserver for () {
         false
     }
 }
+
+/// An observer if there is one: a live run recorded or not.
+impl EpuckObserver for Option<&mut dyn EpuckObserver> {
+    fn watches(&self) -> bool {
+        self.as_ref().is_some_and(|o| o.watches())
+    }
+    fn on_physics(&mut self, frame: &PhysicsFrame) {
+        if let Some(o) = self {
+            o.on_physics(frame);
+        }
+    }
+    fn on_window(&mut self, frame: &WindowFrame) {
+        if let Some(o) = self {
+            o.on_window(frame);
+        }
+    }
+    fn on_event(&mut self, time_secs: f64, text: &str, warn: bool) {
+        if let Some(o) = self {
+            o.on_event(time_secs, text, warn);
+        }
+    }
+    fn on_start(&mut self, start: &EpisodeStart) {
+        if let Some(o) = self {
+            o.on_start(start);
+        }
+    }
+    fn on_errp(&mut self, time_secs: f64, onset_secs: f64, phase: usize) {
+        if let Some(o) = self {
+            o.on_errp(time_secs, onset_secs, phase);
+        }
+    }
+    fn on_end(&mut self, time_secs: f64, committed: Option<usize>) {
+        if let Some(o) = self {
+            o.on_end(time_secs, committed);
+        }
+    }
+}

@@ -82,7 +82,7 @@ pub fn run_grid_episode_with(
             &belief,
         )?;
         // A decision missed leaves the belief as it was.
-        if !judged.decoded.missed {
+        if !judged.decoded.missed() {
             controller.observe(judged.from, action, judged.decoded.p_error)?;
         }
         plant.keep(&mut judged, || controller.belief().probabilities());

@@ -273,7 +273,7 @@ impl GridPlant {
             &self.grid,
             to,
             error,
-            (!decoded.missed).then_some(decoded.says_error),
+            (!decoded.missed()).then_some(decoded.says_error),
         );
         let onset_secs = self.total_secs;
         self.total_secs += interval_secs;
@@ -411,10 +411,14 @@ pub(crate) struct Decoded {
     pub(crate) says_error: bool,
     pub(crate) fcz: Vec<f64>,
     pub(crate) epoch: Option<EegBlock>,
-    pub(crate) missed: bool,
 }
 
 impl Decoded {
+    /// A live decision that did not come in time (no p(error)).
+    pub(crate) fn missed(&self) -> bool {
+        self.p_error.is_nan()
+    }
+
     /// A live decoder's decision: p(error), or none when it missed.
     fn live(p: Option<f64>) -> Result<Self> {
         let p = p.map(check_p_error).transpose()?;
@@ -423,7 +427,6 @@ impl Decoded {
             says_error: p.is_some_and(|p| p >= 0.5),
             fcz: Vec::new(),
             epoch: None,
-            missed: p.is_none(),
         })
     }
 }
@@ -560,7 +563,6 @@ impl ActionDecoder {
             says_error,
             fcz,
             epoch,
-            missed: false,
         })
     }
 }

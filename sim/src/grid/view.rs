@@ -133,6 +133,16 @@ impl GridRecorder {
         self.episodes
     }
 
+    /// The file.
+    pub(crate) fn file(&self) -> &RrdFile {
+        &self.file
+    }
+
+    /// Where the next episode starts on the timeline (s).
+    pub(crate) fn next_t0(&self) -> f64 {
+        self.t0
+    }
+
     /// Records the next episode, run from `seed` with actions of
     /// `epoch_secs`. A step's belief of NaN (an agent chose the actions)
     /// leaves the posterior and the belief series out.

@@ -51,7 +51,9 @@ pub(super) fn grid_results(
         let mut steps = Vec::new();
         for i in run_rows(a_run, k) {
             let to = cell(a.to_x[i], a.to_y[i])?;
-            tally.action(&grid, to, a.error[i], Some(a.decoded_error[i]));
+            // A live decision missed: no p(error), not scored.
+            let decoded = (!a.p_error[i].is_nan()).then_some(a.decoded_error[i]);
+            tally.action(&grid, to, a.error[i], decoded);
             let name = &a.action[i];
             let action = GridAction::ALL
                 .into_iter()

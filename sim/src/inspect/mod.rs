@@ -22,11 +22,13 @@ use crate::scenario::AnyScenario;
 
 mod frames;
 mod grid_replay;
+mod live;
 mod read;
 mod report;
 mod tables;
 
 pub use crate::record::data::Table;
+pub use live::{LiveReplay, LiveSession};
 pub use read::MAX_RECORDING_BYTES;
 pub use report::{Comparison, RecordingHeadline, RecordingReport};
 pub use tables::{CsvTable, PARQUET_TABLE_KEY, csv_tables, phase_secs};
@@ -84,6 +86,8 @@ pub struct Recording {
     pub tables: std::collections::BTreeMap<String, Table>,
     /// Every run, recomputed from the tables.
     pub runs: Runs,
+    /// A live session's decisions (`errp stream --save`).
+    pub live: Option<LiveSession>,
 }
 
 impl Recording {
@@ -128,11 +132,21 @@ impl Recording {
                 provenance.runs
             )));
         }
+        let live = provenance
+            .live
+            .as_ref()
+            .map(|l| {
+                let grid = matches!(runs, Runs::Grid { .. });
+                live::live_session(&tables, n, (l.speed, &l.decoder), grid)
+            })
+            .transpose()
+            .map_err(&bad)?;
         Ok(Self {
             path: path.to_path_buf(),
             provenance,
             tables,
             runs,
+            live,
         })
     }
 

@@ -64,13 +64,21 @@ fn describe(f: &mut fmt::Formatter<'_>, r: &Recording) -> fmt::Result {
     } else {
         String::new()
     };
-    match &p.agent {
-        Some(agent) => writeln!(
+    match (&p.agent, &r.live) {
+        (_, Some(live)) => writeln!(
+            f,
+            "  live:     errp stream at speed {}, decisions from {}; replay them offline: errp \
+             inspect {} --replay",
+            live.speed,
+            live.decoder,
+            r.path.display()
+        )?,
+        (Some(agent), None) => writeln!(
             f,
             "  driven by: {agent}; each episode's seed is in the runs table \
              (--csv), the actions in the trajectory"
         )?,
-        None => writeln!(
+        (None, None) => writeln!(
             f,
             "  run again: errp inspect {} --scenario > scenario.toml && errp run scenario.toml \
              --seed {}{runs}",
@@ -133,6 +141,19 @@ fn describe(f: &mut fmt::Formatter<'_>, r: &Recording) -> fmt::Result {
             };
             write!(f, "{report}")?;
         }
+    }
+    if let Some(live) = &r.live {
+        let windows = matches!(r.runs, Runs::Epuck { .. });
+        writeln!(f)?;
+        writeln!(
+            f,
+            "Decisions from the online decoder, as received (latencies on its clock):"
+        )?;
+        for (k, run) in live.runs.iter().enumerate() {
+            writeln!(f, "{:>4}  {}", k + 1, run.timing(windows, None))?;
+        }
+        let all = crate::live::LiveRunStats::merged(&live.runs);
+        writeln!(f, "{:>4}  {}", "all", all.timing(windows, Some(live.speed)))?;
     }
     Ok(())
 }

@@ -95,7 +95,7 @@ pub fn run_epuck_live(
 
     let mut out = Vec::with_capacity(runs);
     for k in 0..runs {
-        let run = live_run(&mut s, scenario, &prepared, k)?;
+        let run = live_run(&mut s, scenario, &prepared, k, observer)?;
         observer.run(k, &run);
         out.push(run);
     }
@@ -132,12 +132,13 @@ fn stream_epuck_calibration(
 }
 
 /// Run `k` of `scenario` live on `s`, with the decoder `prepared` (its
-/// detection spans and the user's EEG model).
+/// detection spans and the user's EEG model), watched as `observer` asks.
 fn live_run(
     s: &mut Streamer<'_, WindowTracker>,
     scenario: &EpuckScenario,
     prepared: &ContinuousDecoder,
     k: usize,
+    observer: &mut dyn LiveObserver<EpuckLiveRun>,
 ) -> Result<EpuckLiveRun> {
     let names = scenario.layout.goals();
     let goal = scenario.episode.goal;
@@ -149,6 +150,8 @@ fn live_run(
     let mut decide = |w: &LiveWindow<'_>| -> Result<Vec<f64>> {
         if let Some(warm_up) = w.warm_up {
             s.stream(warm_up)?;
+            let origin = s.now_stamp();
+            s.tracker.run_began(origin);
         }
         if phase != Some(w.phase) {
             phase = Some(w.phase);
@@ -169,12 +172,9 @@ fn live_run(
         decisions.push(got.clone());
         Ok(got)
     };
-    let result = run_epuck_episode_live(
-        scenario,
-        prepared,
-        epuck_run_seed(scenario.seed, k),
-        &mut decide,
-    )?;
+    let seed = epuck_run_seed(scenario.seed, k);
+    let mut watch = observer.watch(k, seed);
+    let result = run_epuck_episode_live(scenario, prepared, seed, &mut decide, &mut watch)?;
     s.marker(&json!({
         "event": "run_end", "run": k, "reached": result.reached(),
         "committed": result.committed.map(|j| names[j].name.clone()),
@@ -212,6 +212,7 @@ pub fn replay_epuck(
             decoder,
             epuck_run_seed(scenario.seed, k),
             &mut decide,
+            &mut (),
         )?);
     }
     Ok(out)

@@ -202,7 +202,7 @@ fn live_run(
         &scenario.params,
         GridDecoding::Live(&mut decide),
         grid_episode_seed(scenario.seed, k),
-        false,
+        true,
     )?;
     s.marker(&json!({
         "event": "run_end", "run": k, "reached": result.reached(),
@@ -253,7 +253,7 @@ pub fn replay_grid(
             &scenario.params,
             GridDecoding::Live(&mut decide),
             grid_episode_seed(scenario.seed, k),
-            false,
+            true,
         )?);
     }
     Ok(out)

@@ -14,10 +14,18 @@
 
 use errp_bci::EegBlock;
 
+use crate::epuck::EpuckObserver;
 use crate::error::{Result, SimError};
 
+mod decisions;
 pub mod epuck;
 pub mod grid;
+#[cfg(feature = "rerun")]
+pub mod save;
+
+pub use decisions::{
+    DecisionTracker, Decisions, Fate, LiveRunStats, LoggedDecision, Received, WindowTracker,
+};
 
 /// The fastest a live loop runs: 100 times the wall clock.
 pub const MAX_SPEED: f64 = 100.0;
@@ -93,17 +101,6 @@ impl LiveOptions {
     }
 }
 
-/// A decision as the decoder sent it.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Received {
-    /// The action it is for (the marker's `action`), as sent.
-    pub id: f64,
-    /// Its p(error).
-    pub p_error: f64,
-    /// When it arrived (the link's clock, s).
-    pub arrived: f64,
-}
-
 /// What carries a live loop: EEG, markers and state out, decisions in.
 pub trait LiveLink: Send {
     /// The link's clock (s); every timestamp is on it.
@@ -134,6 +131,11 @@ pub trait LiveObserver<R> {
     fn note(&mut self, text: &str);
     /// Run `k` ended.
     fn run(&mut self, k: usize, run: &R);
+    /// What watches the e-puck's run `k` (seed `seed`) step by step as it
+    /// runs (a recording), if anything; the grid's runs carry their steps.
+    fn watch(&mut self, _k: usize, _seed: u64) -> Option<&mut dyn EpuckObserver> {
+        None
+    }
 }
 
 /// After the calibration: rest EEG from `eeg` until the decoder's stream
@@ -221,260 +223,6 @@ pub(crate) fn end_session<D: Decisions>(
     s.marker(&serde_json::json!({"event": "end"}))?;
     let fs = eeg.params().sfreq_hz;
     s.stream(&eeg.generate(fs as usize))
-}
-
-/// Per run: what the decoder's timing was.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct LiveRunStats {
-    /// Each decision applied: seconds (link clock) from its action's onset
-    /// to its arrival.
-    pub latencies_secs: Vec<f64>,
-    /// Actions whose decision did not come before the next action.
-    pub missed: usize,
-    /// Decisions that came for an action already past (or twice).
-    pub late: usize,
-    /// Decisions for no action announced.
-    pub stray: usize,
-}
-
-impl LiveRunStats {
-    /// The `q` quantile of the latencies (s; linear between order
-    /// statistics), none without decisions.
-    pub fn latency_quantile(&self, q: f64) -> Option<f64> {
-        let mut v = self.latencies_secs.clone();
-        if v.is_empty() {
-            return None;
-        }
-        v.sort_by(f64::total_cmp);
-        let pos = q.clamp(0.0, 1.0) * (v.len() - 1) as f64;
-        let (lo, hi) = (pos.floor() as usize, pos.ceil() as usize);
-        Some(v[lo] + (v[hi] - v[lo]) * (pos - lo as f64))
-    }
-}
-
-/// What a live loop does with the decisions that come.
-pub trait Decisions {
-    /// Takes what came by `now` (the link's clock).
-    fn receive(&mut self, got: &[Received], now: f64) -> Result<()>;
-    /// Samples up to `stamp` are published.
-    fn published(&mut self, _stamp: f64) {}
-    /// The control starts at `now`: silence counts from here.
-    fn start(&mut self, now: f64);
-}
-
-/// The rules every decoder keeps: p(error) is a probability, and silence
-/// lasts at most `timeout_secs` once the control has started.
-#[derive(Debug)]
-struct Silence {
-    name: String,
-    timeout_secs: f64,
-    /// When the decoder was last heard from (or the control started).
-    heard: Option<f64>,
-}
-
-impl Silence {
-    fn new(name: &str, timeout_secs: f64) -> Self {
-        Self {
-            name: name.into(),
-            timeout_secs,
-            heard: None,
-        }
-    }
-
-    fn check(&mut self, r: &Received) -> Result<()> {
-        if !(r.p_error.is_finite() && (0.0..=1.0).contains(&r.p_error)) {
-            return Err(SimError::Live(format!(
-                "the decoder stream {:?} sent p(error) = {} for {}, expected a number from 0 \
-                 to 1",
-                self.name, r.p_error, r.id
-            )));
-        }
-        self.heard = Some(r.arrived);
-        Ok(())
-    }
-
-    fn quiet(&self, now: f64, waiting: &str) -> Result<()> {
-        if let Some(heard) = self.heard
-            && now - heard > self.timeout_secs
-        {
-            return Err(SimError::Live(format!(
-                "the decoder stream {:?} sent nothing for {:.1} s{waiting}: it stopped or \
-                 hangs; the loop waits at most --timeout {} s",
-                self.name,
-                now - heard,
-                self.timeout_secs
-            )));
-        }
-        Ok(())
-    }
-}
-
-/// The decisions of the grid: which action waits for one, what came in
-/// time, and what came late. A decision names its action by the id of the
-/// action's marker.
-#[derive(Debug)]
-pub struct DecisionTracker {
-    silence: Silence,
-    /// The action waiting (its id and onset on the link's clock).
-    pending: Option<(u64, f64)>,
-    /// Its decision, once come.
-    decided: Option<f64>,
-    /// Actions announced so far.
-    announced: u64,
-    /// The current run's statistics.
-    stats: LiveRunStats,
-}
-
-impl DecisionTracker {
-    /// A tracker for the decoder `name`, stopping after `timeout_secs` of
-    /// silence once [`DecisionTracker::start`]ed.
-    pub fn new(name: &str, timeout_secs: f64) -> Self {
-        Self {
-            silence: Silence::new(name, timeout_secs),
-            pending: None,
-            decided: None,
-            announced: 0,
-            stats: LiveRunStats::default(),
-        }
-    }
-
-    /// Announces the next action, with its onset at `onset` (link clock);
-    /// returns its id.
-    pub fn announce(&mut self, onset: f64) -> u64 {
-        let id = self.announced;
-        self.announced += 1;
-        self.pending = Some((id, onset));
-        self.decided = None;
-        id
-    }
-
-    /// Ends the action waiting: its decision, or none (counted missed).
-    pub fn settle(&mut self) -> Option<f64> {
-        self.pending = None;
-        let d = self.decided.take();
-        if d.is_none() {
-            self.stats.missed += 1;
-        }
-        d
-    }
-
-    /// The statistics of the run that ended, and a fresh count.
-    pub fn take_run(&mut self) -> LiveRunStats {
-        std::mem::take(&mut self.stats)
-    }
-}
-
-impl Decisions for DecisionTracker {
-    fn start(&mut self, now: f64) {
-        self.silence.heard = Some(now);
-    }
-
-    /// A decision for the action waiting is kept (the first one), others
-    /// are counted. A decoder silent too long, or a p(error) that is not
-    /// one, is an error.
-    fn receive(&mut self, got: &[Received], now: f64) -> Result<()> {
-        for r in got {
-            self.silence.check(r)?;
-            let id =
-                (r.id.is_finite() && r.id >= 0.0 && r.id.fract() == 0.0).then_some(r.id as u64);
-            match (id, self.pending) {
-                (Some(id), Some((waiting, onset))) if id == waiting && self.decided.is_none() => {
-                    self.decided = Some(r.p_error);
-                    self.stats.latencies_secs.push(r.arrived - onset);
-                }
-                (Some(id), _) if id < self.announced => self.stats.late += 1,
-                _ => self.stats.stray += 1,
-            }
-        }
-        let waiting = self
-            .pending
-            .map(|(id, _)| format!(" (waiting for action {id})"))
-            .unwrap_or_default();
-        self.silence.quiet(now, &waiting)
-    }
-}
-
-/// The decisions of the e-puck: p(error) of windows, each named by the
-/// timestamp of its window's last sample. A window's decision is applied at
-/// the device's next window if it is newer than the last one applied and
-/// the window ended within the current movement phase; one about an
-/// earlier phase is late (it judged a motion already past).
-#[derive(Debug)]
-pub struct WindowTracker {
-    silence: Silence,
-    /// The timestamp at which the current movement phase began.
-    phase_start: f64,
-    /// The window of the last decision applied.
-    last_applied: f64,
-    /// The last sample published.
-    published: f64,
-    /// Decisions come since the device's last window.
-    accepted: Vec<f64>,
-    stats: LiveRunStats,
-}
-
-impl WindowTracker {
-    /// A tracker for the decoder `name`, stopping after `timeout_secs` of
-    /// silence once [`WindowTracker::start`]ed.
-    pub fn new(name: &str, timeout_secs: f64) -> Self {
-        Self {
-            silence: Silence::new(name, timeout_secs),
-            phase_start: f64::NEG_INFINITY,
-            last_applied: f64::NEG_INFINITY,
-            published: f64::NEG_INFINITY,
-            accepted: Vec::new(),
-            stats: LiveRunStats::default(),
-        }
-    }
-
-    /// A movement phase began with the sample stamped `stamp`.
-    pub fn phase_began(&mut self, stamp: f64) {
-        self.phase_start = stamp;
-    }
-
-    /// The decisions to apply at the device's window (counted missed if
-    /// none).
-    pub fn take(&mut self) -> Vec<f64> {
-        if self.accepted.is_empty() {
-            self.stats.missed += 1;
-        }
-        std::mem::take(&mut self.accepted)
-    }
-
-    /// The statistics of the run that ended, and a fresh count (decisions
-    /// not yet applied are dropped).
-    pub fn take_run(&mut self) -> LiveRunStats {
-        self.accepted.clear();
-        self.last_applied = f64::NEG_INFINITY;
-        std::mem::take(&mut self.stats)
-    }
-}
-
-impl Decisions for WindowTracker {
-    fn start(&mut self, now: f64) {
-        self.silence.heard = Some(now);
-    }
-
-    fn published(&mut self, stamp: f64) {
-        self.published = stamp;
-    }
-
-    fn receive(&mut self, got: &[Received], now: f64) -> Result<()> {
-        for r in got {
-            self.silence.check(r)?;
-            let w = r.id;
-            if !w.is_finite() || w > self.published + 1e-9 {
-                self.stats.stray += 1;
-            } else if w <= self.last_applied || w < self.phase_start {
-                self.stats.late += 1;
-            } else {
-                self.last_applied = w;
-                self.accepted.push(r.p_error);
-                self.stats.latencies_secs.push(r.arrived - w);
-            }
-        }
-        self.silence.quiet(now, "")
-    }
 }
 
 /// Publishes the EEG on the link's clock, `speed` times faster than it,
@@ -568,79 +316,6 @@ impl<'l, D: Decisions> Streamer<'l, D> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn got(id: f64, p: f64, arrived: f64) -> Received {
-        Received {
-            id,
-            p_error: p,
-            arrived,
-        }
-    }
-
-    #[test]
-    fn a_decision_in_time_is_applied_and_a_late_one_counted() {
-        let mut t = DecisionTracker::new("dec", 10.0);
-        t.start(0.0);
-        let a = t.announce(1.0);
-        t.receive(&[got(a as f64, 0.9, 1.3)], 1.3).unwrap();
-        // A second decision for the same action is not applied again.
-        t.receive(&[got(a as f64, 0.1, 1.4)], 1.4).unwrap();
-        assert_eq!(t.settle(), Some(0.9));
-        let b = t.announce(4.0);
-        assert_eq!(t.settle(), None);
-        t.receive(&[got(b as f64, 0.2, 7.5), got(9.0, 0.5, 7.5)], 7.5)
-            .unwrap();
-        let s = t.take_run();
-        assert_eq!(s.missed, 1);
-        assert_eq!(s.late, 2);
-        assert_eq!(s.stray, 1);
-        assert!((s.latencies_secs[0] - 0.3).abs() < 1e-12);
-        assert_eq!(s.latency_quantile(0.5), Some(s.latencies_secs[0]));
-    }
-
-    #[test]
-    fn a_silent_decoder_or_a_bad_probability_stops_the_loop() {
-        let mut t = DecisionTracker::new("dec", 2.0);
-        t.receive(&[], 100.0).unwrap();
-        t.start(100.0);
-        t.receive(&[], 101.9).unwrap();
-        let e = t.receive(&[], 102.5).unwrap_err().to_string();
-        assert!(e.contains("--timeout 2 s"), "{e}");
-        assert!(e.contains("\"dec\" sent nothing for 2.5 s"), "{e}");
-        let mut t = DecisionTracker::new("dec", 2.0);
-        t.start(0.0);
-        let e = t
-            .receive(&[got(0.0, 1.5, 0.1)], 0.1)
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("p(error) = 1.5"), "{e}");
-    }
-
-    #[test]
-    fn a_window_decision_applies_once_and_within_its_phase() {
-        let mut t = WindowTracker::new("dec", 10.0);
-        assert_eq!(t.take(), Vec::<f64>::new());
-        t.take_run();
-        t.start(0.0);
-        t.published(5.0);
-        t.phase_began(3.0);
-        t.receive(
-            &[
-                got(4.0, 0.9, 5.01),
-                got(4.0, 0.8, 5.02),
-                got(2.5, 0.7, 5.03),
-                got(6.0, 0.1, 5.04),
-                got(4.5, 0.2, 5.05),
-            ],
-            5.05,
-        )
-        .unwrap();
-        assert_eq!(t.take(), vec![0.9, 0.2]);
-        assert_eq!(t.take(), Vec::<f64>::new());
-        let s = t.take_run();
-        assert_eq!((s.late, s.stray, s.missed), (2, 1, 1));
-        assert!((s.latencies_secs[0] - 1.01).abs() < 1e-9);
-    }
 
     #[test]
     fn options_name_their_flags() {

@@ -54,6 +54,19 @@ pub struct Provenance {
     /// ...`): the file's name, size and SHA-256.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub eeg_recording: Option<crate::files::FileDigest>,
+    /// Set when a decoder outside the process decided, live (`errp
+    /// stream`): how. The decisions are in `/errp/decisions`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub live: Option<LiveProvenance>,
+}
+
+/// How a live session ran.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LiveProvenance {
+    /// Simulated seconds per second of the link's clock.
+    pub speed: f64,
+    /// The decoder's stream, as `--decisions` found it (`name=...`).
+    pub decoder: String,
 }
 
 impl Provenance {
@@ -73,6 +86,7 @@ impl Provenance {
             decoder_summary: String::new(),
             agent: None,
             eeg_recording: None,
+            live: None,
         }
     }
 

@@ -41,6 +41,8 @@ pub const ACTIONS: &str = "/errp/actions";
 pub const ENDS: &str = "/errp/ends";
 /// E-puck: the event log with run numbers.
 pub const EVENTS: &str = "/errp/events";
+/// A live session (`errp stream`): one row per decision received.
+pub const DECISIONS: &str = "/errp/decisions";
 /// The prefix of the data tables.
 pub const TABLES: &str = "/errp/";
 

@@ -15,9 +15,10 @@
 //! | `/errp/frames` | e-puck | physics step (64 Hz) | `run`, `t_s`, `x_cm`, `y_cm`, `heading_deg`, `tracked_x_cm`, `tracked_y_cm`, `phase` (0 turning, 1 driving, 2 stopped), `target` |
 //! | `/errp/windows` | e-puck | decoder window (16 Hz) | `run`, `t_s`, `p_error`, `evidence`, `detected`, `step` (0 turn, 1 linear, 2 stopped on a goal, 3 idle), `target`, `belief` (one value per goal) |
 //! | `/errp/errps` | e-puck | ErrP of the user | `run`, `t_s` (seen), `onset_s`, `phase` |
-//! | `/errp/actions` | grid | action | `run`, `t_s` (onset), `from_x`, `from_y`, `action`, `to_x`, `to_y`, `error`, `p_error`, `decoded_error`, `belief` (one value per cell) |
+//! | `/errp/actions` | grid | action | `run`, `t_s` (onset), `from_x`, `from_y`, `action`, `to_x`, `to_y`, `error`, `p_error` (NaN: a live decision missed, not scored), `decoded_error`, `belief` (one value per cell) |
 //! | `/errp/ends` | both | run, at its end | `run`, `t_s`, `committed` (goal index, -1 for none; the grid: cell index) |
 //! | `/errp/events` | e-puck | event of the log | `run`, `t_s`, `warn`, `text` |
+//! | `/errp/decisions` | both, live (`errp stream`) | decision received from the decoder | `run`, `t_s` (arrival, on the run's simulated clock), `id` (as sent: the action, or the window's last timestamp), `p_error`, `latency_s` (link clock, from the action's onset or the window's end; NaN for a stray one), `fate` (`applied`, `late`, `stray`), `applied_to` (the run's action or device window, from 0; -1 if not applied) |
 
 use std::collections::BTreeMap;
 
@@ -311,6 +312,18 @@ tables! {
         p_error: F64,
         decoded_error: Bool,
         belief: Rows,
+    }
+
+    /// `/errp/decisions` of a live session: one row per decision
+    /// received, in order of arrival (`t_s` on the run's simulated clock).
+    LiveDecisions, LiveDecisionsView at paths::DECISIONS => {
+        run: I64,
+        t_s: F64,
+        id: F64,
+        p_error: F64,
+        latency_s: F64,
+        fate: Str,
+        applied_to: I64,
     }
 
     /// `/errp/ends`: one row per run, at its end (`committed`: the goal

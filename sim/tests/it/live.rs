@@ -1,12 +1,13 @@
 //! The grid live, on a link with a virtual clock and a decoder that answers
-//! from the markers alone: what is published, which decisions apply, and
-//! the replay of the decisions applied.
+//! from the markers alone: what is published, which decisions apply, the
+//! replay of the decisions applied, and the session recorded and replayed
+//! from its file.
 
 use errp_bci::EegBlock;
 use errp_sim::grid::GridScenario;
-use errp_sim::live::LiveObserver;
+use errp_sim::live::epuck::EpuckLiveRun;
 use errp_sim::live::grid::{GridLiveRun, replay_grid, run_grid_live};
-use errp_sim::live::{LiveLink, LiveOptions, Received};
+use errp_sim::live::{Fate, LiveLink, LiveObserver, LiveOptions, Received};
 use errp_sim::{Result, SimError};
 use serde_json::Value;
 
@@ -116,6 +117,11 @@ impl LiveObserver<GridLiveRun> for Quiet {
     fn run(&mut self, _k: usize, _run: &GridLiveRun) {}
 }
 
+impl LiveObserver<EpuckLiveRun> for Quiet {
+    fn note(&mut self, _text: &str) {}
+    fn run(&mut self, _k: usize, _run: &EpuckLiveRun) {}
+}
+
 fn scenario() -> GridScenario {
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/grid_fixed_goals.toml");
@@ -130,7 +136,12 @@ fn the_decisions_applied_replay_to_the_same_runs() {
         speed: 50.0,
         ..LiveOptions::default()
     };
-    let runs = run_grid_live(&s, &mut link, options, 2, "virtual", &mut Quiet).unwrap();
+    // Recorded as `errp stream --save` records, when the crate records.
+    #[cfg(feature = "rerun")]
+    let mut observer = saved::Saving::grid(&s, 50.0);
+    #[cfg(not(feature = "rerun"))]
+    let mut observer = Quiet;
+    let runs = run_grid_live(&s, &mut link, options, 2, "virtual", &mut observer).unwrap();
     assert_eq!(runs.len(), 2);
     // The calibration: 400 labelled actions, then the control's actions
     // with no label; the EEG at 256 Hz x 50.
@@ -154,15 +165,19 @@ fn the_decisions_applied_replay_to_the_same_runs() {
     for r in &runs {
         let missed = r.decisions.iter().filter(|d| d.is_none()).count();
         assert_eq!(r.stats.missed, missed);
-        assert_eq!(r.stats.latencies_secs.len(), r.result.actions - missed);
-        for l in &r.stats.latencies_secs {
+        assert_eq!(r.stats.latencies_secs().len(), r.result.actions - missed);
+        for l in r.stats.latencies_secs() {
             assert!((l - 0.011).abs() < 1e-9, "latency {l}");
+        }
+        // Each late decision came 0.2 s after its own action's onset.
+        for d in r.stats.decisions.iter().filter(|d| d.fate == Fate::Late) {
+            assert!((d.latency_secs - 0.2).abs() < 1e-9, "{d:?}");
         }
     }
     let missed: usize = runs.iter().map(|r| r.stats.missed).sum();
     assert_eq!(missed, actions / 7, "{actions} actions");
     // The late ones are counted when they come (the last few may not have).
-    let late: usize = runs.iter().map(|r| r.stats.late).sum();
+    let late: usize = runs.iter().map(|r| r.stats.late()).sum();
     assert!(
         late + 3 >= missed && late <= missed,
         "{late} late of {missed}"
@@ -170,13 +185,16 @@ fn the_decisions_applied_replay_to_the_same_runs() {
     // The same decisions, offline: the same runs.
     let decisions: Vec<_> = runs.iter().map(|r| r.decisions.clone()).collect();
     let again = replay_grid(&s, &decisions).unwrap();
+    // (Compared as printed: a missed action's p(error) is NaN.)
     for (live, offline) in runs.iter().zip(&again) {
-        assert_eq!(&live.result, offline);
+        assert_eq!(format!("{:?}", live.result), format!("{offline:?}"));
     }
     // A replay with fewer decisions than a run needs says so.
     let short = vec![decisions[0][..1].to_vec()];
     let e = replay_grid(&s, &short).unwrap_err().to_string();
     assert!(e.contains("more decisions than the 1 recorded"), "{e}");
+    #[cfg(feature = "rerun")]
+    saved::check_grid(observer, &runs);
 }
 
 #[test]
@@ -211,7 +229,7 @@ fn a_decoder_always_late_decides_nothing() {
     assert!(r.decisions.iter().all(Option::is_none));
     assert_eq!(r.result.committed, None);
     assert_eq!(r.stats.missed, r.result.actions);
-    assert!(r.stats.late + 3 >= r.stats.missed, "{:?}", r.stats);
+    assert!(r.stats.late() + 3 >= r.stats.missed, "{:?}", r.stats);
 }
 
 /// The e-puck on a virtual link: the decoder answers each block of EEG
@@ -277,21 +295,17 @@ impl LiveLink for WindowLink {
     }
 }
 
-struct QuietEpuck;
-
-impl LiveObserver<errp_sim::live::epuck::EpuckLiveRun> for QuietEpuck {
-    fn note(&mut self, _text: &str) {}
-    fn run(&mut self, _k: usize, _run: &errp_sim::live::epuck::EpuckLiveRun) {}
-}
-
 #[test]
 fn the_epuck_windows_applied_replay_to_the_same_runs() {
     use errp_sim::epuck::EpuckScenario;
     use errp_sim::live::epuck::{prepare_live_epuck, replay_epuck, run_epuck_live};
 
-    let path =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/mexico_to_pisa.toml");
-    let s = EpuckScenario::parse(&std::fs::read_to_string(&path).unwrap(), &path).unwrap();
+    let scenario_path = path_of_scenario();
+    let s = EpuckScenario::parse(
+        &std::fs::read_to_string(&scenario_path).unwrap(),
+        &scenario_path,
+    )
+    .unwrap();
     let mut link = WindowLink {
         clock: 50.0,
         connected: false,
@@ -304,19 +318,179 @@ fn the_epuck_windows_applied_replay_to_the_same_runs() {
         calibration_actions: Some(40),
         ..LiveOptions::default()
     };
-    let runs = run_epuck_live(&s, &mut link, options, 1, "virtual", &mut QuietEpuck).unwrap();
+    #[cfg(feature = "rerun")]
+    let mut observer = saved::Saving::epuck(&s, 10.0);
+    #[cfg(not(feature = "rerun"))]
+    let mut observer = Quiet;
+    let runs = run_epuck_live(&s, &mut link, options, 1, "virtual", &mut observer).unwrap();
     let r = &runs[0];
     assert!(link.phases >= 2, "{} phase markers", link.phases);
     // Each decision came 20 ms after its window: applied at the next
     // window, 0.2 s of simulated time later at speed 10.
-    assert!(!r.stats.latencies_secs.is_empty());
-    for l in &r.stats.latencies_secs {
+    assert!(!r.stats.latencies_secs().is_empty());
+    for l in r.stats.latencies_secs() {
         assert!((l - 0.02).abs() < 1e-9, "latency {l}");
     }
     let applied: usize = r.decisions.iter().map(Vec::len).sum();
-    assert_eq!(applied, r.stats.latencies_secs.len());
+    assert_eq!(applied, r.stats.latencies_secs().len());
     assert!(r.result.detected_errors > 0, "{:?}", r.result);
     let decoder = prepare_live_epuck(&s).unwrap();
     let again = replay_epuck(&s, &decoder, std::slice::from_ref(&r.decisions)).unwrap();
     assert_eq!(again[0], r.result);
+    #[cfg(feature = "rerun")]
+    saved::check_epuck(observer, r, &s);
+}
+
+fn path_of_scenario() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/mexico_to_pisa.toml")
+}
+
+/// The sessions recorded as `errp stream --save` records them, read back
+/// and replayed.
+#[cfg(feature = "rerun")]
+mod saved {
+    use std::path::PathBuf;
+
+    use errp_sim::epuck::{EpuckObserver, EpuckScenario};
+    use errp_sim::grid::GridScenario;
+    use errp_sim::inspect::Recording;
+    use errp_sim::live::epuck::EpuckLiveRun;
+    use errp_sim::live::grid::GridLiveRun;
+    use errp_sim::live::save::LiveRecording;
+    use errp_sim::live::{LiveObserver, LiveRunStats};
+    use errp_sim::record::data::{LiveProvenance, Provenance};
+
+    /// Records a session as `errp stream --save` does.
+    pub(super) struct Saving {
+        recording: Option<LiveRecording>,
+        dir: PathBuf,
+    }
+
+    impl Saving {
+        pub(super) fn grid(s: &GridScenario, speed: f64) -> Self {
+            let dir = scratch("grid");
+            let text = std::fs::read_to_string(&s.path).unwrap();
+            let p = Self::provenance("grid", text, s.seed, speed);
+            let recording = LiveRecording::grid(&dir.join("live.rrd"), s, p).unwrap();
+            Self {
+                recording: Some(recording),
+                dir,
+            }
+        }
+
+        pub(super) fn epuck(s: &EpuckScenario, speed: f64) -> Self {
+            let dir = scratch("epuck");
+            let text = std::fs::read_to_string(&s.path).unwrap();
+            let p = Self::provenance("epuck", text, s.seed, speed);
+            let recording = LiveRecording::epuck(&dir.join("live.rrd"), s, p).unwrap();
+            Self {
+                recording: Some(recording),
+                dir,
+            }
+        }
+
+        fn provenance(task: &str, text: String, seed: u64, speed: f64) -> Provenance {
+            let mut p = Provenance::new(task, "test", text, seed);
+            p.live = Some(LiveProvenance {
+                speed,
+                decoder: "name=virtual".into(),
+            });
+            p
+        }
+
+        fn finish(&mut self) -> Recording {
+            let path = self.recording.take().unwrap().finish().unwrap();
+            Recording::open(path).unwrap()
+        }
+    }
+
+    impl LiveObserver<GridLiveRun> for Saving {
+        fn note(&mut self, _text: &str) {}
+        fn run(&mut self, k: usize, run: &GridLiveRun) {
+            self.recording.as_mut().unwrap().grid_run(k, run).unwrap();
+        }
+    }
+
+    impl LiveObserver<EpuckLiveRun> for Saving {
+        fn note(&mut self, _text: &str) {}
+        fn run(&mut self, k: usize, run: &EpuckLiveRun) {
+            self.recording.as_mut().unwrap().epuck_run(k, run).unwrap();
+        }
+        fn watch(&mut self, k: usize, seed: u64) -> Option<&mut dyn EpuckObserver> {
+            self.recording.as_mut().unwrap().epuck_watch(k, seed)
+        }
+    }
+
+    /// The decisions a recording read back holds: those received, each with
+    /// its fate and latency, and the same count missed.
+    fn assert_recorded(recorded: &[LiveRunStats], live: &[&LiveRunStats]) {
+        assert_eq!(recorded.len(), live.len());
+        for (r, l) in recorded.iter().zip(live) {
+            assert_eq!(r.missed, l.missed);
+            assert_eq!(r.decisions.len(), l.decisions.len());
+            for (a, b) in r.decisions.iter().zip(&l.decisions) {
+                assert_eq!(a.fate, b.fate);
+                assert_eq!(a.received.p_error, b.received.p_error);
+                assert_eq!(a.received.id, b.received.id);
+                assert!(
+                    a.latency_secs == b.latency_secs
+                        || (a.latency_secs.is_nan() && b.latency_secs.is_nan())
+                );
+            }
+        }
+    }
+
+    /// An empty directory of this test process.
+    fn scratch(name: &str) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("errp-live-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    /// The grid session's recording holds the decisions as received; its runs
+    /// replayed from it give the table the session printed.
+    pub(super) fn check_grid(mut saving: Saving, runs: &[GridLiveRun]) {
+        // The recording holds the decisions as received; its runs replayed
+        // from it give the table the session printed.
+        let rec = saving.finish();
+        let live = rec.live.as_ref().expect("a live recording");
+        assert_eq!(live.speed, 50.0);
+        assert_recorded(
+            &live.runs,
+            &runs.iter().map(|r| &r.stats).collect::<Vec<_>>(),
+        );
+        let replay = rec.replay_live().unwrap();
+        let printed: Vec<String> = runs
+            .iter()
+            .enumerate()
+            .map(|(k, r)| errp_sim::grid::GridEpisodeRow(k, &r.result).to_string())
+            .collect();
+        assert_eq!(replay.recorded, printed);
+        assert_eq!(replay.replayed, printed);
+        assert_eq!(replay.first_difference(), None);
+        std::fs::remove_dir_all(&saving.dir).unwrap();
+    }
+
+    /// The e-puck session's recording: the decisions as received, each
+    /// window's as applied, and the run replayed from the file as the session
+    /// printed it.
+    pub(super) fn check_epuck(mut saving: Saving, r: &EpuckLiveRun, s: &EpuckScenario) {
+        // The recording: the decisions as received, each window's as applied,
+        // and the run replayed from the file as the session printed it.
+        let rec = saving.finish();
+        let live = rec.live.as_ref().expect("a live recording");
+        assert_recorded(&live.runs, &[&r.stats]);
+        assert_eq!(live.applied[0], r.decisions);
+        let replay = rec.replay_live().unwrap();
+        let printed = errp_sim::epuck::EpuckRunRow {
+            index: 0,
+            result: &r.result,
+            layout: &s.layout,
+        }
+        .to_string();
+        assert_eq!(replay.recorded, std::slice::from_ref(&printed));
+        assert_eq!(replay.replayed, [printed]);
+        std::fs::remove_dir_all(&saving.dir).unwrap();
+    }
 }

@@ -244,6 +244,16 @@ impl EpuckRecorder {
         self.keep(r);
     }
 
+    /// Names what each run's log opens with, after the run's number.
+    pub(crate) fn set_run_title(&mut self, title: String) {
+        self.run_title = title;
+    }
+
+    /// Where the current run starts on the timeline (s).
+    pub(crate) fn run_offset_secs(&self) -> f64 {
+        self.offset_secs
+    }
+
     /// Logs the last run's overview; returns the first recording error, if
     /// any (logging goes on regardless).
     pub fn finish(mut self) -> Result<()> {

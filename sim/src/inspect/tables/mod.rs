@@ -148,6 +148,40 @@ pub fn phase_secs(rec: &Recording) -> Vec<[f64; 3]> {
 
 /// Every tidy table of `rec`.
 pub fn csv_tables(rec: &Recording) -> Vec<CsvTable> {
+    let mut out = task_tables(rec);
+    if rec.live.is_some() {
+        out.push(decisions_table(rec));
+    }
+    out
+}
+
+/// A live session's decisions as received, one row each: the run and the
+/// step (grid action) or window it was applied to, from 1 (0: late or
+/// stray), and its latency in ms of the decoder's clock.
+fn decisions_table(rec: &Recording) -> CsvTable {
+    let d = crate::record::schema::LiveDecisionsView::or_empty(&rec.tables);
+    CsvTable {
+        name: "decisions",
+        columns: vec![
+            ("run", Column::I64(d.run.iter().map(|r| r + 1).collect())),
+            ("t_s", Column::F64(d.t_s.to_vec())),
+            ("id", Column::F64(d.id.to_vec())),
+            ("p_error", Column::F64(d.p_error.to_vec())),
+            (
+                "latency_ms",
+                Column::F64(d.latency_s.iter().map(|l| l * 1000.0).collect()),
+            ),
+            ("fate", Column::Str(d.fate.to_vec())),
+            (
+                "applied_to",
+                Column::I64(d.applied_to.iter().map(|a| a + 1).collect()),
+            ),
+        ],
+    }
+}
+
+/// The task's tables of `rec`.
+fn task_tables(rec: &Recording) -> Vec<CsvTable> {
     match &rec.runs {
         Runs::Epuck { scenario, results } => {
             let names: Vec<String> = scenario
