@@ -313,25 +313,30 @@ fn log_step(
         let max = step.belief.iter().copied().fold(0.0, f64::max);
         rec.log(paths::BELIEF_MAX, &Scalars::single(max))?;
     }
-    let decoded = if step.p_error >= 0.5 {
-        "error"
-    } else {
-        "correct"
-    };
     let truth = if step.error { "error" } else { "correct" };
-    let level = if (step.p_error >= 0.5) == step.error {
-        "INFO"
+    // A live decoder's decision that did not come in time: no p(error).
+    let (decoded, level) = if step.p_error.is_nan() {
+        ("no decision in time (missed)".to_string(), "WARN")
     } else {
-        "WARN"
+        let says = if step.p_error >= 0.5 {
+            "error"
+        } else {
+            "correct"
+        };
+        let level = if (step.p_error >= 0.5) == step.error {
+            "INFO"
+        } else {
+            "WARN"
+        };
+        (format!("decoded {says} (p = {:.2})", step.p_error), level)
     };
     rec.log(
         paths::LOG,
         &TextLog::new(format!(
-            "{} {} -> {}: user {truth}, decoded {decoded} (p = {:.2})",
+            "{} {} -> {}: user {truth}, {decoded}",
             step.action.name(),
             step.from,
             step.to,
-            step.p_error
         ))
         .with_level(level),
     )?;

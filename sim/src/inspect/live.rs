@@ -116,6 +116,16 @@ pub struct LiveReplay {
 }
 
 impl LiveReplay {
+    /// The rows of `recorded` and `replayed` results, each run `k` as
+    /// `row(k, result)` prints it.
+    fn of<T>(recorded: &[T], replayed: &[T], row: impl Fn(usize, &T) -> String) -> Self {
+        let rows = |results: &[T]| results.iter().enumerate().map(|(k, r)| row(k, r)).collect();
+        Self {
+            recorded: rows(recorded),
+            replayed: rows(replayed),
+        }
+    }
+
     /// The first run (from 0) whose rows differ, if any.
     pub fn first_difference(&self) -> Option<usize> {
         (0..self.recorded.len().max(self.replayed.len()))
@@ -145,21 +155,14 @@ impl Recording {
                     .map(|run| run.iter().map(|a| a.first().copied()).collect())
                     .collect();
                 let replayed = crate::live::grid::replay_grid(scenario, &decisions)?;
-                let row = |k: usize, r| GridEpisodeRow(k, r).to_string();
-                Ok(LiveReplay {
-                    recorded: results.iter().enumerate().map(|(k, r)| row(k, r)).collect(),
-                    replayed: replayed
-                        .iter()
-                        .enumerate()
-                        .map(|(k, r)| row(k, r))
-                        .collect(),
-                })
+                let row = |k, r: &_| GridEpisodeRow(k, r).to_string();
+                Ok(LiveReplay::of(results, &replayed, row))
             }
             Runs::Epuck { scenario, results } => {
                 let decoder = crate::live::epuck::prepare_live_epuck(scenario)?;
                 let replayed = crate::live::epuck::replay_epuck(scenario, &decoder, &live.applied)?;
                 let layout = &scenario.layout;
-                let row = |index: usize, result| {
+                let row = |index, result: &_| {
                     EpuckRunRow {
                         index,
                         result,
@@ -167,14 +170,7 @@ impl Recording {
                     }
                     .to_string()
                 };
-                Ok(LiveReplay {
-                    recorded: results.iter().enumerate().map(|(k, r)| row(k, r)).collect(),
-                    replayed: replayed
-                        .iter()
-                        .enumerate()
-                        .map(|(k, r)| row(k, r))
-                        .collect(),
-                })
+                Ok(LiveReplay::of(results, &replayed, row))
             }
         }
     }

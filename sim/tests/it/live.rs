@@ -349,7 +349,7 @@ fn path_of_scenario() -> std::path::PathBuf {
 /// and replayed.
 #[cfg(feature = "rerun")]
 mod saved {
-    use std::path::PathBuf;
+    use std::path::{Path, PathBuf};
 
     use errp_sim::epuck::{EpuckObserver, EpuckScenario};
     use errp_sim::grid::GridScenario;
@@ -368,21 +368,28 @@ mod saved {
 
     impl Saving {
         pub(super) fn grid(s: &GridScenario, speed: f64) -> Self {
-            let dir = scratch("grid");
-            let text = std::fs::read_to_string(&s.path).unwrap();
-            let p = Self::provenance("grid", text, s.seed, speed);
-            let recording = LiveRecording::grid(&dir.join("live.rrd"), s, p).unwrap();
-            Self {
-                recording: Some(recording),
-                dir,
-            }
+            Self::new("grid", (&s.path, s.seed, speed), |path, p| {
+                LiveRecording::grid(path, s, p)
+            })
         }
 
         pub(super) fn epuck(s: &EpuckScenario, speed: f64) -> Self {
-            let dir = scratch("epuck");
-            let text = std::fs::read_to_string(&s.path).unwrap();
-            let p = Self::provenance("epuck", text, s.seed, speed);
-            let recording = LiveRecording::epuck(&dir.join("live.rrd"), s, p).unwrap();
+            Self::new("epuck", (&s.path, s.seed, speed), |path, p| {
+                LiveRecording::epuck(path, s, p)
+            })
+        }
+
+        /// A recording of `task` from the scenario file at `scenario`, in a
+        /// directory of its own.
+        fn new(
+            task: &str,
+            (scenario, seed, speed): (&Path, u64, f64),
+            open: impl FnOnce(&Path, Provenance) -> errp_sim::Result<LiveRecording>,
+        ) -> Self {
+            let dir = scratch(task);
+            let text = std::fs::read_to_string(scenario).unwrap();
+            let p = Self::provenance(task, text, seed, speed);
+            let recording = open(&dir.join("live.rrd"), p).unwrap();
             Self {
                 recording: Some(recording),
                 dir,
