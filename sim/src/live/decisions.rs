@@ -95,14 +95,8 @@ impl LiveRunStats {
     /// The `q` quantile of the latencies applied (s; linear between order
     /// statistics), none without decisions.
     pub fn latency_quantile(&self, q: f64) -> Option<f64> {
-        let mut v = self.latencies_secs();
-        if v.is_empty() {
-            return None;
-        }
-        v.sort_by(f64::total_cmp);
-        let pos = q.clamp(0.0, 1.0) * (v.len() - 1) as f64;
-        let (lo, hi) = (pos.floor() as usize, pos.ceil() as usize);
-        Some(v[lo] + (v[hi] - v[lo]) * (pos - lo as f64))
+        let v = self.latencies_secs();
+        (!v.is_empty()).then(|| crate::stats::quantile(&v, q))
     }
 
     /// The decisions applied, their latencies (median and 95th percentile,

@@ -12,12 +12,14 @@ use crate::live::epuck::EpuckLiveRun;
 use crate::live::grid::GridLiveRun;
 use crate::live::{Fate, LiveRunStats};
 use crate::record::RrdFile;
-use crate::record::data::Provenance;
+use crate::record::data::{LiveProvenance, Provenance};
 use crate::record::schema::LiveDecisions;
 
 /// The task's recorder.
 enum Task {
-    Grid(GridRecorder),
+    /// With the scenario's seed and action length (s), which each
+    /// episode's row records.
+    Grid(GridRecorder, u64, f64),
     Epuck(Box<EpuckRecorder>, RrdFile),
 }
 
@@ -29,23 +31,31 @@ pub struct LiveRecording {
     /// Simulated seconds per second of the link's clock.
     speed: f64,
     runs: usize,
-    /// The grid's scenario seed and action length (s).
-    grid: (u64, f64),
 }
 
 impl LiveRecording {
     /// A grid session's recording of `scenario` at `path`, made as
-    /// `provenance` says (its `live` set).
-    pub fn grid(path: &Path, scenario: &GridScenario, provenance: Provenance) -> Result<Self> {
+    /// `provenance` says, live as `live` says.
+    pub fn grid(
+        path: &Path,
+        scenario: &GridScenario,
+        provenance: Provenance,
+        live: LiveProvenance,
+    ) -> Result<Self> {
         let file = crate::grid::grid_recording(path)?;
-        let mut out = Self::new(Task::Grid(GridRecorder::new(file)?), provenance);
-        out.grid = (scenario.seed, scenario.params.epoch_secs);
-        Ok(out)
+        let (seed, epoch_secs) = (scenario.seed, scenario.params.epoch_secs);
+        let task = Task::Grid(GridRecorder::new(file)?, seed, epoch_secs);
+        Ok(Self::new(task, provenance, live))
     }
 
     /// An e-puck session's recording of `scenario` at `path`, made as
-    /// `provenance` says (its `live` set).
-    pub fn epuck(path: &Path, scenario: &EpuckScenario, provenance: Provenance) -> Result<Self> {
+    /// `provenance` says, live as `live` says.
+    pub fn epuck(
+        path: &Path,
+        scenario: &EpuckScenario,
+        provenance: Provenance,
+        live: LiveProvenance,
+    ) -> Result<Self> {
         let file = crate::epuck::epuck_recording(path)?;
         // The detector reads a decoder outside at the scenario's T_e.
         let t_e = scenario.params.control.t_e;
@@ -54,29 +64,32 @@ impl LiveRecording {
             "the user wants {} (your online decoder)",
             scenario.layout.goals()[scenario.episode.goal].name
         ));
-        Ok(Self::new(Task::Epuck(Box::new(recorder), file), provenance))
+        Ok(Self::new(
+            Task::Epuck(Box::new(recorder), file),
+            provenance,
+            live,
+        ))
     }
 
-    fn new(task: Task, provenance: Provenance) -> Self {
-        let speed = provenance.live.as_ref().map_or(1.0, |l| l.speed);
+    fn new(task: Task, mut provenance: Provenance, live: LiveProvenance) -> Self {
+        let speed = live.speed;
+        provenance.live = Some(live);
         Self {
             task,
             provenance,
             speed,
             runs: 0,
-            grid: (0, 0.0),
         }
     }
 
     /// Records grid run `k` (run with its steps) and its decisions.
     pub fn grid_run(&mut self, k: usize, run: &GridLiveRun) -> Result<()> {
-        let Task::Grid(recorder) = &mut self.task else {
+        let Task::Grid(recorder, scenario_seed, epoch_secs) = &mut self.task else {
             return Ok(());
         };
         let t0 = recorder.next_t0();
-        let (scenario_seed, epoch_secs) = self.grid;
-        let seed = crate::grid::grid_episode_seed(scenario_seed, k);
-        recorder.episode(seed, epoch_secs, &run.result)?;
+        let seed = crate::grid::grid_episode_seed(*scenario_seed, k);
+        recorder.episode(seed, *epoch_secs, &run.result)?;
         self.runs = k + 1;
         let file = recorder.file();
         send_decisions(file, k, t0, self.speed, &run.stats)
@@ -104,7 +117,7 @@ impl LiveRecording {
     /// moves it into place.
     pub fn finish(self) -> Result<PathBuf> {
         match self.task {
-            Task::Grid(recorder) => recorder.finish(&self.provenance),
+            Task::Grid(recorder, ..) => recorder.finish(&self.provenance),
             Task::Epuck(recorder, file) => {
                 recorder.finish()?;
                 self.provenance.write(&file, self.runs)?;

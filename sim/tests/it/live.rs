@@ -368,14 +368,14 @@ mod saved {
 
     impl Saving {
         pub(super) fn grid(s: &GridScenario, speed: f64) -> Self {
-            Self::new("grid", (&s.path, s.seed, speed), |path, p| {
-                LiveRecording::grid(path, s, p)
+            Self::new("grid", (&s.path, s.seed, speed), |path, p, live| {
+                LiveRecording::grid(path, s, p, live)
             })
         }
 
         pub(super) fn epuck(s: &EpuckScenario, speed: f64) -> Self {
-            Self::new("epuck", (&s.path, s.seed, speed), |path, p| {
-                LiveRecording::epuck(path, s, p)
+            Self::new("epuck", (&s.path, s.seed, speed), |path, p, live| {
+                LiveRecording::epuck(path, s, p, live)
             })
         }
 
@@ -384,25 +384,20 @@ mod saved {
         fn new(
             task: &str,
             (scenario, seed, speed): (&Path, u64, f64),
-            open: impl FnOnce(&Path, Provenance) -> errp_sim::Result<LiveRecording>,
+            open: impl FnOnce(&Path, Provenance, LiveProvenance) -> errp_sim::Result<LiveRecording>,
         ) -> Self {
             let dir = scratch(task);
             let text = std::fs::read_to_string(scenario).unwrap();
-            let p = Self::provenance(task, text, seed, speed);
-            let recording = open(&dir.join("live.rrd"), p).unwrap();
+            let p = Provenance::new(task, "test", text, seed);
+            let live = LiveProvenance {
+                speed,
+                decoder: "name=virtual".into(),
+            };
+            let recording = open(&dir.join("live.rrd"), p, live).unwrap();
             Self {
                 recording: Some(recording),
                 dir,
             }
-        }
-
-        fn provenance(task: &str, text: String, seed: u64, speed: f64) -> Provenance {
-            let mut p = Provenance::new(task, "test", text, seed);
-            p.live = Some(LiveProvenance {
-                speed,
-                decoder: "name=virtual".into(),
-            });
-            p
         }
 
         fn finish(&mut self) -> Recording {

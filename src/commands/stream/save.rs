@@ -32,10 +32,9 @@ pub(super) fn open(
         "decoder: outside the process, over Lab Streaming Layer ({}), live at speed {}\n",
         live.decoder, live.speed
     );
-    p.live = Some(live);
     match scenario {
-        AnyScenario::Grid(s) => LiveRecording::grid(path, s, p),
-        AnyScenario::Epuck(s) => LiveRecording::epuck(path, s, p),
+        AnyScenario::Grid(s) => LiveRecording::grid(path, s, p, live),
+        AnyScenario::Epuck(s) => LiveRecording::epuck(path, s, p, live),
     }
     .context("--save")
 }
