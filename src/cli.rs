@@ -56,16 +56,18 @@ pub(crate) enum DecoderArg {
 
 #[derive(Clone, Copy, ValueEnum)]
 pub(crate) enum EegArg {
-    /// Synthesise each action's EEG when it happens.
-    Stream,
-    /// Draw preprocessed epochs from a bank streamed in advance.
+    /// Synthesise each action's EEG when it happens (`stream`, its former
+    /// name, is still accepted).
+    #[value(name = "per_action", alias = "stream")]
+    PerAction,
+    /// Draw preprocessed epochs from a bank synthesised in advance.
     Bank,
 }
 
 impl EegArg {
     pub(crate) fn mode(self) -> EegMode {
         match self {
-            EegArg::Stream => EegMode::Stream,
+            EegArg::PerAction => EegMode::PerAction,
             EegArg::Bank => EegMode::Bank,
         }
     }
@@ -91,8 +93,8 @@ pub(crate) struct RunArgs {
     /// seed derived from the scenario's.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     pub(crate) runs: Option<u64>,
-    /// Override how the EEG reaches the decoder: streamed or from a bank
-    /// (grid scenarios).
+    /// Override how the EEG reaches the decoder: synthesised per action or
+    /// drawn from a bank (grid scenarios).
     #[arg(long, value_enum)]
     pub(crate) eeg: Option<EegArg>,
     /// Record every episode to this `.rrd`. Grid: cursor, goal, posterior,
@@ -117,9 +119,9 @@ pub(crate) struct Table1Args {
     /// EEG decoder (default) or oracle.
     #[arg(long, value_enum, default_value = "eeg")]
     pub(crate) decoder: DecoderArg,
-    /// Stream each action's EEG (default) or draw epochs from a bank of
-    /// 1000 per class streamed in advance (much faster).
-    #[arg(long, value_enum, default_value = "stream")]
+    /// Synthesise each action's EEG (default) or draw epochs from a bank of
+    /// 1000 per class synthesised in advance (much faster).
+    #[arg(long, value_enum, default_value = "per_action")]
     pub(crate) eeg: EegArg,
     /// The simulated users: the `[realism]` table of this scenario file
     /// (e.g. scenarios/variants/grid_fixed_goals_ideal.toml for the

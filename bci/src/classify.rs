@@ -5,7 +5,7 @@ use nalgebra::DMatrix;
 use rand::seq::SliceRandom;
 
 use crate::error::Result;
-use crate::rng::stream;
+use crate::rng::labelled;
 
 /// Feature matrix, one trial per row: shape `(n_trials, n_features)`.
 pub type Features = DMatrix<f64>;
@@ -92,7 +92,7 @@ pub(crate) fn check_training_set(x: &Features, labels: &[bool]) -> Result<(usize
 /// Fold index of every trial, for cross-validation: each class shuffled
 /// and dealt round-robin.
 pub fn stratified_folds(labels: &[bool], folds: usize, seed: u64) -> Vec<usize> {
-    let mut rng = stream(seed, "cv/folds");
+    let mut rng = labelled(seed, "cv/folds");
     let mut fold_of = vec![0; labels.len()];
     for class in [false, true] {
         let mut idx: Vec<usize> = (0..labels.len()).filter(|&i| labels[i] == class).collect();

@@ -25,8 +25,8 @@
 //! * the subjects of Table 1 ([`subject`]), EDF+ export ([`EdfWriter`]);
 //! * a person's own recording in place of the synthetic EEG: EDF, EDF+,
 //!   BDF and BDF+ read and checked ([`EdfFile`]), matched to the montage
-//!   ([`Recording`]) and split into a calibration part and held-out epochs
-//!   ([`split_recording`]).
+//!   ([`OwnEeg`]) and split into a calibration part and held-out epochs
+//!   ([`split_own_eeg`]).
 //!
 //! ```
 //! use errp_bci::{MeanAccuracy, RequestedAccuracy, subject};
@@ -59,10 +59,10 @@ mod lda;
 mod montage;
 mod noise;
 mod online;
+mod own_eeg;
 mod platt;
 mod preprocess;
 mod psd;
-mod recorded;
 pub mod rng;
 mod smo;
 pub mod stop;
@@ -95,8 +95,9 @@ pub use errp_valid::{Check, Valid, shown};
 pub use features::{EpochWindow, FeatureExtractor};
 pub use filter::{Biquad, FilterBank, FilterChain};
 pub use generator::{
-    Assessment, BASELINE_SECS, Components, EegBlock, EegGenerator, EegStream, ErrpTemplate,
-    GeneratorParams, HybridEeg, HybridSource, MIN_HYBRID_PART_SECS, Realism, TEMPLATE_SECS,
+    Assessment, BASELINE_SECS, Components, EegBlock, EegFeed, EegGenerator, ErrpTemplate,
+    GeneratorParams, HybridEeg, HybridSource, MIN_HYBRID_PART_SECS, Realism, SFREQ_HZ,
+    TEMPLATE_SECS,
 };
 pub use information::{
     ActionInformation, INFORMATION_BINS, binary_channel_bits, binary_entropy,
@@ -106,18 +107,18 @@ pub use lda::{LdaDecoder, LdaModel, Shrinkage, ledoit_wolf_shrinkage, pca_basis}
 pub use montage::{Channel, ChannelKind, DECODING_CHANNELS, Montage};
 pub use noise::{PinkNoise, Resonator};
 pub use online::{
-    Decision, Detector, DetectorMode, DetectorParams, OnlineRecording, OnlineRecordingParams,
-    OnlineStep, OnlineTarget, OnlineTargeting, OperatingPoint, ResponseSpan, SPAN_ALPHA,
-    SlidingWindow, WARM_UP_SECS, WINDOW_STEP_SECS, binomial_upper_tail, detector_span, firings,
-    operating_point, record_online, record_online_from, response_span, target_online,
+    Decision, Detector, DetectorMode, DetectorParams, HeldOutParams, HeldOutSession, OnlineStep,
+    OnlineTarget, OnlineTargeting, OperatingPoint, ResponseSpan, SPAN_ALPHA, SlidingWindow,
+    WARM_UP_SECS, WINDOW_STEP_SECS, binomial_upper_tail, detector_span, firings, operating_point,
+    response_span, simulate_held_out, simulate_held_out_from, target_online,
     threshold_for_false_alarms,
+};
+pub use own_eeg::{
+    CalibrationPart, EOG_CHANNELS, EventNames, MIN_CALIBRATION_PER_CLASS, OwnEeg, OwnEegEpoch,
+    OwnEegSplit, calibration_events, split_own_eeg,
 };
 pub use platt::PlattScaling;
 pub use preprocess::{PreprocessParams, Preprocessing, Preprocessor};
 pub use psd::ThetaPsd;
-pub use recorded::{
-    CalibrationPart, EOG_CHANNELS, EventNames, MIN_CALIBRATION_PER_CLASS, RecordedEpoch,
-    RecordedSession, Recording, calibration_events, split_recording,
-};
 pub use subjects::{GoalSet, Subject, subject, subjects};
 pub use svm::{SvmDecoder, SvmModel, SvmParts};

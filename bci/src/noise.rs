@@ -131,7 +131,7 @@ impl Resonator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rng::stream;
+    use crate::rng::labelled;
 
     fn variance(xs: &[f64]) -> f64 {
         let m = xs.iter().sum::<f64>() / xs.len() as f64;
@@ -140,7 +140,7 @@ mod tests {
 
     #[test]
     fn sources_have_unit_variance() {
-        let mut rng = stream(3, "test");
+        let mut rng = labelled(3, "test");
         // Average over many short independent runs: pink noise has long memory.
         let mut pink_var = 0.0;
         for _ in 0..200 {

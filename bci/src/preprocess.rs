@@ -321,7 +321,7 @@ mod tests {
     }
 
     #[test]
-    fn streaming_equals_one_block() {
+    fn blockwise_equals_one_block() {
         let m = Montage::standard();
         let mut g = EegGenerator::new(&eye_heavy(), &m, 3).unwrap();
         let session = g.generate(256 * 20);

@@ -1,12 +1,13 @@
-//! Seeded, labelled random streams.
+//! Seeded, labelled random number generators: one per consumer.
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
-/// A ChaCha8 stream derived from a seed and a label, so that every consumer
-/// (background EEG, artifacts, ERPs, the user, exploration, ...) draws from its
-/// own stream and adding draws to one never shifts another.
-pub fn stream(seed: u64, label: &str) -> ChaCha8Rng {
+/// A ChaCha8 generator derived from a seed and a label (the label picks
+/// ChaCha's stream), so that every consumer (background EEG, artifacts,
+/// ERPs, the user, exploration, ...) draws from its own sequence and adding
+/// draws to one never shifts another.
+pub fn labelled(seed: u64, label: &str) -> ChaCha8Rng {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     rng.set_stream(fnv1a(label));
     rng
@@ -38,10 +39,10 @@ mod tests {
     use rand::Rng;
 
     #[test]
-    fn streams_differ_by_label_and_repeat_by_seed() {
-        let a: u64 = stream(1, "eeg").random();
-        let b: u64 = stream(1, "user").random();
-        let c: u64 = stream(1, "eeg").random();
+    fn generators_differ_by_label_and_repeat_by_seed() {
+        let a: u64 = labelled(1, "eeg").random();
+        let b: u64 = labelled(1, "user").random();
+        let c: u64 = labelled(1, "eeg").random();
         assert_ne!(a, b);
         assert_eq!(a, c);
         assert_ne!(derive_seed(1, "trial", 0), derive_seed(1, "trial", 1));

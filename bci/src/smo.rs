@@ -206,14 +206,14 @@ fn rho(alpha: &[f64], grad: &[f64], y: &[f64], c: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rng::stream;
+    use crate::rng::labelled;
     use rand::Rng;
     use rand_distr::StandardNormal;
 
     #[test]
     fn dual_solution_meets_the_kkt_conditions() {
         // Overlapping classes: some alphas at 0, some free, some at C.
-        let mut rng = stream(2, "test/kkt");
+        let mut rng = labelled(2, "test/kkt");
         let (n, d) = (120, 5);
         let y: Vec<f64> = (0..n)
             .map(|i| if i % 2 == 1 { 1.0 } else { -1.0 })

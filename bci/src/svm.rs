@@ -339,14 +339,14 @@ fn rbf_kernel(z: &DMatrix<f64>, gamma: f64) -> Vec<f64> {
 mod tests {
     use super::*;
     use crate::lda::LdaDecoder;
-    use crate::rng::stream;
+    use crate::rng::labelled;
     use rand::Rng;
     use rand_distr::StandardNormal;
 
     /// `n` points per class of two Gaussian blobs `sep` apart along every
     /// axis of `d` dimensions.
     fn blobs(n: usize, d: usize, sep: f64, seed: u64) -> (Features, Vec<bool>) {
-        let mut rng = stream(seed, "test/blobs");
+        let mut rng = labelled(seed, "test/blobs");
         let labels: Vec<bool> = (0..2 * n).map(|i| i % 2 == 1).collect();
         let x = DMatrix::from_fn(2 * n, d, |i, _| {
             let shift = if labels[i] { sep } else { 0.0 };
@@ -364,7 +364,7 @@ mod tests {
     #[test]
     fn separates_xor_that_a_linear_model_cannot() {
         // Four clusters at (+-1, +-1); error where the signs differ.
-        let mut rng = stream(1, "test/xor");
+        let mut rng = labelled(1, "test/xor");
         let mut data = Vec::new();
         let mut labels = Vec::new();
         for k in 0..120 {

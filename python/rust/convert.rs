@@ -8,7 +8,8 @@ use errp_bci::{EegBlock, Montage, RequestedAccuracy};
 use errp_sim::epuck::EpuckScenario;
 use errp_sim::grid::GridScenario;
 use errp_sim::{
-    AnyScenario, LoadedScenario, ScenarioInput, ScenarioSeed, ScenarioSource, SetterNames, SimError,
+    AnyScenario, LoadedScenario, Names, ScenarioInput, ScenarioSeed, ScenarioSource, SimError,
+    TaskKind,
 };
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray2};
@@ -48,6 +49,12 @@ fn chain(e: &(dyn std::error::Error + 'static)) -> String {
 /// A `ValueError` naming `field`.
 pub(crate) fn value_error(field: &str, value: impl std::fmt::Display, expected: &str) -> PyErr {
     PyValueError::new_err(format!("{field} = {value} is invalid: expected {expected}"))
+}
+
+/// The task named `text`, for the keyword `field`.
+pub(crate) fn task_kind(field: &str, text: &str) -> PyResult<TaskKind> {
+    text.parse()
+        .map_err(|_| value_error(field, format!("{text:?}"), TaskKind::EXPECTED))
 }
 
 /// `overrides={"control.tau": 0.5, ...}` as scenario keys and TOML values,
@@ -196,7 +203,7 @@ impl PyDecoder {
         result.map_err(|e| {
             let text = Python::attach(|py| e.value(py).to_string());
             self.raised.get_or_insert(e);
-            SimError::Scenario(format!("decoder raised: {text}"))
+            SimError::DecoderRaised(text)
         })
     }
 
@@ -217,16 +224,6 @@ pub(crate) fn check_callable(py: Python<'_>, name: &str, f: Option<&Py<PyAny>>) 
         _ => Ok(()),
     }
 }
-
-/// How errors name the keyword arguments that set a scenario's values.
-pub(crate) const KEYWORDS: SetterNames = SetterNames {
-    accuracy: "accuracy",
-    seed: "seed",
-    runs: "runs",
-    decoder: "overrides[\"decoder\"]",
-    eeg: "overrides[\"eeg\"]",
-    save: "save",
-};
 
 /// The keyword arguments that set a scenario's keys, set before
 /// `overrides=` and as `errp run`'s flags set them
@@ -310,12 +307,11 @@ impl Keys {
     }
 }
 
-/// The scenario keyword (the file given, or the built-in scenario of the
-/// e-puck (`default_epuck`) or of the grid) with `keys` and `overrides=`
-/// set, loaded once.
+/// The scenario keyword (the file given, or the built-in scenario of
+/// `default`) with `keys` and `overrides=` set, loaded once.
 pub(crate) fn load(
     scenario: Option<PathBuf>,
-    default_epuck: bool,
+    default: TaskKind,
     keys: Keys,
     given: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<LoadedScenario> {
@@ -327,8 +323,10 @@ pub(crate) fn load(
             p.display()
         )));
     }
-    let source = ScenarioSource::file_or_built_in(scenario, default_epuck);
-    keys.input(source, given)?.load(&KEYWORDS).map_err(py_err)
+    let source = ScenarioSource::file_or_built_in(scenario, default);
+    keys.input(source, given)?
+        .load(&Names::PYTHON)
+        .map_err(py_err)
 }
 
 /// A grid scenario (the built-in one by default) and its text as run;
@@ -340,7 +338,7 @@ pub(crate) fn load_grid(
     who: &str,
 ) -> PyResult<(GridScenario, String)> {
     let shown = shown(&scenario);
-    let loaded = load(scenario, false, keys, given)?;
+    let loaded = load(scenario, TaskKind::Grid, keys, given)?;
     match loaded.scenario {
         AnyScenario::Grid(s) => Ok((*s, loaded.text)),
         AnyScenario::Epuck(_) => Err(PyValueError::new_err(format!(
@@ -358,7 +356,7 @@ pub(crate) fn load_epuck(
     who: &str,
 ) -> PyResult<(EpuckScenario, String)> {
     let shown = shown(&scenario);
-    let loaded = load(scenario, true, keys, given)?;
+    let loaded = load(scenario, TaskKind::Epuck, keys, given)?;
     match loaded.scenario {
         AnyScenario::Epuck(s) => Ok((*s, loaded.text)),
         AnyScenario::Grid(_) => Err(PyValueError::new_err(format!(

@@ -224,9 +224,10 @@ impl GridEnvCore {
         Ok(d)
     }
 
-    /// True if the decoder streams EEG (so epochs can be observed).
+    /// True if the decoder synthesises each action's EEG (so epochs can be
+    /// observed).
     #[getter]
-    fn streams(&self) -> bool {
+    fn per_action(&self) -> bool {
         matches!(*self.decoder, AssessmentDecoder::Eeg(_))
     }
 
@@ -242,7 +243,7 @@ impl GridEnvCore {
                     fs,
                 )
             }
-            _ => (Vec::new(), 0, 256.0),
+            _ => (Vec::new(), 0, errp_bci::SFREQ_HZ),
         }
     }
 

@@ -26,7 +26,7 @@ pub(crate) fn read_recording<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bo
     let json =
         serde_json::to_string(&rec.provenance).map_err(|e| PyValueError::new_err(e.to_string()))?;
     out.set_item("provenance", json)?;
-    out.set_item("task", rec.provenance.task.clone())?;
+    out.set_item("task", rec.provenance.task.as_str())?;
     let tables = PyDict::new(py);
     let order = PyDict::new(py);
     for t in csv_tables(&rec) {

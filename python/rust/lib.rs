@@ -18,7 +18,7 @@ mod env;
 #[cfg(feature = "rerun")]
 mod inspect;
 mod interrupt;
-mod recorded;
+mod own_eeg;
 mod run;
 mod session;
 mod tasks;

@@ -5,25 +5,26 @@ use std::path::PathBuf;
 use std::sync::{Mutex, PoisonError};
 
 use errp_bci::stop::WindDown;
+use errp_sim::Names;
+use errp_sim::TaskKind;
 use errp_sim::calibration::CalibrationReport;
 use errp_sim::epuck::{
     ContinuousDecoder, ContinuousReport, EpuckEpisodeResult, EpuckScenario, EpuckTask, epuck_row,
     epuck_run_seed,
 };
 use errp_sim::grid::{
-    GridEpisodeResult, GridScenario, GridTask, RecordedReport, decoder_accuracy, grid_row,
+    GridEpisodeResult, GridScenario, GridTask, OwnEegReport, decoder_accuracy, grid_row,
 };
 use errp_sim::task::{EpisodeRow, Task, TaskInfo, format_number};
 use errp_sim::{AnyScenario, RunOutcome};
 use errp_sweep::{
-    InputNames, Shard, SweepOptions, SweepOutcome, SweepSpec, SweepTask, TargetCache,
-    parse_accuracies, parse_axis, sweep_fixed, sweep_scenario,
+    Shard, SweepOptions, SweepOutcome, SweepSpec, TargetCache, parse_axis, sweep_scenario,
 };
 use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{KEYWORDS, Keys, load, py_err, value_error};
+use crate::convert::{Keys, load, py_err, task_kind, value_error};
 use crate::interrupt::{CALIBRATING, EPISODES, Meter, RUNS, long_or, long_shown};
 
 /// What a sweep reports from Python: its progress (its decoders
@@ -65,23 +66,12 @@ impl errp_sweep::SweepObserver for SweepWatch {
 /// Most worker threads of a sweep.
 pub(crate) const MAX_THREADS: usize = 1024;
 
-/// Keyword names in errors.
-const NAMES: InputNames = InputNames {
-    scenario: "scenario=",
-    task: "task=",
-    eeg: "stream=",
-    accuracy: "accuracy=",
-    param: "params=",
-    episodes: "episodes=",
-    seed: "seed=",
-};
-
 /// A grid scenario's episodes as the CSV text `run` and the tasks' `run`
 /// return: the columns of `episodes.csv` without the sweep's swept values
 /// and checksum, one row per episode.
 pub(crate) fn grid_csv(
     s: &GridScenario,
-    recorded: Option<&RecordedReport>,
+    recorded: Option<&OwnEegReport>,
     episodes: &[GridEpisodeResult],
 ) -> String {
     let rows = episodes
@@ -121,18 +111,7 @@ fn csv(info: &TaskInfo, accuracy: f64, rows: impl Iterator<Item = (u64, EpisodeR
 /// `episodes.csv` names them.
 #[pyfunction]
 pub(crate) fn episode_columns(task: &str) -> PyResult<Vec<&'static str>> {
-    let info = match task {
-        "grid" => &GridTask::INFO,
-        "epuck" => &EpuckTask::INFO,
-        other => {
-            return Err(value_error(
-                "task",
-                format!("{other:?}"),
-                "\"grid\" or \"epuck\"",
-            ));
-        }
-    };
-    Ok(info.row_columns())
+    Ok(task_kind("task", task)?.info().row_columns())
 }
 
 /// Checks `save=` before any work.
@@ -222,7 +201,7 @@ pub(crate) fn run<'py>(
         seed,
         runs,
     };
-    let loaded = load(scenario, true, keys, overrides)?;
+    let loaded = load(scenario, TaskKind::Epuck, keys, overrides)?;
     let total = match &loaded.scenario {
         AnyScenario::Grid(s) => s.episodes.len(),
         AnyScenario::Epuck(s) => s.runs,
@@ -234,7 +213,7 @@ pub(crate) fn run<'py>(
     let options = errp_sim::RunOptions {
         save: save.as_deref(),
         provenance: &provenance,
-        names: &KEYWORDS,
+        names: &Names::PYTHON,
     };
     let meter = Meter::default();
     let watch = RunMeter {
@@ -246,18 +225,17 @@ pub(crate) fn run<'py>(
     })?
     .map_err(|e| py_err(e.error))?;
     let out = PyDict::new(py);
+    out.set_item("task", done.outcome.kind().as_str())?;
     match &done.outcome {
         RunOutcome::Grid(report) => {
             let s = &report.scenario;
-            out.set_item("task", "grid")?;
-            let recorded = report.recorded.as_ref();
-            out.set_item("csv", grid_csv(s, recorded, &report.episodes))?;
-            let info = grid_summary(s, recorded, report.calibration.as_ref());
+            let own_eeg = report.own_eeg.as_ref();
+            out.set_item("csv", grid_csv(s, own_eeg, &report.episodes))?;
+            let info = grid_summary(s, own_eeg, report.calibration.as_ref());
             out.set_item("decoder", info)?;
         }
         RunOutcome::Epuck(r) => {
             let s = &r.scenario;
-            out.set_item("task", "epuck")?;
             out.set_item("csv", epuck_csv(s, &r.results))?;
             out.set_item("decoder", epuck_summary(s, &r.decoder, &r.report))?;
         }
@@ -283,7 +261,7 @@ pub(crate) fn summary_dict<'py>(
 /// What the grid decoder's calibration found (none for the oracle).
 pub(crate) fn grid_summary(
     s: &GridScenario,
-    recorded: Option<&RecordedReport>,
+    recorded: Option<&OwnEegReport>,
     calibration: Option<&CalibrationReport>,
 ) -> DecoderSummary {
     let mut info = vec![("accuracy", decoder_accuracy(s, recorded))];
@@ -321,7 +299,7 @@ pub(crate) fn epuck_summary(
         (
             "accuracy",
             decoder
-                .recorded
+                .own_eeg
                 .as_ref()
                 .map_or(s.accuracy.get(), |r| r.accuracy),
         ),
@@ -330,7 +308,7 @@ pub(crate) fn epuck_summary(
         ("cv_mean", a.mean()),
         ("t_e", decoder.detector_t_e(&s.params, false)),
     ];
-    if decoder.recorded.is_none() {
+    if decoder.own_eeg.is_none() {
         // A hybrid's response has the amplitude it has: no ratio.
         info.insert(1, ("errp_to_noise", report.generator.errp_to_noise));
     }
@@ -354,37 +332,30 @@ pub(crate) struct SweepKeywords {
     episodes: usize,
     seed: u64,
     params: Option<Vec<String>>,
+    #[pyo3(default)]
+    per_action: Option<bool>,
+    /// `per_action=`'s former name, still read.
+    #[pyo3(default)]
     stream: Option<bool>,
     cache: Option<PathBuf>,
     threads: Option<usize>,
 }
 
 /// The `task=` of a sweep: none (the scenario's), "grid" or "epuck".
-fn sweep_task(task: Option<&str>) -> PyResult<Option<SweepTask>> {
-    match task {
-        None => Ok(None),
-        Some("grid") => Ok(Some(SweepTask::Grid)),
-        Some("epuck") => Ok(Some(SweepTask::Epuck)),
-        Some(other) => Err(value_error(
-            "task",
-            format!("{other:?}"),
-            "\"grid\" or \"epuck\"",
-        )),
-    }
+fn sweep_task(task: Option<&str>) -> PyResult<Option<TaskKind>> {
+    task.map(|t| task_kind("task", t)).transpose()
 }
 
 /// The sweep `errp.sweep`'s keywords ask for, on the scenario `text` of
-/// `task` at `path`.
-#[allow(clippy::too_many_arguments)] // Python's keywords, one each
+/// `task` at `path`; errors name the keywords as `names` does.
 fn sweep_spec(
-    task: SweepTask,
-    text: String,
-    path: PathBuf,
+    task: TaskKind,
+    (text, path): (String, PathBuf),
     accuracy: Option<String>,
     params: Option<Vec<String>>,
-    stream: Option<bool>,
-    episodes: usize,
-    seed: u64,
+    per_action: Option<bool>,
+    (episodes, seed): (usize, u64),
+    names: &Names,
 ) -> PyResult<SweepSpec> {
     let mut spec = SweepSpec {
         task,
@@ -394,29 +365,23 @@ fn sweep_spec(
         axes: params
             .unwrap_or_default()
             .iter()
-            .map(|p| parse_axis(task, p, &NAMES))
+            .map(|p| parse_axis(task, p, names))
             .collect::<errp_sim::Result<_>>()
             .map_err(py_err)?,
         fixed: Vec::new(),
         episodes,
         seed,
     };
-    // On recordings no accuracy is targeted and the EEG is theirs: the
-    // sweep's check refuses either keyword, saying why.
-    let recordings = spec.on_recordings();
-    match (accuracy, recordings) {
-        (Some(a), _) => spec.accuracies = parse_accuracies(&a, &NAMES).map_err(py_err)?,
-        (None, false) => {
-            return Err(PyValueError::new_err(
-                "accuracy: give the decoder accuracy levels (e.g. \"0.6:0.9:0.05\" or \
-                 [0.7, 0.8]); only a sweep over recordings (eeg.recording) has none",
-            ));
-        }
-        (None, true) => {}
+    // On own EEG no accuracy is targeted: no levels are needed (the
+    // sweep's check refuses accuracy=, saying why).
+    if accuracy.is_none() && !spec.on_own_eeg() {
+        return Err(PyValueError::new_err(
+            "accuracy: give the decoder accuracy levels (e.g. \"0.6:0.9:0.05\" or [0.7, 0.8]); \
+             only a sweep over recordings (eeg.recording) has none",
+        ));
     }
-    if !recordings || stream.is_some() {
-        spec.fixed = sweep_fixed(task, stream, NAMES).map_err(py_err)?;
-    }
+    spec.set_levels(accuracy.as_deref(), per_action, names)
+        .map_err(py_err)?;
     Ok(spec)
 }
 
@@ -438,6 +403,7 @@ pub(crate) fn sweep<'py>(
         episodes,
         seed,
         params,
+        per_action,
         stream,
         cache,
         threads,
@@ -461,9 +427,28 @@ pub(crate) fn sweep<'py>(
         Some(n) => n,
         None => rayon::current_num_threads(),
     };
-    let (task, text, path) = sweep_scenario(scenario.as_deref(), want, NAMES).map_err(py_err)?;
-    let spec = sweep_spec(task, text, path, accuracy, params, stream, episodes, seed)?;
-    let sweep = spec.checked(&NAMES).map_err(py_err)?;
+    // The EEG mode's keyword, or its former name (named as given).
+    let (per_action, names) = match (per_action, stream) {
+        (None, Some(_)) => (
+            stream,
+            Names {
+                sweep_eeg: "stream=",
+                ..Names::PYTHON
+            },
+        ),
+        _ => (per_action, Names::PYTHON),
+    };
+    let (task, text, path) = sweep_scenario(scenario.as_deref(), want, names).map_err(py_err)?;
+    let spec = sweep_spec(
+        task,
+        (text, path),
+        accuracy,
+        params,
+        per_action,
+        (episodes, seed),
+        &names,
+    )?;
+    let sweep = spec.checked(&names).map_err(py_err)?;
     let opts = SweepOptions {
         out: out.clone(),
         cache: match cache {

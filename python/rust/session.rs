@@ -20,7 +20,7 @@ use crate::convert::{
 use crate::interrupt::{CALIBRATING, Meter, long_shown};
 
 /// The most samples one `generate` call returns: an hour at 256 Hz.
-pub(crate) const MAX_GENERATE_SAMPLES: usize = 3600 * 256;
+pub(crate) const MAX_GENERATE_SAMPLES: usize = 3600 * errp_bci::SFREQ_HZ as usize;
 
 /// Simulates the discrete calibration session of `errp calibrate
 /// --accuracy ACCURACY --seed SEED`: the ErrP-to-noise ratio targeted so

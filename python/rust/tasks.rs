@@ -11,18 +11,19 @@ use errp_sim::epuck::{ContinuousDecoder, EpuckScenario};
 use errp_sim::grid::{
     AssessmentDecoder, EegDecoder, EpochBlocks, GridDecoding, GridScenario, prepare_decoder,
 };
-use errp_sim::recorded::RecordedTask;
+use errp_sim::rules::{self, Claim, Origin, OwnEegFrom};
 use errp_sim::{
     BatchRecord, PendingRecording, RunProvenance, run_epuck_batch_recorded, run_grid_batch,
 };
+use errp_sim::{Names, TaskKind};
 use numpy::{IntoPyArray, PyReadonlyArray1, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::{
-    KEYWORDS, Keys, PyDecoder, blocks_to_array3, channel_names, check_callable, load_epuck,
-    load_grid, py_err, value_error,
+    Keys, PyDecoder, blocks_to_array3, channel_names, check_callable, load_epuck, load_grid,
+    py_err, value_error,
 };
 use crate::interrupt::{CALIBRATING, Meter, long, long_shown};
 use crate::run::{
@@ -48,7 +49,7 @@ fn eeg_of(d: &AssessmentDecoder) -> Option<&EegDecoder> {
     match d {
         AssessmentDecoder::Eeg(e) => Some(e),
         AssessmentDecoder::EegBank(b) => Some(&b.decoder),
-        AssessmentDecoder::Oracle { .. } | AssessmentDecoder::Recorded(_) => None,
+        AssessmentDecoder::Oracle { .. } | AssessmentDecoder::OwnEeg(_) => None,
     }
 }
 
@@ -86,12 +87,10 @@ impl GridTask {
         progress: Option<&Bound<'_, PyAny>>,
         eeg: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
-        if eeg.is_some() && accuracy.is_some() {
-            return Err(PyValueError::new_err(
-                "accuracy: with eeg=..., the decoder is calibrated on the recording's first part \
-                 and has the accuracy the recording gives (GridTask.calibration); no accuracy is \
-                 targeted: leave out accuracy",
-            ));
+        let given = Origin::Input(&Names::PYTHON);
+        let supplied = eeg.map(|_| OwnEegFrom::Supplied(TaskKind::Grid));
+        if let Some(a) = accuracy {
+            rules::own_eeg_is_the_user(supplied, &[(Claim::Accuracy(a), given)]).map_err(py_err)?;
         }
         let keys = Keys {
             accuracy,
@@ -101,12 +100,12 @@ impl GridTask {
         let (s, text) = load_grid(scenario, keys, overrides, "errp.GridTask")?;
         let s = match eeg {
             Some(eeg) => {
-                let recorded = crate::recorded::supplied_recording(
+                let recorded = crate::own_eeg::supplied_own_eeg(
                     eeg,
                     std::path::Path::new("eeg_options"),
-                    RecordedTask::Grid,
+                    TaskKind::Grid,
                 )?;
-                s.on_recording(recorded).map_err(py_err)?
+                s.on_own_eeg(recorded).map_err(py_err)?
             }
             None => s,
         };
@@ -117,23 +116,23 @@ impl GridTask {
                 "decoder and batch_decoder: give one of them, not both",
             ));
         }
+        if decoder.is_some() || batch_decoder.is_some() {
+            let own = s
+                .accuracy
+                .own_eeg()
+                .map(|e| e.origin(&s.path, TaskKind::Grid));
+            rules::own_eeg_is_the_user(own, &[(Claim::OwnDecoder, given)]).map_err(py_err)?;
+        }
         let meter = Meter::default();
         let (builtin, calibration) = long_shown(py, &meter, progress, || {
             prepare_decoder(&s, |_| meter.step(CALIBRATING, 0))
         })?
         .map_err(py_err)?;
         let recorded = match &builtin {
-            AssessmentDecoder::Recorded(bank) => Some(&bank.report),
+            AssessmentDecoder::OwnEeg(bank) => Some(&bank.report),
             _ => None,
         };
         let info = grid_summary(&s, recorded, calibration.as_ref());
-        if (decoder.is_some() || batch_decoder.is_some()) && recorded.is_some() {
-            return Err(PyValueError::new_err(
-                "decoder: the scenario's EEG is a recording, decoded by a decoder calibrated on \
-                 its first part; a decoder of your own reads the synthetic user's EEG (remove \
-                 the [eeg] table, or fit your decoder on the recording yourself)",
-            ));
-        }
         if (decoder.is_some() || batch_decoder.is_some()) && eeg_of(&builtin).is_none() {
             return Err(PyValueError::new_err(
                 "decoder: the scenario's decoder is the oracle (no EEG); a decoder of your own \
@@ -168,9 +167,9 @@ impl GridTask {
         check_save(save.as_ref())?;
         let s = &self.scenario;
         if save.is_some() {
-            errp_sim::check_recordable_episodes(s, &KEYWORDS).map_err(py_err)?;
+            errp_sim::check_recordable_episodes(s, &Names::PYTHON).map_err(py_err)?;
         }
-        let recording = PendingRecording::open(save.as_deref(), false).map_err(py_err)?;
+        let recording = PendingRecording::open(save.as_deref(), TaskKind::Grid).map_err(py_err)?;
         let own = self.decoder.is_some() || self.scores.is_some();
         let made_by = made_by("GridTask", own);
         let record = BatchRecord {
@@ -208,7 +207,7 @@ impl GridTask {
                     .map_err(|e| py_err(e.error))?
             }
         };
-        Ok(grid_csv(s, report.recorded.as_ref(), &report.episodes))
+        Ok(grid_csv(s, report.own_eeg.as_ref(), &report.episodes))
     }
 
     /// What the calibration found: the requested accuracy, the ErrP-to-noise
@@ -229,7 +228,7 @@ impl GridTask {
     /// Sampling rate of the epochs (Hz).
     #[getter]
     fn sfreq(&self) -> f64 {
-        eeg_of(&self.builtin).map_or(256.0, |e| e.generator.sfreq_hz)
+        eeg_of(&self.builtin).map_or(errp_bci::SFREQ_HZ, |e| e.generator.sfreq_hz)
     }
 
     /// Samples per epoch, from the action's onset: the span of the paper's
@@ -334,13 +333,16 @@ impl EpuckTask {
         progress: Option<&Bound<'_, PyAny>>,
         eeg: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
-        if eeg.is_some() && (accuracy.is_some() || decoder.is_some()) {
-            return Err(PyValueError::new_err(
-                "accuracy and decoder: with eeg=..., the runs stream a hybrid of the recording, \
-                 decoded by the SVM calibrated on its first part, which has the accuracy the \
-                 recording gives; no accuracy is targeted: leave out accuracy and decoder",
-            ));
+        let given = Origin::Input(&Names::PYTHON);
+        let supplied = eeg.map(|_| OwnEegFrom::Supplied(TaskKind::Epuck));
+        let mut claims = Vec::new();
+        if let Some(a) = accuracy {
+            claims.push((Claim::Accuracy(a), given));
         }
+        if decoder.is_some() {
+            claims.push((Claim::OwnDecoder, given));
+        }
+        rules::own_eeg_is_the_user(supplied, &claims).map_err(py_err)?;
         let keys = Keys {
             accuracy,
             seed,
@@ -348,14 +350,21 @@ impl EpuckTask {
         };
         let (s, text) = load_epuck(scenario, keys, overrides, "errp.EpuckTask")?;
         let s = match eeg {
-            Some(eeg) => s.on_recording(crate::recorded::supplied_recording(
+            Some(eeg) => s.on_own_eeg(crate::own_eeg::supplied_own_eeg(
                 eeg,
                 std::path::Path::new("eeg_options"),
-                RecordedTask::Epuck,
+                TaskKind::Epuck,
             )?),
             None => s,
         };
         check_callable(py, "decoder", decoder.as_ref())?;
+        if decoder.is_some() {
+            let own = s
+                .own_eeg
+                .as_deref()
+                .map(|e| e.origin(&s.path, TaskKind::Epuck));
+            rules::own_eeg_is_the_user(own, &[(Claim::OwnDecoder, given)]).map_err(py_err)?;
+        }
         let meter = Meter::default();
         let (builtin, report) = long_shown(py, &meter, progress, || {
             errp_sim::epuck::prepare_continuous_decoder_with(
@@ -401,11 +410,11 @@ impl EpuckTask {
             ));
         }
         if save.is_some() {
-            errp_sim::check_recordable_runs(runs as u64, &KEYWORDS).map_err(py_err)?;
+            errp_sim::check_recordable_runs(runs as u64, &Names::PYTHON).map_err(py_err)?;
         }
         let s = &self.scenario;
         let d = &self.builtin;
-        let recording = PendingRecording::open(save.as_deref(), true).map_err(py_err)?;
+        let recording = PendingRecording::open(save.as_deref(), TaskKind::Epuck).map_err(py_err)?;
         let made_by = made_by("EpuckTask", self.decoder.is_some());
         let record = BatchRecord {
             flag: "save",

@@ -12,7 +12,7 @@
 //! [`Twist`], [`integrate`]), the arena's goals ([`GoalLayout::cities`]),
 //! the potentials of eq. (5) ([`QuadraticPotential`]), the likelihoods of
 //! eq. (6) and (7) ([`turn_likelihood`], [`linear_likelihood`]) and the
-//! [`ContinuousController`] that turns, drives and stops the robot, with
+//! [`EpuckController`] that turns, drives and stops the robot, with
 //! the obstacle reflex under it ([`AvoidanceParams`]).
 //!
 //! Both controllers choose their actions by a [`Strategy`]: the paper's
@@ -38,22 +38,23 @@
 #![cfg_attr(not(test), warn(clippy::too_many_lines))]
 
 mod belief;
-mod continuous;
+mod epuck;
 mod error;
 mod grid;
 mod strategy;
 
 pub use belief::{Belief, log_sum_exp};
-pub use continuous::avoidance::AvoidanceParams;
-pub use continuous::control::{ContinuousController, Observation, Phase, StepKind, StopReason};
-pub use continuous::epuck::{EpuckParams, Twist, WheelSpeeds, integrate};
-pub use continuous::layout::{Goal, GoalLayout, LAYOUT_GRID_CELLS};
-pub use continuous::likelihood::{ContinuousControlParams, linear_likelihood, turn_likelihood};
-pub use continuous::pose::{Pose, wrap_angle};
-pub use continuous::potential::QuadraticPotential;
+pub use epuck::avoidance::AvoidanceParams;
+pub use epuck::control::{EpuckController, Observation, Phase, StepKind, StopReason};
+pub use epuck::drive::{EpuckParams, Twist, WheelSpeeds, integrate};
+pub use epuck::layout::{Goal, GoalLayout, LAYOUT_GRID_CELLS};
+pub use epuck::likelihood::{EpuckControlParams, linear_likelihood, turn_likelihood};
+pub use epuck::pose::{Pose, wrap_angle};
+pub use epuck::potential::QuadraticPotential;
 pub use error::{Result, RobotError};
 pub use errp_valid::{Check, Valid};
-pub use grid::control::{GridControlParams, GridController, policy_likelihood};
+pub use grid::control::{GridControlParams, GridController};
+pub use grid::policy::policy_likelihood;
 pub use grid::qvalues::{QParams, QTable, softmax};
 pub use grid::{Cell, Grid, GridAction};
 pub use strategy::{Strategy, entropy_nats, expected_information_gain};

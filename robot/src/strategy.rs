@@ -43,7 +43,7 @@ pub enum Strategy {
     /// Thompson in 55.1 (84.2 redrawing every action); at 0.65 greedy finds
     /// 90 % in 152.6, Thompson 80.5 % in 223.9 (43.5 % in 280.3). The
     /// e-puck controller has no random numbers, so the check of
-    /// [`ContinuousControlParams`](crate::ContinuousControlParams) rejects
+    /// [`EpuckControlParams`](crate::EpuckControlParams) rejects
     /// it.
     Thompson,
 }

@@ -45,7 +45,7 @@ fn make_recording() -> PathBuf {
     let out = std::env::temp_dir().join(format!("errp-bench-inspect-{}.rrd", std::process::id()));
     let file = epuck_recording(&out).unwrap();
     let text = std::fs::read_to_string(path).unwrap();
-    let p = Provenance::new("epuck", &s.name, text, s.seed);
+    let p = Provenance::new(errp_sim::TaskKind::Epuck, &s.name, text, s.seed);
     record_epuck_runs(&file, &s, &d, &p).unwrap();
     file.finish().unwrap();
     let mb = std::fs::metadata(&out).unwrap().len() as f64 / 1e6;

@@ -7,8 +7,8 @@
 //! (defaults 0.95 and 1; 30 minutes of held-out EEG).
 
 use errp_bci::{
-    Detector, DetectorMode, DetectorParams, OnlineRecordingParams, Valid, detector_span,
-    operating_point, record_online,
+    Detector, DetectorMode, DetectorParams, HeldOutParams, Valid, detector_span, operating_point,
+    simulate_held_out,
 };
 use errp_sim::epuck::{ContinuousDecoder, ContinuousRequest, run_continuous_calibration};
 
@@ -21,11 +21,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         |_| {},
     )?;
     let d = ContinuousDecoder::from_report(&report);
-    let params = Valid::new(OnlineRecordingParams {
+    let params = Valid::new(HeldOutParams {
         duration_secs: 1800.0,
-        ..OnlineRecordingParams::default()
+        ..HeldOutParams::default()
     })?;
-    let rec = record_online(
+    let rec = simulate_held_out(
         &d.generator,
         &d.montage,
         &d.preprocessor,

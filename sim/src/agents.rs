@@ -160,8 +160,15 @@ mod imp {
     use crate::grid::{GridEnvironment, GridRecorder, GridScenario};
     use crate::record::RrdFile;
     use crate::record::data::Provenance;
+    use crate::task_kind::TaskKind;
 
-    fn provenance(task: &str, name: &str, text: String, seed: u64, info: AgentInfo) -> Provenance {
+    fn provenance(
+        task: TaskKind,
+        name: &str,
+        text: String,
+        seed: u64,
+        info: AgentInfo,
+    ) -> Provenance {
         let mut p = Provenance::new(task, name, text, seed);
         p.command = info.command;
         p.agent = Some(info.agent);
@@ -185,7 +192,7 @@ mod imp {
             let file = crate::grid::grid_recording(path)?;
             Ok(Self {
                 recorder: GridRecorder::new(file)?,
-                provenance: provenance("grid", &s.name, text, s.seed, info),
+                provenance: provenance(TaskKind::Grid, &s.name, text, s.seed, info),
                 open: false,
             })
         }
@@ -245,7 +252,7 @@ mod imp {
             Ok(Self {
                 file,
                 recorder,
-                provenance: provenance("epuck", &s.name, text, s.seed, info),
+                provenance: provenance(TaskKind::Epuck, &s.name, text, s.seed, info),
                 runs: 0,
                 open: false,
             })
@@ -324,10 +331,9 @@ mod imp {
     use crate::grid::{GridEnvironment, GridScenario};
 
     fn refused(path: &Path) -> SimError {
-        SimError::Scenario(format!(
-            "{}: this build records nothing (built without the `rerun` feature)",
-            path.display()
-        ))
+        SimError::NoRecorder {
+            path: path.to_path_buf(),
+        }
     }
 
     /// Never made: there is no recording without Rerun.

@@ -13,7 +13,48 @@ pub enum SimError {
     /// The shared-control side failed.
     #[error(transparent)]
     Robot(#[from] errp_robot::RobotError),
-    /// A scenario is invalid.
+    /// A field of a scenario is invalid: where (the file, with the line
+    /// when the text is the file as written), the field as the file spells
+    /// it, its value and what is accepted.
+    #[error("{at}: field `{field}` = {value} is invalid: expected {expected}")]
+    Field {
+        /// The file, and the line if known.
+        at: String,
+        /// The field (`control.tau`).
+        field: String,
+        /// The value, as written.
+        value: String,
+        /// What is accepted, in words.
+        expected: String,
+    },
+    /// A parameter named as its caller spells it is invalid (the form of
+    /// the lower crates' `InvalidParameter`).
+    #[error("{name} = {value} is invalid: expected {expected}")]
+    InvalidParameter {
+        /// The parameter (`tracker.rate_hz`).
+        name: String,
+        /// Its value.
+        value: String,
+        /// What is accepted, in words.
+        expected: String,
+    },
+    /// A value outside what is accepted, given to a call or a flag (not a
+    /// scenario's field): what it is named, what was given, in words, and
+    /// what is accepted.
+    #[error("{name}: {given}, expected {expected}")]
+    OutOfRange {
+        /// The flag, keyword or argument (`--speed`, `goal`).
+        name: String,
+        /// What was given, in words (`0 is not a speed`).
+        given: String,
+        /// What is accepted, in words.
+        expected: String,
+    },
+    /// A decoder of the caller's own (Python's) raised: its message.
+    #[error("decoder raised: {0}")]
+    DecoderRaised(String),
+    /// A scenario cannot be run as asked: its values do not combine
+    /// ([`crate::rules`]), or it cannot be used for what it was given to.
     #[error("{0}")]
     Scenario(String),
     /// A sweep cannot run as asked (bad levels, a resume that does not
@@ -48,6 +89,16 @@ pub enum SimError {
         /// The SDK's message.
         message: String,
     },
+    /// A recording was asked of a build without the Rerun SDK.
+    #[error("{}: this build records nothing (built without the `rerun` feature)", path.display())]
+    NoRecorder {
+        /// The `.rrd` asked for.
+        path: PathBuf,
+    },
+    /// A run stopped because one of its outputs failed (the failure is
+    /// reported where it happened).
+    #[error("the run was stopped: its output failed")]
+    OutputFailed,
 }
 
 /// Shorthand for results in this crate.
@@ -58,8 +109,10 @@ pub fn check_p_error(p: f64) -> Result<f64> {
     if p.is_finite() && (0.0..=1.0).contains(&p) {
         Ok(p)
     } else {
-        Err(SimError::Scenario(format!(
-            "decoder: returned p(error) = {p}, expected a number from 0 to 1"
-        )))
+        Err(SimError::OutOfRange {
+            name: "decoder".into(),
+            given: format!("returned p(error) = {p}"),
+            expected: "a number from 0 to 1".into(),
+        })
     }
 }

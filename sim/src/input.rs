@@ -11,8 +11,11 @@ use errp_bci::RequestedAccuracy;
 
 use crate::error::{Result, SimError};
 use crate::grid::{DecoderChoice, EegMode};
+use crate::names::Names;
+use crate::rules::{self, Claim, Origin, OwnEegFrom, TaskValue};
 use crate::scenario::{AnyScenario, apply_overrides, parse_scenario, parse_scenario_table};
 use crate::scenario_file::{parse_toml, read_scenario};
+use crate::task_kind::TaskKind;
 
 /// The built-in grid scenario (`scenarios/grid_fixed_goals.toml`): what a
 /// Python call or a sweep runs without a scenario file.
@@ -43,19 +46,23 @@ pub enum ScenarioSource {
 }
 
 impl ScenarioSource {
-    /// The file `path`, or the built-in scenario of the e-puck (`epuck`) or
-    /// of the grid.
-    pub fn file_or_built_in(path: Option<PathBuf>, epuck: bool) -> Self {
-        match (path, epuck) {
-            (Some(p), _) => ScenarioSource::File(p),
-            (None, true) => ScenarioSource::BuiltIn {
-                text: BUILT_IN_EPUCK,
-                name: "scenarios/mexico_to_pisa.toml",
+    /// The built-in scenario of `task` ([`BUILT_IN_GRID`],
+    /// [`BUILT_IN_EPUCK`]), named by its path in the repository.
+    pub fn built_in(task: TaskKind) -> Self {
+        ScenarioSource::BuiltIn {
+            text: match task {
+                TaskKind::Grid => BUILT_IN_GRID,
+                TaskKind::Epuck => BUILT_IN_EPUCK,
             },
-            (None, false) => ScenarioSource::BuiltIn {
-                text: BUILT_IN_GRID,
-                name: "scenarios/grid_fixed_goals.toml",
-            },
+            name: task.built_in_path(),
+        }
+    }
+
+    /// The file `path`, or the built-in scenario of `task`.
+    pub fn file_or_built_in(path: Option<PathBuf>, task: TaskKind) -> Self {
+        match path {
+            Some(p) => ScenarioSource::File(p),
+            None => Self::built_in(task),
         }
     }
 
@@ -78,35 +85,6 @@ impl ScenarioSource {
         }
     }
 }
-
-/// How a front end names the values it sets, in its errors: `--runs` on
-/// the command line, `runs:` in Python.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct SetterNames {
-    /// The accuracy.
-    pub accuracy: &'static str,
-    /// The seed.
-    pub seed: &'static str,
-    /// The runs of an e-puck scenario.
-    pub runs: &'static str,
-    /// The grid's decoder.
-    pub decoder: &'static str,
-    /// The grid's EEG mode.
-    pub eeg: &'static str,
-    /// The recording to write.
-    pub save: &'static str,
-}
-
-/// The values named as the scenario file's own keys, for callers that set
-/// only dotted keys (a sweep's levels).
-pub const FILE_KEYS: SetterNames = SetterNames {
-    accuracy: "user.accuracy",
-    seed: "seed",
-    runs: "runs",
-    decoder: "decoder",
-    eeg: "eeg",
-    save: "save",
-};
 
 /// A scenario's seed set from outside (`--seed`, `seed=`): a whole number
 /// from 0 to `i64::MAX`, as a TOML integer holds it; checked once, where
@@ -168,7 +146,7 @@ impl ScenarioInput {
     /// Loads `source` as it is written ([`ScenarioInput::load`] with
     /// nothing set).
     pub fn load_as_written(source: ScenarioSource) -> Result<AnyScenario> {
-        Ok(Self::new(source).load(&FILE_KEYS)?.scenario)
+        Ok(Self::new(source).load(&Names::FILE)?.scenario)
     }
 
     /// `source` with nothing set.
@@ -191,16 +169,16 @@ impl ScenarioInput {
     /// goals drawn from the seed) can be left behind. An error of the file
     /// as written quotes its line; one that only the values set cause
     /// names the file and the field.
-    pub fn load(&self, names: &SetterNames) -> Result<LoadedScenario> {
+    pub fn load(&self, names: &Names) -> Result<LoadedScenario> {
         let path = self.source.path();
         let text = self.source.read()?;
         let table: toml::Table = parse_toml(&text, path)?;
-        let epuck = table.get("task").and_then(toml::Value::as_str) == Some("epuck");
-        if let Err(e) = self.check_task(epuck, &table, names) {
+        let task = TaskKind::of_table(&table);
+        if let Err(e) = self.check_task(task, &table, names) {
             // The file's own error first, with its line.
             return Err(parse_scenario(&text, path).err().unwrap_or(e));
         }
-        let keys = self.pairs(epuck);
+        let keys = self.pairs();
         if keys.is_empty() {
             let scenario = parse_scenario(&text, path)?;
             return Ok(LoadedScenario { scenario, text });
@@ -223,77 +201,71 @@ impl ScenarioInput {
         }
     }
 
-    /// Refuses values that the scenario's task does not take: runs for the
-    /// grid, a decoder or EEG mode for the e-puck, a perfect accuracy for
-    /// anything but the grid's oracle.
-    fn check_task(&self, epuck: bool, table: &toml::Table, names: &SetterNames) -> Result<()> {
-        if epuck && (self.decoder.is_some() || self.eeg.is_some()) {
-            return Err(SimError::Scenario(format!(
-                "{} and {} apply to grid scenarios; the e-puck task always runs the streamed \
-                 EEG through the sliding-window SVM",
-                names.decoder, names.eeg
-            )));
+    /// Refuses what the values set cannot be combined with, by the rules
+    /// ([`rules`]) and in the names of `names`: a value the scenario's task
+    /// does not take, what a scenario on a person's own EEG cannot have, a
+    /// perfect accuracy for anything but the grid's oracle. `table` is the
+    /// scenario as written.
+    fn check_task(&self, task: TaskKind, table: &toml::Table, names: &Names) -> Result<()> {
+        let path = self.source.path();
+        let set = Origin::Input(names);
+        let mut given = Vec::new();
+        if self.decoder.is_some() {
+            given.push((TaskValue::Decoder, set));
         }
-        if !epuck && self.runs.is_some() {
-            return Err(SimError::Scenario(format!(
-                "{}: applies to e-puck scenarios; a grid scenario lists its episodes (set \
-                 `repeats` in {})",
-                names.runs,
-                self.source.path().display()
-            )));
+        if self.eeg.is_some() {
+            given.push((TaskValue::EegMode, set));
         }
+        if self.runs.is_some() {
+            given.push((TaskValue::Runs, set));
+        }
+        rules::task_takes(task, path, &given)?;
         let recording = table
             .get("eeg")
             .and_then(toml::Value::as_table)
             .and_then(|t| t.get("recording"))
             .and_then(toml::Value::as_str);
-        if let Some(recording) = recording {
-            let why = format!(
-                "the EEG of {} is a recording (eeg.recording = {recording:?})",
-                self.source.path().display()
-            );
-            if self.accuracy.is_some() {
-                return Err(SimError::Scenario(format!(
-                    "{}: {why}: its decoder is calibrated on the recording's first part and has \
-                     the accuracy the recording gives (reported when it is read); no accuracy \
-                     is targeted. Leave out {}, or remove the [eeg] table to simulate a user",
-                    names.accuracy, names.accuracy
-                )));
-            }
-            if let Some(eeg) = self.eeg {
-                return Err(SimError::Scenario(format!(
-                    "{} {}: {why}, whose held-out epochs the decoder reads; remove the [eeg] \
-                     table to simulate a user",
-                    names.eeg,
-                    eeg.key()
-                )));
-            }
-            if self.decoder == Some(DecoderChoice::Oracle) {
-                return Err(SimError::Scenario(format!(
-                    "{} oracle: {why}, which only the EEG decoder reads",
-                    names.decoder
-                )));
+        let own = recording.map(|recording| OwnEegFrom::Scenario { path, recording });
+        let mut claims = Vec::new();
+        if let Some(a) = self.accuracy {
+            claims.push((Claim::Accuracy(a.get()), set));
+        }
+        if let Some(eeg) = self.eeg {
+            claims.push((Claim::EegMode(eeg.key()), set));
+        }
+        if self.decoder == Some(DecoderChoice::Oracle) {
+            claims.push((Claim::Oracle, set));
+        }
+        // A mode set as a key would replace the `[eeg]` table that names
+        // the recording.
+        for (key, value) in &self.keys {
+            if let (true, Some(mode)) = (key == "eeg", value.as_str()) {
+                claims.push((Claim::EegMode(mode), set));
             }
         }
-        if self.accuracy == Some(RequestedAccuracy::Perfect) {
-            let oracle = match self.decoder {
-                Some(d) => d == DecoderChoice::Oracle,
-                None => table.get("decoder").and_then(toml::Value::as_str) == Some("oracle"),
-            };
-            if epuck || !oracle {
-                return Err(SimError::Scenario(format!(
-                    "{} 1: only the grid's oracle decoder may be perfect (with {} oracle, or \
-                     decoder = \"oracle\" in the scenario); the EEG decoders take a mean accuracy \
-                     strictly between 0.5 and 1, e.g. 0.95",
-                    names.accuracy, names.decoder
-                )));
-            }
+        rules::own_eeg_is_the_user(own, &claims)?;
+        if let Some(a) = self.accuracy {
+            rules::accuracy_for(task, self.decoder_is_oracle(table), a.get(), set)?;
         }
         Ok(())
     }
 
-    /// The values set, as the file's dotted keys, in order.
-    fn pairs(&self, epuck: bool) -> Vec<(&str, toml::Value)> {
+    /// True if the decoder is the oracle: as set, else as the last key
+    /// that sets it, else as the file writes it.
+    fn decoder_is_oracle(&self, table: &toml::Table) -> bool {
+        let oracle = DecoderChoice::Oracle.key();
+        match self.decoder {
+            Some(d) => d == DecoderChoice::Oracle,
+            None => match self.keys.iter().rev().find(|(k, _)| k == "decoder") {
+                Some((_, v)) => v.as_str() == Some(oracle),
+                None => table.get("decoder").and_then(toml::Value::as_str) == Some(oracle),
+            },
+        }
+    }
+
+    /// The values set, as the file's dotted keys, in order (each the
+    /// scenario's task takes: [`rules::task_takes`] refused the others).
+    fn pairs(&self) -> Vec<(&str, toml::Value)> {
         let mut out: Vec<(&str, toml::Value)> = Vec::new();
         if let Some(a) = self.accuracy {
             out.push(("user.accuracy", toml::Value::Float(a.get())));
@@ -301,16 +273,14 @@ impl ScenarioInput {
         if let Some(seed) = self.seed {
             out.push(("seed", toml::Value::Integer(seed.as_toml())));
         }
-        if epuck && let Some(runs) = self.runs {
+        if let Some(runs) = self.runs {
             out.push(("runs", toml::Value::Integer(runs as i64)));
         }
-        if !epuck {
-            if let Some(d) = self.decoder {
-                out.push(("decoder", toml::Value::String(d.key().into())));
-            }
-            if let Some(e) = self.eeg {
-                out.push(("eeg", toml::Value::String(e.key().into())));
-            }
+        if let Some(d) = self.decoder {
+            out.push(("decoder", toml::Value::String(d.key().into())));
+        }
+        if let Some(e) = self.eeg {
+            out.push(("eeg", toml::Value::String(e.key().into())));
         }
         out.extend(self.keys.iter().map(|(k, v)| (k.as_str(), v.clone())));
         out

@@ -29,28 +29,20 @@
 //! use errp_bci::RequestedAccuracy;
 //! use errp_sim::grid::DecoderChoice;
 //! use errp_sim::{
-//!     RunOptions, RunOutcome, RunProvenance, ScenarioInput, ScenarioSource, SetterNames,
+//!     Names, RunOptions, RunOutcome, RunProvenance, ScenarioInput, ScenarioSource, TaskKind,
 //!     run_scenario,
 //! };
 //!
-//! const NAMES: SetterNames = SetterNames {
-//!     accuracy: "accuracy",
-//!     seed: "seed",
-//!     runs: "runs",
-//!     decoder: "decoder",
-//!     eeg: "eeg",
-//!     save: "save",
-//! };
 //! let input = ScenarioInput {
 //!     accuracy: Some(RequestedAccuracy::new(0.9).unwrap()),
 //!     decoder: Some(DecoderChoice::Oracle),
-//!     ..ScenarioInput::new(ScenarioSource::file_or_built_in(None, false))
+//!     ..ScenarioInput::new(ScenarioSource::built_in(TaskKind::Grid))
 //! };
-//! let loaded = input.load(&NAMES).unwrap();
+//! let loaded = input.load(&Names::PYTHON).unwrap();
 //! let options = RunOptions {
 //!     save: None,
 //!     provenance: &RunProvenance::default(),
-//!     names: &NAMES,
+//!     names: &Names::PYTHON,
 //! };
 //! let run = run_scenario(loaded, options, &()).unwrap();
 //! let RunOutcome::Grid(report) = run.outcome else { unreachable!() };
@@ -74,12 +66,15 @@ mod input;
 pub mod inspect;
 mod key;
 pub mod live;
+mod names;
 mod output;
+pub mod own_eeg;
+pub mod pace;
 mod paper;
 pub mod realism;
 #[cfg(feature = "rerun")]
 pub mod record;
-pub mod recorded;
+pub mod rules;
 mod runner;
 mod scenario;
 mod scenario_file;
@@ -87,15 +82,16 @@ mod scenario_file;
 mod snapshot;
 mod stats;
 pub mod task;
+mod task_kind;
 
 pub use agents::{AgentInfo, EpuckAgentRecording, GridAgentRecording};
 pub use error::{Result, SimError, check_p_error};
 pub use files::{append_regular, is_foreign, open_regular, open_regular_with, write_regular};
 pub use input::{
-    BUILT_IN_EPUCK, BUILT_IN_GRID, FILE_KEYS, LoadedScenario, ScenarioInput, ScenarioSeed,
-    ScenarioSource, SetterNames,
+    BUILT_IN_EPUCK, BUILT_IN_GRID, LoadedScenario, ScenarioInput, ScenarioSeed, ScenarioSource,
 };
 pub use key::StableKey;
+pub use names::Names;
 pub use output::{
     CreatedDirs, PendingFile, create_dir, create_dirs, forget_if_interrupted,
     remove_if_interrupted, remove_unfinished, write_atomic,
@@ -107,11 +103,14 @@ pub use runner::{
     check_recordable_episodes, check_recordable_runs, epuck_decoder_summary, grid_decoder_summary,
     run_epuck_batch_recorded, run_grid_batch, run_scenario,
 };
-pub use scenario::{AnyScenario, apply_overrides, is_epuck, parse_scenario, parse_scenario_table};
+pub use scenario::{
+    AnyScenario, apply_overrides, parse_scenario, parse_scenario_table, scenario_kind,
+};
 pub use scenario_file::{
     MAX_KEY_PARTS, MAX_SCENARIO_BYTES, key_parts, parse_toml, table_into, truncate,
 };
 pub use stats::{
-    StreamingPearson, correlation_p_value, fixed_or_dash, incomplete_beta, mean_sd, median,
-    pearson, percentile_of, quantile, wilson_interval,
+    RunningPearson, correlation_p_value, fixed_or_dash, incomplete_beta, mean_sd, median, pearson,
+    percentile_of, quantile, wilson_interval,
 };
+pub use task_kind::{TaskKind, UnknownTask};

@@ -19,8 +19,10 @@ use crate::grid::{
     AssessmentDecoder, GridDecoding, GridEpisodeResult, GridRunReport, GridScenario,
     prepare_decoder, run_grid_scenario_with,
 };
-use crate::input::{LoadedScenario, SetterNames};
+use crate::input::LoadedScenario;
+use crate::names::Names;
 use crate::scenario::AnyScenario;
+use crate::task_kind::TaskKind;
 
 /// The most e-puck runs one recording holds.
 pub const MAX_RECORDED_RUNS: u64 = 100;
@@ -75,7 +77,7 @@ pub struct RunOptions<'a> {
     /// How the recording says it was made.
     pub provenance: &'a RunProvenance,
     /// How the front end names its inputs in errors.
-    pub names: &'a SetterNames,
+    pub names: &'a Names,
 }
 
 /// An e-puck scenario's runs.
@@ -98,6 +100,16 @@ pub enum RunOutcome {
     Grid(Box<GridRunReport>),
     /// An e-puck scenario's runs.
     Epuck(Box<EpuckRun>),
+}
+
+impl RunOutcome {
+    /// Its task.
+    pub fn kind(&self) -> TaskKind {
+        match self {
+            RunOutcome::Grid(_) => TaskKind::Grid,
+            RunOutcome::Epuck(_) => TaskKind::Epuck,
+        }
+    }
 }
 
 /// A finished run.
@@ -148,8 +160,8 @@ pub fn run_scenario(
 ) -> Result<ScenarioRun, RunError> {
     let LoadedScenario { scenario, text } = loaded;
     check_recordable(&scenario, &options)?;
-    let epuck = matches!(scenario, AnyScenario::Epuck(_));
-    let recording = PendingRecording::open(options.save, epuck).map_err(at(options.names.save))?;
+    let recording =
+        PendingRecording::open(options.save, scenario.kind()).map_err(at(options.names.save))?;
     observer.start(&scenario);
     match scenario {
         AnyScenario::Grid(s) => run_grid(*s, recording, text, options, observer),
@@ -160,9 +172,7 @@ pub fn run_scenario(
 /// The error of a run its observer stopped.
 fn check_going(observer: &impl RunObserver) -> Result<(), RunError> {
     if observer.stopped() {
-        return Err(plain(SimError::Scenario(
-            "the run was stopped: its output failed".into(),
-        )));
+        return Err(plain(SimError::OutputFailed));
     }
     Ok(())
 }
@@ -230,7 +240,7 @@ fn check_recordable(scenario: &AnyScenario, options: &RunOptions<'_>) -> Result<
 
 /// Refuses to record `runs` e-puck runs into one file: more than
 /// [`MAX_RECORDED_RUNS`]. The error names the inputs as `names` says.
-pub fn check_recordable_runs(runs: u64, names: &SetterNames) -> Result<(), SimError> {
+pub fn check_recordable_runs(runs: u64, names: &Names) -> Result<(), SimError> {
     if runs <= MAX_RECORDED_RUNS {
         return Ok(());
     }
@@ -245,10 +255,7 @@ pub fn check_recordable_runs(runs: u64, names: &SetterNames) -> Result<(), SimEr
 
 /// Refuses to record the episodes of `scenario` into one file: more than
 /// [`MAX_RECORDED_EPISODES`]. The error names the inputs as `names` says.
-pub fn check_recordable_episodes(
-    scenario: &GridScenario,
-    names: &SetterNames,
-) -> Result<(), SimError> {
+pub fn check_recordable_episodes(scenario: &GridScenario, names: &Names) -> Result<(), SimError> {
     let n = scenario.episodes.len();
     if n <= MAX_RECORDED_EPISODES {
         return Ok(());
@@ -271,7 +278,7 @@ pub fn grid_decoder_summary(
     decoder: &AssessmentDecoder,
     calibration: Option<&CalibrationReport>,
 ) -> String {
-    if let AssessmentDecoder::Recorded(bank) = decoder {
+    if let AssessmentDecoder::OwnEeg(bank) = decoder {
         return bank.report.to_string();
     }
     match calibration {
@@ -294,11 +301,11 @@ pub struct PendingRecording {
 }
 
 impl PendingRecording {
-    /// The `.rrd` at `save` of a grid or an e-puck (`epuck`) batch, created
-    /// now (refused by a build without the `rerun` feature).
-    pub fn open(save: Option<&Path>, epuck: bool) -> Result<Self, SimError> {
+    /// The `.rrd` at `save` of a batch of `task`, created now (refused by
+    /// a build without the `rerun` feature).
+    pub fn open(save: Option<&Path>, task: TaskKind) -> Result<Self, SimError> {
         Ok(Self {
-            file: recording::open(save, epuck)?,
+            file: recording::open(save, task)?,
         })
     }
 
@@ -337,7 +344,7 @@ pub fn run_grid_batch(
     observer: &impl RunObserver,
 ) -> Result<(GridRunReport, Option<PathBuf>), RunError> {
     let recorded = match &decoding {
-        GridDecoding::Builtin(AssessmentDecoder::Recorded(bank)) => Some(bank.report.clone()),
+        GridDecoding::Builtin(AssessmentDecoder::OwnEeg(bank)) => Some(bank.report.clone()),
         _ => None,
     };
     let episodes = run_grid_scenario_with(&scenario, decoding, recording.is_some(), |k, r| {
@@ -348,7 +355,7 @@ pub fn run_grid_batch(
     let report = GridRunReport {
         scenario,
         calibration,
-        recorded,
+        own_eeg: recorded,
         episodes,
     };
     let path = recording::grid(recording.file, &report, &record).map_err(at(record.flag))?;
@@ -482,22 +489,20 @@ mod recording {
     use crate::grid::GridRunReport;
     use crate::record::RrdFile;
     use crate::record::data::Provenance;
+    use crate::task_kind::TaskKind;
 
     pub(super) type File = RrdFile;
 
     /// The `.rrd` at `save`, created now.
-    pub(super) fn open(save: Option<&Path>, epuck: bool) -> Result<Option<File>> {
-        save.map(|p| {
-            if epuck {
-                crate::epuck::epuck_recording(p)
-            } else {
-                crate::grid::grid_recording(p)
-            }
+    pub(super) fn open(save: Option<&Path>, task: TaskKind) -> Result<Option<File>> {
+        save.map(|p| match task {
+            TaskKind::Epuck => crate::epuck::epuck_recording(p),
+            TaskKind::Grid => crate::grid::grid_recording(p),
         })
         .transpose()
     }
 
-    fn provenance(task: &str, name: &str, seed: u64, of: &BatchRecord<'_>) -> Provenance {
+    fn provenance(task: TaskKind, name: &str, seed: u64, of: &BatchRecord<'_>) -> Provenance {
         let mut p = Provenance::new(task, name, of.text.to_string(), seed);
         if let Some(commit) = &of.made_by.commit {
             p.commit.clone_from(commit);
@@ -515,8 +520,8 @@ mod recording {
     ) -> Result<Option<PathBuf>> {
         let Some(file) = file else { return Ok(None) };
         let s = &report.scenario;
-        let mut p = provenance("grid", &s.name, s.seed, of);
-        p.eeg_recording = report.recorded.as_ref().map(|r| r.file.clone());
+        let mut p = provenance(TaskKind::Grid, &s.name, s.seed, of);
+        p.own_eeg = report.own_eeg.as_ref().map(|r| r.file.clone());
         crate::grid::record_grid_run(file, report, &p).map(Some)
     }
 
@@ -530,8 +535,8 @@ mod recording {
         of: &BatchRecord<'_>,
         on_run: &(dyn Fn(usize) + Sync),
     ) -> Result<Vec<EpuckEpisodeResult>> {
-        let mut p = provenance("epuck", &scenario.name, scenario.seed, of);
-        p.eeg_recording = decoder.recorded.as_ref().map(|r| r.file.clone());
+        let mut p = provenance(TaskKind::Epuck, &scenario.name, scenario.seed, of);
+        p.own_eeg = decoder.own_eeg.as_ref().map(|r| r.file.clone());
         crate::epuck::record_epuck_runs_with(
             file,
             scenario,
@@ -558,17 +563,17 @@ mod recording {
     use crate::epuck::{ContinuousDecoder, EpuckEpisodeResult, EpuckScenario, WindowDecoder};
     use crate::error::{Result, SimError};
     use crate::grid::GridRunReport;
+    use crate::task_kind::TaskKind;
 
     /// No file is ever open.
     pub(super) enum File {}
 
-    pub(super) fn open(save: Option<&Path>, _epuck: bool) -> Result<Option<File>> {
+    pub(super) fn open(save: Option<&Path>, _task: TaskKind) -> Result<Option<File>> {
         match save {
             None => Ok(None),
-            Some(p) => Err(SimError::Scenario(format!(
-                "{}: this build records nothing (built without the `rerun` feature)",
-                p.display()
-            ))),
+            Some(p) => Err(SimError::NoRecorder {
+                path: p.to_path_buf(),
+            }),
         }
     }
 

@@ -5,10 +5,24 @@ use std::path::Path;
 
 use serde::Deserialize;
 
+use crate::epuck::EpuckTask;
 use crate::epuck::scenario::EpuckScenario;
 use crate::error::Result;
+use crate::grid::GridTask;
 use crate::grid::scenario::GridScenario;
 use crate::scenario_file::{key_parts, parse_toml};
+use crate::task::{Task, TaskInfo};
+use crate::task_kind::TaskKind;
+
+impl TaskKind {
+    /// The task's columns, labels and sweepable parameters.
+    pub fn info(self) -> &'static TaskInfo {
+        match self {
+            TaskKind::Grid => &GridTask::INFO,
+            TaskKind::Epuck => &EpuckTask::INFO,
+        }
+    }
+}
 
 /// A scenario of either task, as `errp run` takes it.
 #[derive(Debug, Clone)]
@@ -20,6 +34,14 @@ pub enum AnyScenario {
 }
 
 impl AnyScenario {
+    /// Its task.
+    pub fn kind(&self) -> TaskKind {
+        match self {
+            AnyScenario::Grid(_) => TaskKind::Grid,
+            AnyScenario::Epuck(_) => TaskKind::Epuck,
+        }
+    }
+
     /// The scenario, if it is an `S` (a task's
     /// [`Task::Scenario`](crate::task::Task::Scenario)).
     pub fn get<S: 'static>(&self) -> Option<&S> {
@@ -117,37 +139,28 @@ fn set_edit_key(
 /// values set from the command line or a sweep). Errors name `path` and the
 /// field, but no line: the table is not the file as written.
 pub fn parse_scenario_table(table: &toml::Table, path: &Path) -> Result<AnyScenario> {
-    if table.get("task").and_then(toml::Value::as_str) == Some("epuck") {
-        Ok(AnyScenario::Epuck(Box::new(EpuckScenario::from_table(
-            table, path,
-        )?)))
-    } else {
-        Ok(AnyScenario::Grid(Box::new(GridScenario::from_table(
-            table, path,
-        )?)))
-    }
+    Ok(match TaskKind::of_table(table) {
+        TaskKind::Epuck => AnyScenario::Epuck(Box::new(EpuckScenario::from_table(table, path)?)),
+        TaskKind::Grid => AnyScenario::Grid(Box::new(GridScenario::from_table(table, path)?)),
+    })
 }
 
 /// Validates scenario text of either task; `path` names it in errors.
 pub fn parse_scenario(text: &str, path: &Path) -> Result<AnyScenario> {
-    if is_epuck(text, path)? {
-        Ok(AnyScenario::Epuck(Box::new(EpuckScenario::parse(
-            text, path,
-        )?)))
-    } else {
-        Ok(AnyScenario::Grid(Box::new(GridScenario::parse(
-            text, path,
-        )?)))
-    }
+    Ok(match scenario_kind(text, path)? {
+        TaskKind::Epuck => AnyScenario::Epuck(Box::new(EpuckScenario::parse(text, path)?)),
+        TaskKind::Grid => AnyScenario::Grid(Box::new(GridScenario::parse(text, path)?)),
+    })
 }
 
-/// True if the scenario text says `task = "epuck"`; any other task is left
-/// to the grid loader, which names the accepted values.
-pub fn is_epuck(text: &str, path: &Path) -> Result<bool> {
+/// The task scenario text selects ([`TaskKind::of_field`]): the e-puck
+/// for `task = "epuck"`; any other task is left to the grid loader, which
+/// names the accepted values.
+pub fn scenario_kind(text: &str, path: &Path) -> Result<TaskKind> {
     #[derive(Deserialize)]
     struct Task {
         task: Option<String>,
     }
     let task: Task = parse_toml(text, path)?;
-    Ok(task.task.as_deref() == Some("epuck"))
+    Ok(TaskKind::of_field(task.task.as_deref()))
 }

@@ -115,15 +115,18 @@ fn toml_error(path: &Path, text: Option<&str>, e: &toml::de::Error) -> SimError 
         .map(str::trim)
         .filter(|v| v.parse::<toml::value::Datetime>().is_ok());
     match value_and_expected(&message) {
-        Some((value, expected)) if value == "a table" && written.is_some() => {
-            SimError::Scenario(format!(
-                "{at}: field `{key}` = {} (a date-time) is invalid: expected {expected}",
-                written.unwrap_or_default()
-            ))
-        }
-        Some((value, expected)) => SimError::Scenario(format!(
-            "{at}: field `{key}` = {value} is invalid: expected {expected}"
-        )),
+        Some((value, expected)) if value == "a table" && written.is_some() => SimError::Field {
+            at,
+            field: key.into(),
+            value: format!("{} (a date-time)", written.unwrap_or_default()),
+            expected,
+        },
+        Some((value, expected)) => SimError::Field {
+            at,
+            field: key.into(),
+            value,
+            expected,
+        },
         None => SimError::Scenario(format!("{at}: field `{key}`: {message}")),
     }
 }
@@ -247,11 +250,12 @@ pub fn truncate(text: &str, n: usize) -> String {
 
 /// The error for a bad `field` of the scenario at `path`.
 pub(crate) fn field_error(path: &Path, field: &str, value: String, expected: &str) -> SimError {
-    SimError::Scenario(format!(
-        "{}: field `{field}` = {} is invalid: expected {expected}",
-        path.display(),
-        errp_bci::shown(value)
-    ))
+    SimError::Field {
+        at: path.display().to_string(),
+        field: field.into(),
+        value: errp_bci::shown(value),
+        expected: expected.into(),
+    }
 }
 
 /// The `[realism]` table of a scenario, checked: the error names the field

@@ -100,7 +100,7 @@ pub fn correlation_p_value(r: f64, n: usize) -> f64 {
 /// Pearson's r accumulated one pair at a time (Welford's co-moments), for
 /// data streamed from disk: constant memory, whatever the number of pairs.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct StreamingPearson {
+pub struct RunningPearson {
     n: usize,
     mean_x: f64,
     mean_y: f64,
@@ -109,7 +109,7 @@ pub struct StreamingPearson {
     sxy: f64,
 }
 
-impl StreamingPearson {
+impl RunningPearson {
     /// Adds the pair (x, y).
     pub fn push(&mut self, x: f64, y: f64) {
         self.n += 1;
@@ -268,12 +268,12 @@ mod tests {
     }
 
     #[test]
-    fn streaming_pearson_equals_the_two_pass_one() {
+    fn running_pearson_equals_the_two_pass_one() {
         let x: Vec<f64> = (0..50).map(|i| (i as f64 * 0.37).sin() + 3.0).collect();
         let y: Vec<f64> = (0..50)
             .map(|i| (i as f64 * 0.11).cos() * 40.0 + x[i])
             .collect();
-        let mut s = StreamingPearson::default();
+        let mut s = RunningPearson::default();
         for i in 0..50 {
             s.push(x[i], y[i]);
         }
@@ -283,7 +283,7 @@ mod tests {
             (r - r2).abs() < 1e-12 && (p - p2).abs() < 1e-10,
             "{r} {r2} {p} {p2}"
         );
-        assert!(StreamingPearson::default().r_p().0.is_nan());
+        assert!(RunningPearson::default().r_p().0.is_nan());
     }
 
     #[test]

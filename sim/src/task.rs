@@ -14,16 +14,17 @@ use errp_bci::Accuracy;
 
 use crate::calibration::TargetingCache;
 use crate::error::Result;
+use crate::task_kind::TaskKind;
 
 /// The fixed facts of a task: its name, the columns of its episode rows and
 /// what its summaries call things.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct TaskInfo {
-    /// As in scenario files and `--task` (`grid`, `epuck`).
-    pub name: &'static str,
+    /// Which task.
+    pub kind: TaskKind,
     /// The task's own columns of an episode row, between `success` and the
     /// online accuracy columns, in the order of [`EpisodeRow::fields`].
-    pub columns: &'static [Column],
+    pub columns: &'static [EpisodeColumn],
     /// The column of the cost a sweep summarises (over successful episodes).
     pub cost_column: &'static str,
     /// The cost as a table heading, with its unit.
@@ -43,14 +44,14 @@ pub struct TaskInfo {
 
 /// A column of a task's episode rows: its name and what it may hold.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Column {
+pub struct EpisodeColumn {
     /// The CSV header's name.
     pub name: &'static str,
     /// What a field of it may hold.
     pub kind: ColumnKind,
 }
 
-impl Column {
+impl EpisodeColumn {
     /// A column `name` of `kind`.
     pub const fn new(name: &'static str, kind: ColumnKind) -> Self {
         Self { name, kind }
@@ -156,8 +157,8 @@ pub struct DecoderInfo {
     /// A person's recording, when the decoder was calibrated on one: its
     /// name, size and SHA-256 (a sweep resumed on another file is refused
     /// by it).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub recording: Option<crate::files::FileDigest>,
+    #[serde(default, rename = "recording", skip_serializing_if = "Option::is_none")]
+    pub own_eeg: Option<crate::files::FileDigest>,
     /// True if the targeting came from the cache (not written to disk).
     #[serde(skip)]
     pub cached: bool,

@@ -1,7 +1,7 @@
 //! `errp calibrate` and `errp subjects`.
 
 use anyhow::{Context, Result, bail};
-use errp_bci::{EdfWriter, GoalSet, MeanAccuracy, SessionOptions, subject, subjects};
+use errp_bci::{EdfWriter, GoalSet, MeanAccuracy, SFREQ_HZ, SessionOptions, subject, subjects};
 use errp_sim::PendingFile;
 use errp_sim::calibration::{CalibrationReport, CalibrationRequest, run_calibration};
 
@@ -53,7 +53,7 @@ pub(crate) fn calibrate(args: &CalibrateArgs) -> Result<()> {
         Some(p) => {
             let (pending, file) = PendingFile::create(p).context("--export")?;
             let montage = errp_bci::Montage::standard();
-            let writer = EdfWriter::new(std::io::BufWriter::new(file), &montage, 256.0)?;
+            let writer = EdfWriter::new(std::io::BufWriter::new(file), &montage, SFREQ_HZ)?;
             Some((pending, writer))
         }
         None => None,

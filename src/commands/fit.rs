@@ -5,12 +5,13 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
+use errp_sim::Names;
 use errp_sim::grid::GridTaskParams;
 use errp_sweep::fit::{
-    EpuckFitReport, EpuckFitSpec, FitOutcome, GridFitOutcome, GridFitReport, GridFitSpec,
-    Provenance, run_epuck_fit, run_grid_fit,
+    EpuckFitReport, EpuckFitSpec, FitOutcome, FitProvenance, GridFitOutcome, GridFitReport,
+    GridFitSpec, run_epuck_fit, run_grid_fit,
 };
-use errp_sweep::{InputNames, parse_accuracies, parse_values};
+use errp_sweep::{parse_accuracies, parse_values};
 use toml::Value;
 
 use crate::cli::parse_seed;
@@ -146,7 +147,7 @@ pub fn fit(cmd: &FitCommand) -> Result<bool> {
 
 fn fit_epuck(args: &EpuckFitArgs) -> Result<bool> {
     let spec = EpuckFitSpec {
-        accuracies: parse_accuracies(&args.accuracy, &InputNames::CLI)?,
+        accuracies: parse_accuracies(&args.accuracy, &Names::CLI)?,
         calibrations: args.calibrations,
         runs: args.runs,
         seed: args.seed,
@@ -269,8 +270,8 @@ fn start(
 }
 
 /// The command line, version and commit, for a fit's result file.
-fn provenance() -> Provenance {
-    Provenance {
+fn provenance() -> FitProvenance {
+    FitProvenance {
         command: crate::commands::command_line().join(" "),
         errp_version: env!("CARGO_PKG_VERSION").to_string(),
         commit: COMMIT.to_string(),

@@ -24,7 +24,7 @@ pub(crate) fn user_realism(path: Option<&std::path::Path>) -> anyhow::Result<err
 /// scenarios as an [`errp_sim::ScenarioInput`].
 pub(crate) fn load(path: &std::path::Path) -> anyhow::Result<errp_sim::AnyScenario> {
     let input = errp_sim::ScenarioInput::new(errp_sim::ScenarioSource::File(path.to_path_buf()));
-    Ok(input.load(&run::FLAGS)?.scenario)
+    Ok(input.load(&errp_sim::Names::CLI)?.scenario)
 }
 
 /// The command line as it was given, for a result's provenance: an

@@ -4,8 +4,8 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
-use errp_sim::AnyScenario;
 use errp_sim::realism::measure_realism;
+use errp_sim::{AnyScenario, TaskKind};
 
 use crate::out::{errln, out};
 
@@ -35,11 +35,11 @@ pub(crate) struct RealismArgs {
 pub(crate) fn realism(args: &RealismArgs) -> Result<()> {
     let grid = match crate::commands::load(&args.grid)? {
         AnyScenario::Grid(s) => s,
-        AnyScenario::Epuck(_) => wrong_task(&args.grid, "--grid", "grid")?,
+        AnyScenario::Epuck(_) => wrong_task(&args.grid, "--grid", TaskKind::Grid)?,
     };
     let epuck = match crate::commands::load(&args.epuck)? {
         AnyScenario::Epuck(s) => s,
-        AnyScenario::Grid(_) => wrong_task(&args.epuck, "--epuck", "epuck")?,
+        AnyScenario::Grid(_) => wrong_task(&args.epuck, "--epuck", TaskKind::Epuck)?,
     };
     let quiet = args.quiet;
     let report = measure_realism(&grid, &epuck, &mut |stage: &str| {
@@ -51,15 +51,10 @@ pub(crate) fn realism(args: &RealismArgs) -> Result<()> {
     Ok(())
 }
 
-fn wrong_task<T>(path: &Path, flag: &str, task: &str) -> Result<T> {
+fn wrong_task<T>(path: &Path, flag: &str, task: TaskKind) -> Result<T> {
     bail!(
-        "{flag} {}: field `task` is not \"{task}\": give a {task} scenario, e.g. \
-         scenarios/{}",
+        "{flag} {}: field `task` is not \"{task}\": give a {task} scenario, e.g. {}",
         path.display(),
-        if task == "grid" {
-            "grid_fixed_goals.toml"
-        } else {
-            "mexico_to_pisa.toml"
-        }
+        task.built_in_path()
     )
 }

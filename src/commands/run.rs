@@ -7,23 +7,13 @@ use errp_bci::{OnlineStep, TargetingStep};
 use errp_sim::epuck::{EpuckRunsTable, EpuckSummaryReport, summarise};
 use errp_sim::grid::{DecoderChoice, GridEpisodeHeader, GridEpisodeResult, GridEpisodeRow};
 use errp_sim::{
-    AnyScenario, RunHeadline, RunObserver, RunOptions, RunOutcome, RunProvenance, ScenarioInput,
-    ScenarioSource, SetterNames, run_scenario,
+    AnyScenario, Names, RunHeadline, RunObserver, RunOptions, RunOutcome, RunProvenance,
+    ScenarioInput, ScenarioSource, TaskKind, run_scenario,
 };
 
 use crate::cli::{DecoderArg, RunArgs};
 use crate::out::{errln, out, outln};
 use crate::save::check_save;
-
-/// The flags that set a scenario's values, as errors name them.
-pub(crate) const FLAGS: SetterNames = SetterNames {
-    accuracy: "--accuracy",
-    seed: "--seed",
-    runs: "--runs",
-    decoder: "--decoder",
-    eeg: "--eeg",
-    save: "--save",
-};
 
 pub(crate) fn run(args: &RunArgs) -> Result<()> {
     // The flags are keys of the scenario file, set before it is parsed, so
@@ -39,7 +29,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<()> {
         eeg: args.eeg.map(|e| e.mode()),
         ..ScenarioInput::new(ScenarioSource::File(args.scenario.clone()))
     };
-    let loaded = input.load(&FLAGS)?;
+    let loaded = input.load(&Names::CLI)?;
     check_save(args.save.as_deref())?;
     let provenance = RunProvenance {
         command: crate::commands::command_line(),
@@ -48,11 +38,11 @@ pub(crate) fn run(args: &RunArgs) -> Result<()> {
     let options = RunOptions {
         save: args.save.as_deref(),
         provenance: &provenance,
-        names: &FLAGS,
+        names: &Names::CLI,
     };
     let printer = Printer {
         quiet: args.quiet,
-        grid: matches!(loaded.scenario, AnyScenario::Grid(_)),
+        task: loaded.scenario.kind(),
         printed: Mutex::new(Ok(())),
     };
     let run = run_scenario(loaded, options, &printer).map_err(|e| match e.context {
@@ -99,8 +89,9 @@ pub(crate) fn run(args: &RunArgs) -> Result<()> {
 /// decoder's summary, and each grid episode's row.
 struct Printer {
     quiet: bool,
-    /// A grid run: its table of episodes follows the decoder's summary.
-    grid: bool,
+    /// The task: a grid run's table of episodes follows the decoder's
+    /// summary.
+    task: TaskKind,
     /// The first failure to print.
     printed: Mutex<Result<()>>,
 }
@@ -133,29 +124,19 @@ impl RunObserver for Printer {
 
     fn targeting(&self, s: &TargetingStep) {
         if !self.quiet {
-            errln!(
-                "  calibrating: ErrP-to-noise {:.4} -> mean {:.2} %",
-                s.ratio,
-                100.0 * s.accuracy.mean()
-            );
+            print_targeting(s);
         }
     }
 
     fn online_step(&self, s: &OnlineStep) {
         if !self.quiet {
-            errln!(
-                "  calibrating: ErrP-to-noise {:.4}, T_e {:.3} -> {:.1} % hits, {:.2} false alarms/min",
-                s.ratio,
-                s.t_e,
-                100.0 * s.point.hit_rate,
-                s.point.false_alarms_per_min
-            );
+            print_online_step(s);
         }
     }
 
     fn decoder_ready(&self, summary: &str) {
         self.print(|| out!("{summary}"));
-        if self.grid {
+        if self.task == TaskKind::Grid {
             self.print(|| outln!("{GridEpisodeHeader}"));
         }
     }
@@ -169,4 +150,24 @@ impl RunObserver for Printer {
             errln!("  running {runs} runs in parallel");
         }
     }
+}
+
+/// A step of the search for the ErrP-to-noise ratio, on standard error.
+pub(crate) fn print_targeting(s: &TargetingStep) {
+    errln!(
+        "  calibrating: ErrP-to-noise {:.4} -> mean {:.2} %",
+        s.ratio,
+        100.0 * s.accuracy.mean()
+    );
+}
+
+/// A step of the e-puck detector's calibration, on standard error.
+pub(crate) fn print_online_step(s: &OnlineStep) {
+    errln!(
+        "  calibrating: ErrP-to-noise {:.4}, T_e {:.3} -> {:.1} % hits, {:.2} false alarms/min",
+        s.ratio,
+        s.t_e,
+        100.0 * s.point.hit_rate,
+        s.point.false_alarms_per_min
+    );
 }

@@ -7,34 +7,30 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use clap::ValueEnum;
+use errp_sim::Names;
+use errp_sim::TaskKind;
+use errp_sim::grid::EegMode;
 use errp_sweep::{
-    CheckedSweep, DecoderInfo, InputNames, MAX_EPISODES, Shard, SweepObserver, SweepOptions,
-    SweepOutcome, SweepReport, SweepSpec, SweepTask, TargetCache, aliases, merge_sweeps,
-    parse_accuracies, parse_axis, prepare_sweep, run_sweep, sweep_fixed, sweep_scenario,
+    CheckedSweep, DecoderInfo, MAX_EPISODES, Shard, SweepObserver, SweepOptions, SweepOutcome,
+    SweepReport, SweepSpec, TargetCache, aliases, merge_sweeps, parse_axis, prepare_sweep,
+    run_sweep, sweep_scenario,
 };
 
-use crate::cli::parse_seed;
+use crate::cli::{EegArg, parse_seed};
 use crate::interrupt;
 use crate::out::{errln, out, outln};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-/// The task of a sweep, as the flag takes it.
-#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum TaskArg {
-    /// The 5x5 grid.
-    Grid,
-    /// The e-puck.
-    Epuck,
-}
-
-/// How the grid's EEG reaches the decoder in a sweep.
-#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum SweepEeg {
-    /// A bank of epochs streamed in advance (fast; the default).
-    Bank,
-    /// Streamed per action (about 200 times slower).
-    Stream,
+/// `--task`: `grid` or `epuck`, parsed as [`TaskKind`] is.
+fn task_parser() -> impl clap::builder::TypedValueParser<Value = TaskKind> {
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+    PossibleValuesParser::new(TaskKind::ALL.map(|t| {
+        PossibleValue::new(t.as_str()).help(match t {
+            TaskKind::Grid => "The 5x5 grid",
+            TaskKind::Epuck => "The e-puck",
+        })
+    }))
+    .map(|s| s.parse::<TaskKind>().expect("one of TaskKind::ALL"))
 }
 
 /// `errp sweep`.
@@ -43,8 +39,8 @@ pub struct SweepArgs {
     /// The task. Without --scenario, its built-in scenario is swept
     /// (grid: the five fixed goals; e-puck: Mexico to Pisa); with it, it must
     /// match the scenario's `task`.
-    #[arg(long, value_enum)]
-    task: Option<TaskArg>,
+    #[arg(long, value_parser = task_parser())]
+    task: Option<TaskKind>,
     /// The scenario to sweep.
     #[arg(long, value_name = "FILE.toml")]
     scenario: Option<PathBuf>,
@@ -68,9 +64,10 @@ pub struct SweepArgs {
     /// Output directory (rerunning into it resumes).
     #[arg(long, value_name = "DIR", required_unless_present = "prepare_only")]
     out: Option<PathBuf>,
-    /// Grid only: how EEG reaches the decoder.
+    /// Grid only: how EEG reaches the decoder [default: bank; per_action is
+    /// about 200 times slower].
     #[arg(long, value_enum)]
-    eeg: Option<SweepEeg>,
+    eeg: Option<EegArg>,
     /// Run only slice K of N (1 <= K <= N); merge the N directories with
     /// `errp merge`.
     #[arg(long, value_name = "K/N")]
@@ -211,7 +208,7 @@ impl SweepObserver for Progress {
         let reached = info.cv_mean.map_or("exact (oracle)".to_string(), |m| {
             format!("{:.2} % cross-validated", 100.0 * m)
         });
-        let what = match &info.recording {
+        let what = match &info.own_eeg {
             Some(r) => format!("recording {}", r.name),
             None => format!("accuracy {}", info.accuracy),
         };
@@ -271,12 +268,8 @@ impl SweepObserver for Progress {
 }
 
 /// The sweep the flags ask for, each flag parsed (named by `NAMES`).
-fn sweep_spec(args: &SweepArgs, names: InputNames) -> Result<SweepSpec> {
-    let want = args.task.map(|t| match t {
-        TaskArg::Grid => SweepTask::Grid,
-        TaskArg::Epuck => SweepTask::Epuck,
-    });
-    let (task, text, path) = sweep_scenario(args.scenario.as_deref(), want, names)?;
+fn sweep_spec(args: &SweepArgs, names: Names) -> Result<SweepSpec> {
+    let (task, text, path) = sweep_scenario(args.scenario.as_deref(), args.task, names)?;
     let mut spec = SweepSpec {
         task,
         scenario_path: path,
@@ -291,20 +284,14 @@ fn sweep_spec(args: &SweepArgs, names: InputNames) -> Result<SweepSpec> {
         episodes: args.episodes as usize,
         seed: args.seed,
     };
-    // On recordings no accuracy is targeted and the EEG is theirs: the
-    // sweep's check refuses either flag, saying why.
-    let recordings = spec.on_recordings();
-    let accuracy = match (&args.accuracy, recordings) {
-        (Some(a), _) => Some(a.as_str()),
-        (None, false) => Some(DEFAULT_ACCURACIES),
-        (None, true) => None,
+    // On own EEG no accuracy is targeted: no default levels (the sweep's
+    // check refuses --accuracy, saying why).
+    let accuracy = match &args.accuracy {
+        Some(a) => Some(a.as_str()),
+        None => (!spec.on_own_eeg()).then_some(DEFAULT_ACCURACIES),
     };
-    if let Some(a) = accuracy {
-        spec.accuracies = parse_accuracies(a, &names)?;
-    }
-    if !recordings || args.eeg.is_some() {
-        spec.fixed = sweep_fixed(task, args.eeg.map(|e| e == SweepEeg::Stream), names)?;
-    }
+    let per_action = args.eeg.map(|e| e.mode() == EegMode::PerAction);
+    spec.set_levels(accuracy, per_action, &names)?;
     Ok(spec)
 }
 
@@ -313,7 +300,7 @@ const DEFAULT_ACCURACIES: &str = "0.55:0.95:0.05";
 
 /// Runs `errp sweep`. Returns false if interrupted (exit code 130).
 pub fn sweep(args: &SweepArgs) -> Result<bool> {
-    const NAMES: InputNames = InputNames::CLI;
+    const NAMES: Names = Names::CLI;
     let spec = sweep_spec(args, NAMES)?;
     let shard = match &args.shard {
         Some(s) => Shard::parse(s)?,
@@ -505,7 +492,7 @@ fn param_help() -> String {
         "Also sweep a scenario parameter, NAME=start:stop:step or NAME=a,b,c \
          (repeatable; every combination runs). NAME is a dotted path into the scenario \
          file (e.g. control.tau) or a short name.\n\nGrid: {}\n\nE-puck: {}",
-        aliases(SweepTask::Grid),
-        aliases(SweepTask::Epuck)
+        aliases(TaskKind::Grid),
+        aliases(TaskKind::Epuck)
     )
 }

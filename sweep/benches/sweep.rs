@@ -9,9 +9,10 @@ use std::path::PathBuf;
 use errp_bci::stop::WindDown;
 
 use divan::Bencher;
+use errp_sim::Names;
+use errp_sim::TaskKind;
 use errp_sweep::{
-    InputNames, Shard, SweepOptions, SweepOutcome, SweepSpec, SweepTask, TargetCache,
-    parse_accuracies, run_sweep,
+    Shard, SweepOptions, SweepOutcome, SweepSpec, TargetCache, parse_accuracies, run_sweep,
 };
 
 fn main() {
@@ -19,12 +20,12 @@ fn main() {
 }
 
 /// A sweep of the shipped scenario `file` (its text is `toml`).
-fn spec(task: SweepTask, file: &str, toml: &str, accuracies: &str, episodes: usize) -> SweepSpec {
+fn spec(task: TaskKind, file: &str, toml: &str, accuracies: &str, episodes: usize) -> SweepSpec {
     SweepSpec {
         task,
         scenario_path: format!("scenarios/{file}").into(),
         scenario_toml: toml.into(),
-        accuracies: parse_accuracies(accuracies, &InputNames::CLI).unwrap(),
+        accuracies: parse_accuracies(accuracies, &Names::CLI).unwrap(),
         axes: vec![],
         fixed: vec![],
         episodes,
@@ -37,7 +38,7 @@ fn grid_spec(episodes: usize) -> SweepSpec {
     SweepSpec {
         fixed: vec![("eeg".into(), toml::Value::String("bank".into()))],
         ..spec(
-            SweepTask::Grid,
+            TaskKind::Grid,
             "grid_fixed_goals.toml",
             toml,
             "0.55:0.95:0.04",
@@ -49,7 +50,7 @@ fn grid_spec(episodes: usize) -> SweepSpec {
 fn epuck_spec(episodes: usize) -> SweepSpec {
     let toml = include_str!("../../scenarios/mexico_to_pisa.toml");
     spec(
-        SweepTask::Epuck,
+        TaskKind::Epuck,
         "mexico_to_pisa.toml",
         toml,
         "0.75",
@@ -78,7 +79,7 @@ fn sweep(spec: &SweepSpec, threads: usize, cache: &TargetCache, name: &str) {
         .unwrap();
     let outcome = pool
         .install(|| {
-            let sweep = spec.clone().checked(&InputNames::CLI).unwrap();
+            let sweep = spec.clone().checked(&Names::CLI).unwrap();
             run_sweep(&sweep, &opts, &WindDown::new(), &())
         })
         .unwrap();
@@ -115,7 +116,7 @@ fn epuck_40_episodes(bencher: Bencher, threads: usize) {
 fn recheck_40000_rows(bencher: Bencher) {
     let toml = "task = \"grid\"\ndecoder = \"oracle\"\n[user]\naccuracy = 0.8\n\
                 [free_goals]\ncount = 50\n";
-    let spec = spec(SweepTask::Grid, "oracle.toml", toml, "0.6:0.9:0.1", 10_000);
+    let spec = spec(TaskKind::Grid, "oracle.toml", toml, "0.6:0.9:0.1", 10_000);
     let out = scratch("recheck");
     let _ = std::fs::remove_dir_all(&out);
     let opts = SweepOptions {
@@ -126,7 +127,7 @@ fn recheck_40000_rows(bencher: Bencher) {
         repair: false,
     };
     let wind_down = WindDown::new();
-    let sweep = spec.checked(&InputNames::CLI).unwrap();
+    let sweep = spec.checked(&Names::CLI).unwrap();
     run_sweep(&sweep, &opts, &wind_down, &()).unwrap();
     bencher.bench_local(|| {
         let outcome = run_sweep(&sweep, &opts, &wind_down, &()).unwrap();

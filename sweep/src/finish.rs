@@ -10,24 +10,29 @@ use errp_sim::{ScenarioInput, ScenarioSource};
 use crate::figure::sweep_plot;
 use crate::manifest::{EPISODES, Manifest};
 use crate::plot::{self};
-use crate::spec::InputNames;
 use crate::summary::{SweepReport, summarise_dir};
 use crate::table::summary_csv;
+use errp_sim::Names;
 
 /// Writes `summary.csv`, `sweep.svg`, `sweep.png` and the final `sweep.json`
 /// of a complete sweep in `dir`, each atomically.
 pub fn finish_dir(dir: &Path, manifest: &Manifest) -> Result<SweepReport> {
     let spec = &manifest.spec;
     let mut report = summarise_dir(dir, spec)?;
-    // The scenario as the file gives it (the e-puck's paper point is drawn
-    // at its accuracy), else the first level's.
-    let scenario = match ScenarioInput::load_as_written(ScenarioSource::Text {
-        text: spec.scenario_toml.clone(),
-        name: spec.scenario_path.clone(),
-    }) {
-        Ok(s) => s,
+    // The scenario as the file gives it with what the sweep sets for every
+    // level (the e-puck's paper point is drawn at its accuracy; the grid's
+    // EEG mode is the levels'), else the first level's.
+    let as_run = ScenarioInput {
+        keys: spec.fixed.clone(),
+        ..ScenarioInput::new(ScenarioSource::Text {
+            text: spec.scenario_toml.clone(),
+            name: spec.scenario_path.clone(),
+        })
+    };
+    let scenario = match as_run.load(&Names::FILE) {
+        Ok(s) => s.scenario,
         Err(_) => spec
-            .levels(&InputNames::CLI)?
+            .levels(&Names::CLI)?
             .into_iter()
             .next()
             .map(|l| l.scenario)

@@ -13,12 +13,13 @@
 //! sharding and merging, the summaries and the plots.
 //!
 //! ```
-//! use errp_sweep::{InputNames, parse_accuracies};
+//! use errp_sim::Names;
+//! use errp_sweep::parse_accuracies;
 //!
 //! // A sweep's accuracy levels, as `--accuracy` and `accuracy=` give them.
-//! let levels = parse_accuracies("0.6:0.9:0.1", &InputNames::CLI).unwrap();
+//! let levels = parse_accuracies("0.6:0.9:0.1", &Names::CLI).unwrap();
 //! assert_eq!(levels.len(), 4);
-//! assert!(parse_accuracies("0.4", &InputNames::CLI).is_err());
+//! assert!(parse_accuracies("0.4", &Names::CLI).is_err());
 //! ```
 
 #![warn(clippy::unwrap_used, clippy::print_stdout, clippy::iter_over_hash_type)]
@@ -57,9 +58,8 @@ pub use plot::{
 pub use rows::{CHECKSUM, episodes_header};
 pub use run::{MAX_DECODER_BYTES, SweepOptions, SweepOutcome, prepare_sweep, run_sweep};
 pub use spec::{
-    Axis, BUILT_IN_EPUCK, BUILT_IN_GRID, CheckedSweep, InputNames, Level, MAX_EPISODES, MAX_LEVELS,
-    Shard, SweepSpec, SweepTask, aliases, parse_accuracies, parse_axis, parse_values, read_task,
-    sweep_fixed, sweep_scenario, sweepable,
+    Axis, CheckedSweep, Level, MAX_EPISODES, MAX_LEVELS, Shard, SweepSpec, aliases,
+    parse_accuracies, parse_axis, parse_values, read_task, sweep_fixed, sweep_scenario, sweepable,
 };
 pub use summary::{LevelSummary, SweepReport, summarise_dir};
 pub use table::summary_csv;

@@ -16,9 +16,10 @@ use crate::lock::DirLock;
 use crate::manifest::{EPISODES, MANIFEST, Manifest};
 use crate::rows::{RowCheck, episodes_header};
 use crate::run::{foreign_files, measured_levels};
-use crate::spec::{InputNames, Level, SweepSpec, SweepTask};
+use crate::spec::{Level, SweepSpec};
 use crate::summary::SweepReport;
 use crate::writer::read_row;
+use errp_sim::{Names, TaskKind};
 
 /// The manifests of the shard directories `dirs`, each a shard of one
 /// and the same sweep with the same decoders.
@@ -133,14 +134,14 @@ pub fn merge_sweeps(dirs: &[PathBuf], out: &Path) -> Result<SweepReport> {
             )));
         }
     }
-    let levels = measured_levels(&spec, &spec.levels(&InputNames::CLI)?, &first.decoders)?;
+    let levels = measured_levels(&spec, &spec.levels(&Names::CLI)?, &first.decoders)?;
     let created = create_dirs(out)?;
     // Go if the merge is interrupted before it is written.
     created.remove_if_interrupted();
     let result = DirLock::acquire(out, "--out").and_then(|lock| {
         let report = match spec.task {
-            SweepTask::Grid => merge_rows::<GridTask>(&spec, &levels, &inputs, out),
-            SweepTask::Epuck => merge_rows::<EpuckTask>(&spec, &levels, &inputs, out),
+            TaskKind::Grid => merge_rows::<GridTask>(&spec, &levels, &inputs, out),
+            TaskKind::Epuck => merge_rows::<EpuckTask>(&spec, &levels, &inputs, out),
         }
         .and_then(|()| {
             let manifest = Manifest {

@@ -59,20 +59,21 @@ mod tests {
     use errp_sim::epuck::EpuckTask;
 
     use super::*;
-    use crate::spec::{InputNames, Level, SweepSpec, SweepTask, parse_accuracies, parse_axis};
+    use crate::spec::{Level, SweepSpec, parse_accuracies, parse_axis};
+    use errp_sim::{Names, TaskKind};
 
     fn epuck_levels(param: &str) -> Vec<Level> {
         SweepSpec {
-            task: SweepTask::Epuck,
+            task: TaskKind::Epuck,
             scenario_path: "mexico_to_pisa.toml".into(),
             scenario_toml: include_str!("../../scenarios/mexico_to_pisa.toml").into(),
-            accuracies: parse_accuracies("0.9", &InputNames::CLI).unwrap(),
-            axes: vec![parse_axis(SweepTask::Epuck, param, &InputNames::CLI).unwrap()],
+            accuracies: parse_accuracies("0.9", &Names::CLI).unwrap(),
+            axes: vec![parse_axis(TaskKind::Epuck, param, &Names::CLI).unwrap()],
             fixed: vec![],
             episodes: 1,
             seed: 1,
         }
-        .levels(&InputNames::CLI)
+        .levels(&Names::CLI)
         .unwrap()
     }
 

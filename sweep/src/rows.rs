@@ -10,7 +10,8 @@
 use errp_sim::task::{FieldError, Task};
 use errp_sim::{Result, SimError};
 
-use crate::spec::{Level, SweepSpec, format_number, value_text};
+use crate::spec::{Level, SweepSpec, value_text};
+use errp_sim::task::format_number;
 
 /// The name of the last column.
 pub const CHECKSUM: &str = "crc32";
@@ -49,7 +50,7 @@ pub(crate) fn run_row<T: Task>(
     if row.fields.len() != T::INFO.columns.len() {
         return Err(SimError::Sweep(format!(
             "the {} task gave {} fields for its {} columns",
-            T::INFO.name,
+            T::INFO.kind,
             row.fields.len(),
             T::INFO.columns.len()
         )));
@@ -108,7 +109,7 @@ impl<'a, T: Task> RowCheck<'a, T> {
                     SimError::Sweep(format!(
                         "{} is not a {} scenario",
                         spec.scenario_path.display(),
-                        T::INFO.name
+                        T::INFO.kind
                     ))
                 })
             })

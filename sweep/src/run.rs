@@ -20,9 +20,10 @@ use crate::manifest::{EPISODES, MANIFEST, Manifest};
 use crate::observer::SweepObserver;
 use crate::prepare::prepare_all;
 use crate::rows::{RowCheck, episodes_header};
-use crate::spec::{CheckedSweep, Level, Shard, SweepSpec, SweepTask};
+use crate::spec::{CheckedSweep, Level, Shard, SweepSpec};
 use crate::summary::SweepReport;
 use crate::writer::{EpisodeJob, Resumed, Slice, resume_rows};
+use errp_sim::TaskKind;
 
 /// The most memory a sweep's decoders may hold, bytes: what fits, with
 /// the rest of the process, in the 4 GB that the Slurm job script
@@ -129,10 +130,10 @@ pub fn run_sweep(
     created.remove_if_interrupted();
 
     let outcome = match spec.task {
-        SweepTask::Grid => {
+        TaskKind::Grid => {
             run_levels::<GridTask>(spec, opts, levels, fresh, &made_with, wind_down, observer)
         }
-        SweepTask::Epuck => {
+        TaskKind::Epuck => {
             run_levels::<EpuckTask>(spec, opts, levels, fresh, &made_with, wind_down, observer)
         }
     };
@@ -198,7 +199,7 @@ impl<'a, T: Task> Plan<'a, T> {
                 level.scenario.get::<T::Scenario>().ok_or_else(|| {
                     SimError::Sweep(format!(
                         "the sweep is of the {} task, but {} is not a scenario of it",
-                        T::INFO.name,
+                        T::INFO.kind,
                         spec.scenario_path.display()
                     ))
                 })
@@ -317,8 +318,8 @@ pub fn prepare_sweep(
             .collect())
     }
     match spec.task {
-        SweepTask::Grid => infos::<GridTask>(spec, levels, cache, observer),
-        SweepTask::Epuck => infos::<EpuckTask>(spec, levels, cache, observer),
+        TaskKind::Grid => infos::<GridTask>(spec, levels, cache, observer),
+        TaskKind::Epuck => infos::<EpuckTask>(spec, levels, cache, observer),
     }
 }
 
@@ -331,8 +332,8 @@ pub(crate) fn measured_levels(
     infos: &[DecoderInfo],
 ) -> Result<Vec<Level>> {
     match spec.task {
-        SweepTask::Grid => Plan::<GridTask>::new(spec, levels)?.measured(spec, infos),
-        SweepTask::Epuck => Plan::<EpuckTask>::new(spec, levels)?.measured(spec, infos),
+        TaskKind::Grid => Plan::<GridTask>::new(spec, levels)?.measured(spec, infos),
+        TaskKind::Epuck => Plan::<EpuckTask>::new(spec, levels)?.measured(spec, infos),
     }
 }
 
@@ -351,7 +352,7 @@ fn check_made_with(out: &Path, made_with: &[DecoderInfo], infos: &[DecoderInfo])
         })
     {
         let show = |d: Option<&DecoderInfo>| {
-            d.map_or("none".to_string(), |d| match &d.recording {
+            d.map_or("none".to_string(), |d| match &d.own_eeg {
                 Some(r) => format!(
                     "recording {} ({} bytes, SHA-256 {})",
                     r.name, r.bytes, r.sha256

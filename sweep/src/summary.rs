@@ -8,11 +8,12 @@ use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 
 use errp_sim::{Result, SimError};
-use errp_sim::{StreamingPearson, pearson};
+use errp_sim::{RunningPearson, pearson};
 use errp_sim::{mean_sd, median};
 
 use crate::manifest::EPISODES;
-use crate::spec::{SweepSpec, SweepTask};
+use crate::spec::SweepSpec;
+use errp_sim::TaskKind;
 
 /// The statistics of one level.
 #[derive(Debug, Clone, PartialEq)]
@@ -54,7 +55,7 @@ impl LevelSummary {
 #[derive(Debug, Clone, PartialEq)]
 pub struct SweepReport {
     /// Task.
-    pub task: SweepTask,
+    pub task: TaskKind,
     /// One row per level.
     pub levels: Vec<LevelSummary>,
     /// Per series (axis values), Pearson r and p between online accuracy and
@@ -75,7 +76,7 @@ struct Columns {
     detector: Option<(usize, usize)>,
 }
 
-fn columns(header: &str, task: SweepTask, path: &Path) -> Result<Columns> {
+fn columns(header: &str, task: TaskKind, path: &Path) -> Result<Columns> {
     let names: Vec<&str> = header.split(',').collect();
     let find = |name: &str| {
         names
@@ -111,7 +112,7 @@ pub fn summarise_dir(dir: &Path, spec: &SweepSpec) -> Result<SweepReport> {
         .ok_or_else(|| SimError::Sweep(format!("{}: empty", path.display())))?;
     let cols = columns(&header, spec.task, &path)?;
     let mut levels = Vec::with_capacity(spec.n_levels());
-    let mut series: Vec<(String, StreamingPearson)> = Vec::new();
+    let mut series: Vec<(String, RunningPearson)> = Vec::new();
     let mut current: Option<Acc> = None;
     let mut rows = 0usize;
     for line in lines {
@@ -216,11 +217,7 @@ impl Acc {
         }
     }
 
-    fn finish(
-        self,
-        spec: &SweepSpec,
-        series: &mut Vec<(String, StreamingPearson)>,
-    ) -> LevelSummary {
+    fn finish(self, spec: &SweepSpec, series: &mut Vec<(String, RunningPearson)>) -> LevelSummary {
         let (mut accuracy, values) = spec.level_values(self.level);
         if spec.accuracies.is_empty() {
             accuracy = self.measured;
@@ -238,7 +235,7 @@ impl Acc {
         let pos = match series.iter().position(|(l, _)| *l == label) {
             Some(i) => i,
             None => {
-                series.push((label.clone(), StreamingPearson::default()));
+                series.push((label.clone(), RunningPearson::default()));
                 series.len() - 1
             }
         };

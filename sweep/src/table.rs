@@ -4,8 +4,9 @@ use std::fmt;
 
 use errp_sim::wilson_interval;
 
-use crate::spec::{SweepSpec, format_number, value_text};
+use crate::spec::{SweepSpec, value_text};
 use crate::summary::SweepReport;
+use errp_sim::task::format_number;
 
 /// A statistic in the summary: 6 decimals, empty when undefined.
 fn stat(x: f64) -> String {

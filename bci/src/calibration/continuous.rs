@@ -16,7 +16,7 @@ use crate::continuous::ContinuousFeatures;
 use crate::erp::AssessmentKind;
 use crate::error::{BciError, Result, check};
 use crate::generator::Assessment;
-use crate::rng::{derive_seed, stream};
+use crate::rng::{derive_seed, labelled};
 use crate::svm::{SvmDecoder, SvmModel};
 
 /// How the calibration of the continuous decoder runs (sec. 5.1 of the
@@ -139,8 +139,8 @@ pub fn continuous_schedule(
     params: &ContinuousCalibrationParams,
     seed: u64,
 ) -> (Vec<Assessment>, Vec<f64>) {
-    let mut intervals = stream(seed, "continuous/schedule");
-    let mut presses = stream(seed, "continuous/trigger");
+    let mut intervals = labelled(seed, "continuous/schedule");
+    let mut presses = labelled(seed, "continuous/trigger");
     let mut t = 2.0;
     let mut assessments = Vec::with_capacity(2 * params.per_class);
     let mut windows = Vec::with_capacity(2 * params.per_class);

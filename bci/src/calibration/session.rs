@@ -11,11 +11,11 @@ use crate::erp::AssessmentKind;
 use crate::error::{Result, check};
 use crate::features::{EpochWindow, FeatureExtractor};
 use crate::generator::{
-    Assessment, Components, EegBlock, EegGenerator, EegStream, GeneratorParams, HybridSource,
+    Assessment, Components, EegBlock, EegFeed, EegGenerator, GeneratorParams, HybridSource,
 };
 use crate::montage::Montage;
 use crate::preprocess::Preprocessor;
-use crate::rng::{derive_seed, stream};
+use crate::rng::{derive_seed, labelled};
 
 /// A simulated calibration session, preprocessed and cut into features.
 #[derive(Debug, Clone)]
@@ -73,7 +73,7 @@ pub fn eog_session(
 /// The action schedule of a session: onsets at U[min, max] s intervals, each
 /// erroneous with probability `error_rate`.
 pub fn schedule(calib: &CalibrationParams, seed: u64) -> Vec<Assessment> {
-    let mut rng = stream(seed, "calibration/schedule");
+    let mut rng = labelled(seed, "calibration/schedule");
     let mut t = 2.0;
     (0..calib.n_actions)
         .map(|_| {
@@ -233,8 +233,8 @@ pub fn simulate_session_with(
         .fold(0.0, f64::max);
     let total = ((last_onset * fs).ceil() as usize + features.span().max(ga_len) + 1).max(1);
 
-    let mut generator: EegStream = match options.hybrid {
-        Some(h) => h.calibration_stream(params, seed)?.into(),
+    let mut generator: EegFeed = match options.hybrid {
+        Some(h) => h.calibration_feed(params, seed)?.into(),
         None => EegGenerator::new(params, montage, seed)?
             .with_components(options.components)
             .into(),

@@ -389,7 +389,7 @@ impl EdfFile {
     }
 
     /// The ordinary signal labelled `label`, matched as a recording's
-    /// channels are ([`Recording`](crate::Recording)): as written, else
+    /// channels are ([`OwnEeg`](crate::OwnEeg)): as written, else
     /// ignoring case and an `EEG ` or `EOG ` prefix.
     pub fn signal(&self, label: &str) -> Option<&EdfSignal> {
         let labels: Vec<&str> = self.signals.iter().map(|s| s.label.as_str()).collect();

@@ -12,7 +12,7 @@ use super::realism::Realism;
 use crate::erp::AssessmentKind;
 use crate::error::Result;
 use crate::montage::{Montage, angle_between};
-use crate::rng::stream;
+use crate::rng::labelled;
 
 /// The SD of one step of an Ornstein-Uhlenbeck process of stationary SD
 /// `sd` and time constant `tau` sampled every `dt`, and its pole.
@@ -101,8 +101,8 @@ pub(crate) struct Perceived {
 impl RealismState {
     pub(crate) fn new(p: &Realism, montage: &Montage, fs: f64, seed: u64) -> Result<Self> {
         let n_ch = montage.len();
-        let mut rng_drift = stream(seed, "eeg/realism/drift");
-        let mut rng_offsets = stream(seed, "eeg/realism/offsets");
+        let mut rng_drift = labelled(seed, "eeg/realism/drift");
+        let mut rng_offsets = labelled(seed, "eeg/realism/offsets");
         let dt = 1.0 / fs;
         let (drift_pole, _) = ou_step(1.0, p.drift_secs, OFFSET_KNOT as f64 * dt);
         let (offset_pole, offset_step) = ou_step(
@@ -160,10 +160,10 @@ impl RealismState {
             bad,
             rng_drift,
             rng_offsets,
-            rng_user: stream(seed, "eeg/realism/user"),
-            rng_artifacts: stream(seed, "eeg/realism/artifacts"),
-            rng_emg: stream(seed, "eeg/realism/emg"),
-            rng_bad: stream(seed, "eeg/realism/bad-channel"),
+            rng_user: labelled(seed, "eeg/realism/user"),
+            rng_artifacts: labelled(seed, "eeg/realism/artifacts"),
+            rng_emg: labelled(seed, "eeg/realism/emg"),
+            rng_bad: labelled(seed, "eeg/realism/bad-channel"),
             n_eeg: montage.n_eeg(),
         };
         state.next_burst = state.draw_interval(0, state.p.emg_rate_hz);

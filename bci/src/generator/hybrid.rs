@@ -14,7 +14,7 @@ use crate::erp::AssessmentKind;
 use crate::error::{BciError, Result};
 use crate::generator::{Assessment, EegBlock, GeneratorParams};
 use crate::montage::Montage;
-use crate::rng::stream;
+use crate::rng::labelled;
 
 /// Seconds of the subject's response kept from each event: the ErrP's
 /// components end within 600 ms; 1 s holds them and their return to zero.
@@ -129,7 +129,7 @@ impl HybridEeg {
             params: params.clone(),
             sample: 0,
             active: Vec::new(),
-            rng: stream(seed, "hybrid/erp"),
+            rng: labelled(seed, "hybrid/erp"),
         })
     }
 
@@ -243,7 +243,7 @@ impl HybridSource {
     /// each of its own error events, so that the stream's errors are the
     /// scheduled ones only. Refused when either part is shorter than
     /// [`MIN_HYBRID_PART_SECS`].
-    pub fn from_recording(
+    pub fn from_own_eeg(
         montage: &Montage,
         raw: &EegBlock,
         fs: f64,
@@ -287,22 +287,22 @@ impl HybridSource {
 
     /// A calibration stream: over the calibration part, from a point drawn
     /// from `seed`, with the single-trial variability of `params`.
-    pub fn calibration_stream(&self, params: &GeneratorParams, seed: u64) -> Result<HybridEeg> {
-        self.stream_over(&self.calibration, params, seed)
+    pub fn calibration_feed(&self, params: &GeneratorParams, seed: u64) -> Result<HybridEeg> {
+        self.feed_over(&self.calibration, params, seed)
     }
 
     /// An online stream: over the held-out part, likewise.
-    pub fn online_stream(&self, params: &GeneratorParams, seed: u64) -> Result<HybridEeg> {
-        self.stream_over(&self.held_out, params, seed)
+    pub fn online_feed(&self, params: &GeneratorParams, seed: u64) -> Result<HybridEeg> {
+        self.feed_over(&self.held_out, params, seed)
     }
 
-    fn stream_over(
+    fn feed_over(
         &self,
         background: &Arc<EegBlock>,
         params: &GeneratorParams,
         seed: u64,
     ) -> Result<HybridEeg> {
-        let start = stream(seed, "hybrid/start").random_range(0..background.n_samples.max(1));
+        let start = labelled(seed, "hybrid/start").random_range(0..background.n_samples.max(1));
         HybridEeg::new(
             Arc::clone(background),
             Arc::clone(&self.template),
@@ -365,26 +365,26 @@ mod tests {
 /// A stream of EEG the online decoder reads: the synthetic user's, or a
 /// hybrid on a person's recording.
 #[derive(Debug, Clone)]
-pub enum EegStream {
+pub enum EegFeed {
     /// The synthetic generator.
     Synthetic(Box<crate::generator::EegGenerator>),
     /// A recording's background with the subject's response.
     Hybrid(Box<HybridEeg>),
 }
 
-impl From<crate::generator::EegGenerator> for EegStream {
+impl From<crate::generator::EegGenerator> for EegFeed {
     fn from(g: crate::generator::EegGenerator) -> Self {
         Self::Synthetic(Box::new(g))
     }
 }
 
-impl From<HybridEeg> for EegStream {
+impl From<HybridEeg> for EegFeed {
     fn from(h: HybridEeg) -> Self {
         Self::Hybrid(Box::new(h))
     }
 }
 
-impl EegStream {
+impl EegFeed {
     /// The sampling rate, Hz.
     pub fn sfreq_hz(&self) -> f64 {
         match self {

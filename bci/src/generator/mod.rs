@@ -9,15 +9,20 @@ use crate::error::{BciError, Result, check};
 mod effects;
 mod hybrid;
 mod realism;
-mod stream;
+mod synthesis;
 
 pub use hybrid::{
-    BASELINE_SECS, EegStream, ErrpTemplate, HybridEeg, HybridSource, MIN_HYBRID_PART_SECS,
+    BASELINE_SECS, EegFeed, ErrpTemplate, HybridEeg, HybridSource, MIN_HYBRID_PART_SECS,
     TEMPLATE_SECS,
 };
 
 pub use realism::Realism;
-pub use stream::*;
+pub use synthesis::*;
+
+/// The sampling rate of the synthetic EEG (Hz): the paper records at 256
+/// Hz (sec. 2.1). Every rate the testbed writes (the generator's default,
+/// the EDF export, the stream) is this one.
+pub const SFREQ_HZ: f64 = 256.0;
 
 /// Parameters of the synthetic EEG. Amplitudes are in uV; every default is
 /// documented next to its field.
@@ -71,7 +76,7 @@ pub struct GeneratorParams {
 impl Default for GeneratorParams {
     fn default() -> Self {
         Self {
-            sfreq_hz: 256.0,
+            sfreq_hz: SFREQ_HZ,
             background_uv: 10.0,
             spatial_length: 1.0,
             alpha_uv: 6.0,

@@ -16,7 +16,7 @@ use rand_distr::StandardNormal;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{BciError, Result, check};
-use crate::rng::{derive_seed, stream};
+use crate::rng::{derive_seed, labelled};
 
 /// How far from the ideal user the simulated one is. Every field is 0 (or
 /// neutral) by default, which is the idealised user: stationary EEG, the
@@ -262,7 +262,7 @@ impl Realism {
             online.clock_offset_secs =
                 (self.clock_offset_secs + calibration_secs).min(MAX_CLOCK_SECS);
         } else {
-            let mut rng = stream(
+            let mut rng = labelled(
                 derive_seed(seed, "realism/day", u64::from(self.day)),
                 "realism/day",
             );

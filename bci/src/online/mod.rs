@@ -17,17 +17,17 @@ use crate::classify::ErrorModel;
 use crate::continuous::ContinuousFeatures;
 use crate::erp::AssessmentKind;
 use crate::error::Result;
-use crate::generator::{Assessment, EegBlock, EegStream};
+use crate::generator::{Assessment, EegBlock, EegFeed};
 use crate::montage::Montage;
 use crate::preprocess::Preprocessor;
 use crate::svm::SvmModel;
 
 mod detector;
-mod recording;
+mod held_out;
 mod targeting;
 
 pub use detector::*;
-pub use recording::*;
+pub use held_out::*;
 pub use targeting::*;
 
 /// The decoder's window step: 62.5 ms (sec. 2.2.2).
@@ -40,7 +40,7 @@ pub const WARM_UP_SECS: f64 = 2.0;
 /// channels, one hop of 62.5 ms at a time.
 #[derive(Debug)]
 pub struct SlidingWindow {
-    generator: EegStream,
+    generator: EegFeed,
     preprocessor: Preprocessor,
     features: ContinuousFeatures,
     window: EegBlock,
@@ -57,7 +57,7 @@ impl SlidingWindow {
     /// reset copy of `preprocessor`, and lets the filters settle for
     /// [`WARM_UP_SECS`]: recording time 0 is generator time `WARM_UP_SECS`.
     pub fn start(
-        generator: impl Into<EegStream>,
+        generator: impl Into<EegFeed>,
         preprocessor: &Preprocessor,
         features: &ContinuousFeatures,
         montage: &Montage,
@@ -159,7 +159,7 @@ mod tests {
     use rand::Rng;
 
     use super::*;
-    use crate::rng::stream;
+    use crate::rng::labelled;
     use errp_valid::{Check, Valid};
 
     #[test]
@@ -211,9 +211,9 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("t_e"), "{e}");
-        let e = OnlineRecordingParams {
+        let e = HeldOutParams {
             duration_secs: 1e9,
-            ..OnlineRecordingParams::default()
+            ..HeldOutParams::default()
         }
         .check()
         .unwrap_err()
@@ -231,7 +231,7 @@ mod tests {
         p[at(10.75)] = 1.0;
         p[at(20.0)] = 1.0;
         p[at(31.5)] = 1.0;
-        let rec = OnlineRecording {
+        let rec = HeldOutSession {
             p_error: p,
             errps: vec![10.0, 30.0],
         };
@@ -257,10 +257,10 @@ mod tests {
     fn the_threshold_search_meets_a_false_alarm_rate() {
         // Background p(error) uniform in [0, 1) per window (seeded): the
         // literal detector's false alarms fall as T_e rises.
-        let mut rng = stream(3, "test");
+        let mut rng = labelled(3, "test");
         let n = (600.0 / WINDOW_STEP_SECS) as usize;
         let p: Vec<f64> = (0..n).map(|_| rng.random::<f64>()).collect();
-        let rec = OnlineRecording {
+        let rec = HeldOutSession {
             p_error: p,
             errps: vec![100.0],
         };
@@ -282,8 +282,8 @@ mod tests {
     /// `early` from 0.25 to 0.5 s after each (windows that hold only the
     /// start of the ErrP) and always from 0.5625 to 1.0 s; background
     /// windows fire now and then.
-    fn synthetic_recording(early: f64) -> OnlineRecording {
-        let mut rng = stream(7, "test");
+    fn synthetic_recording(early: f64) -> HeldOutSession {
+        let mut rng = labelled(7, "test");
         let n = (300.0 / WINDOW_STEP_SECS) as usize;
         let errps: Vec<f64> = (0..50).map(|k| 3.0 + 5.0 * k as f64).collect();
         let mut p: Vec<f64> = (0..n)
@@ -291,7 +291,7 @@ mod tests {
             .collect();
         for &o in &errps {
             for (k, v) in p.iter_mut().enumerate() {
-                let lag = OnlineRecording::window_end_secs(k) - o;
+                let lag = HeldOutSession::window_end_secs(k) - o;
                 if (0.5625 - 1e-9..=1.0 + 1e-9).contains(&lag)
                     || ((0.25 - 1e-9..=0.5 + 1e-9).contains(&lag) && rng.random_bool(early))
                 {
@@ -299,7 +299,7 @@ mod tests {
                 }
             }
         }
-        OnlineRecording { p_error: p, errps }
+        HeldOutSession { p_error: p, errps }
     }
 
     #[test]

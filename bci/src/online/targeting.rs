@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use errp_valid::{Check, Valid};
 
 use super::detector::{Detector, DetectorParams};
-use super::recording::{OnlineRecording, OperatingPoint, detector_span, operating_point};
+use super::held_out::{HeldOutSession, OperatingPoint, detector_span, operating_point};
 use crate::calibration::TargetingParams;
 use crate::error::{BciError, Result, check};
 
@@ -84,7 +84,7 @@ pub struct OnlineTargeting {
 /// `recording` (bisection: false alarms fall as T_e rises), with the
 /// operating point there, scored over the span measured at that T_e.
 pub fn threshold_for_false_alarms(
-    recording: &OnlineRecording,
+    recording: &HeldOutSession,
     detector: Valid<DetectorParams>,
     false_alarms_per_min: f64,
 ) -> Result<(f64, OperatingPoint)> {
@@ -132,7 +132,7 @@ pub fn target_online<E: From<crate::error::BciError>>(
     detector: Valid<DetectorParams>,
     t_e: f64,
     search: &TargetingParams,
-    mut evaluate: impl FnMut(f64) -> std::result::Result<OnlineRecording, E>,
+    mut evaluate: impl FnMut(f64) -> std::result::Result<HeldOutSession, E>,
     mut progress: impl FnMut(&OnlineStep),
 ) -> std::result::Result<OnlineTargeting, E> {
     let mut steps: Vec<OnlineStep> = Vec::new();

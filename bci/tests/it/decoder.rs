@@ -6,7 +6,7 @@
 use errp_bci::{
     CalibrationParams, CalibrationSetup, Classifier, Components, ErrorModel, Features,
     GeneratorParams, LdaDecoder, MeanAccuracy, SessionOptions, SessionParts, Shrinkage, SvmDecoder,
-    TargetingParams, Valid, calibrate, calibrate_session, cross_validate, rng::stream,
+    TargetingParams, Valid, calibrate, calibrate_session, cross_validate, rng::labelled,
     simulate_session, target_accuracy,
 };
 use rand::seq::SliceRandom;
@@ -267,7 +267,7 @@ fn decoder_trained_on_shuffled_labels_scores_chance() {
     let decoder = LdaDecoder::default();
     let real = cross_validate(&decoder, &s.features, &s.labels, 10, 1).unwrap();
     let mut shuffled = s.labels.clone();
-    shuffled.shuffle(&mut stream(5, "test/shuffle"));
+    shuffled.shuffle(&mut labelled(5, "test/shuffle"));
     let chance = cross_validate(&decoder, &s.features, &shuffled, 10, 1).unwrap();
     assert!(real.mean() > 0.7, "real labels: {}", real.mean());
     assert!(

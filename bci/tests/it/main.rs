@@ -5,5 +5,5 @@ mod continuous;
 mod decoder;
 mod determinism;
 mod eeg;
+mod own_eeg;
 mod realism;
-mod recorded;

@@ -42,7 +42,7 @@ import numpy as np
 if TYPE_CHECKING:  # pragma: no cover - for the annotations only
     import pandas
 
-from . import _args, _core, _gym_plugin, _progress, _recording
+from . import _args, _core, _gym_plugin, _own_eeg, _progress
 from ._core import HAS_RERUN, __version__
 
 __all__ = [
@@ -557,10 +557,11 @@ def sweep(
     episodes: int = 100,
     seed: int = 1,
     params: Optional[Mapping[str, Sequence[Scalar]]] = None,
-    stream: Optional[bool] = None,
+    per_action: Optional[bool] = None,
     cache: Optional[PathLike] = None,
     threads: Optional[int] = None,
     progress: Optional[bool] = None,
+    stream: Optional[bool] = None,
 ) -> SweepResult:
     """Runs a Monte Carlo sweep as ``errp sweep`` does.
 
@@ -588,9 +589,10 @@ def sweep(
     params : dict, optional
         Swept parameters: ``{"strategy": ["greedy", "info_gain"]}``, by the
         short names of ``errp sweep --param`` or dotted scenario keys.
-    stream : bool, optional
-        Grid: stream the EEG of every action instead of drawing epochs from
-        a bank (the sweep's default).
+    per_action : bool, optional
+        Grid: synthesise the EEG of every action when it happens instead of
+        drawing epochs from a bank synthesised in advance (the sweep's
+        default; about 200 times faster).
     cache : path, optional
         A directory for the accuracy targeting, shared across sweeps. Each
         cached entry is checked before use; one that does not verify, or a
@@ -600,7 +602,17 @@ def sweep(
     progress : bool, optional
         Show progress on stderr (the decoders calibrated, then the
         episodes: tqdm bars if tqdm is installed, else a line per tenth): by default when stderr is a terminal.
+    stream : bool, optional
+        Deprecated: the former name of ``per_action``.
     """
+    if stream is not None:
+        if per_action is not None:
+            raise TypeError("per_action and stream: give per_action only (stream is its former name)")
+        warnings.warn(
+            "errp.sweep(stream=...) is deprecated: use per_action=...",
+            DeprecationWarning,
+            stacklevel=2,
+        )
     episodes = _args.whole("episodes", episodes, 1, _core.MAX_EPISODES)
     seed = _args.seed("seed", seed)
     threads = _args.whole("threads", threads, 1, _core.MAX_THREADS, optional=True)
@@ -647,6 +659,7 @@ def sweep(
                     episodes=episodes,
                     seed=seed,
                     params=axes,
+                    per_action=per_action,
                     stream=stream,
                     cache=_path(cache, "cache"),
                     threads=threads,
@@ -790,12 +803,6 @@ class GridTask(_Task):
     ) -> None:
         if eeg is None and eeg_options is not None:
             raise ValueError("eeg_options: set with eeg=..., a recording to split and draw from")
-        if eeg is not None and accuracy is not None:
-            raise ValueError(
-                "accuracy: with eeg=..., the decoder is calibrated on the recording's first "
-                "part and has the accuracy the recording gives (GridTask.calibration); no "
-                "accuracy is targeted: leave out accuracy"
-            )
         keywords = dict(
             decoder=decoder,
             batch_decoder=batch_decoder,
@@ -804,7 +811,7 @@ class GridTask(_Task):
             overrides=None if overrides is None else dict(overrides),
         )
         if eeg is not None:
-            keywords["eeg"] = _recording.recorded(eeg, eeg_options)
+            keywords["eeg"] = _own_eeg.read(eeg, eeg_options)
         with _progress.shown(progress, "errp.GridTask") as report:
             self._core = _core.GridTask(_path(scenario, "scenario"), progress=report, **keywords)
 
@@ -878,13 +885,6 @@ class EpuckTask(_Task):
     ) -> None:
         if eeg is None and eeg_options is not None:
             raise ValueError("eeg_options: set with eeg=..., a recording to run a hybrid of")
-        if eeg is not None and (accuracy is not None or decoder is not None):
-            raise ValueError(
-                "accuracy and decoder: with eeg=..., the runs stream a hybrid of the "
-                "recording, decoded by the SVM calibrated on its first part, which has the "
-                "accuracy the recording gives (EpuckTask.calibration); no accuracy is "
-                "targeted: leave out accuracy and decoder"
-            )
         keywords = dict(
             decoder=decoder,
             seed=_args.seed("seed", seed, optional=True),
@@ -892,7 +892,7 @@ class EpuckTask(_Task):
             overrides=None if overrides is None else dict(overrides),
         )
         if eeg is not None:
-            keywords["eeg"] = _recording.recorded(eeg, eeg_options)
+            keywords["eeg"] = _own_eeg.read(eeg, eeg_options)
         with _progress.shown(progress, "errp.EpuckTask") as report:
             self._core = _core.EpuckTask(_path(scenario, "scenario"), progress=report, **keywords)
 

@@ -93,8 +93,9 @@ def sweep(
     ``warnings`` (what the sweep found wrong and worked around).
 
     ``keywords`` holds every keyword of :func:`errp.sweep` (``accuracy``,
-    ``task``, ``scenario``, ``episodes``, ``seed``, ``params``, ``stream``,
-    ``cache``, ``threads``), as that function passes them."""
+    ``task``, ``scenario``, ``episodes``, ``seed``, ``params``,
+    ``per_action`` (or its former name ``stream``), ``cache``, ``threads``),
+    as that function passes them."""
 
 def episode_columns(task: str) -> List[str]: ...
 
@@ -206,7 +207,7 @@ class GridEnvCore:
     ) -> Tuple[Tuple[int, int], Tuple[int, int]]: ...
     def step(self, action: int, keep_epoch: bool = False) -> Dict[str, Any]: ...
     @property
-    def streams(self) -> bool: ...
+    def per_action(self) -> bool: ...
     @property
     def epoch_shape(self) -> Tuple[List[str], int, float]: ...
     @property

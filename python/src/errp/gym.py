@@ -114,7 +114,7 @@ class GridEnv(gym.Env):
         progress: Optional[bool] = None,
     ) -> None:
         _check_render_mode(render_mode, self.metadata["render_modes"])
-        fields = {"eeg": "stream"}
+        fields = {"eeg": "per_action"}
         if overrides:
             fields.update(overrides)
         accuracy = _args.accuracy("accuracy", accuracy, optional=True)
@@ -141,10 +141,10 @@ class GridEnv(gym.Env):
             "p_error": spaces.Box(0.0, 1.0, shape=(1,), dtype=np.float32),
         }
         if self.observe_epoch:
-            if not self._core.streams:
+            if not self._core.per_action:
                 raise ValueError(
-                    "observe_epoch: the scenario's decoder does not stream EEG; "
-                    "set eeg = \"stream\" and decoder = \"eeg\""
+                    "observe_epoch: the scenario's decoder does not synthesise each "
+                    "action's EEG; set eeg = \"per_action\" and decoder = \"eeg\""
                 )
             names, n_samples, _ = self._core.epoch_shape
             obs["epoch"] = spaces.Box(

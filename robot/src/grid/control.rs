@@ -8,6 +8,7 @@ use errp_valid::{Check, Valid};
 
 use crate::belief::Belief;
 use crate::error::{Result, RobotError, check};
+use crate::grid::policy::{Policies, policy_likelihood};
 use crate::grid::qvalues::{QParams, QTable};
 use crate::grid::{Cell, Grid, GridAction};
 use crate::strategy::{Strategy, gain_from_logs};
@@ -127,12 +128,6 @@ const THOMPSON_OBJECTION: f64 = 0.5;
 /// best and close; 1 (give up as soon as another goal leads) is worse.
 const THOMPSON_GIVE_UP_RATIO: f64 = 0.5;
 
-/// Eq. (4): the likelihood of policy i given the action and the decoder's
-/// output, p(c=0|x) Q^_i(s,a) + p(c=1|x) (1 - Q^_i(s,a)).
-pub fn policy_likelihood(q_hat: f64, p_error: f64) -> f64 {
-    (1.0 - p_error) * q_hat + p_error * (1.0 - q_hat)
-}
-
 /// The device's side of the grid task: a belief over the 25 candidate goals
 /// (every cell), updated after each action by eq. (4), and an
 /// epsilon-randomised choice of the next action by the [`Strategy`]: towards
@@ -144,12 +139,8 @@ pub fn policy_likelihood(q_hat: f64, p_error: f64) -> f64 {
 pub struct GridController {
     params: Valid<GridControlParams>,
     table: QTable,
-    /// Eq. (3) at `params.tau`: `softmax[goal_index * n_cells + cell_index]`.
-    softmax: Vec<[f64; 5]>,
-    /// For info gain (empty otherwise), indexed like `softmax`: ln of
-    /// eq. (4) for each action when the decoder says error (p(error) =
-    /// alpha) and says correct (1 - alpha).
-    ln_likelihood: Vec<[[f64; 2]; 5]>,
+    /// Every goal's policy (eq. 3) and its likelihood (eq. 4).
+    policies: Policies,
     belief: Belief,
     /// For Thompson: the goal drawn and not yet given up (see
     /// [`choose`](Self::choose) and [`observe`](Self::observe)).
@@ -168,42 +159,19 @@ impl GridController {
     /// grid and the reward model). Computes the soft-max (eq. 3) of every
     /// goal and cell once.
     pub fn with_table(table: QTable, params: Valid<GridControlParams>) -> Self {
-        let grid = *table.grid();
-        let n = grid.n_cells();
-        let mut softmax = Vec::with_capacity(n * n);
-        for goal in grid.cells() {
-            for cell in grid.cells() {
-                softmax.push(table.softmax(goal, cell, params.tau));
-            }
-        }
-        let alpha = params.assumed_accuracy;
-        let ln_likelihood = match params.strategy {
-            Strategy::Greedy | Strategy::Thompson => Vec::new(),
-            Strategy::InfoGain => softmax
-                .iter()
-                .map(|q| {
-                    q.map(|q| {
-                        [
-                            policy_likelihood(q, alpha).ln(),
-                            policy_likelihood(q, 1.0 - alpha).ln(),
-                        ]
-                    })
-                })
-                .collect(),
+        let n = table.grid().n_cells();
+        let assumed = match params.strategy {
+            Strategy::Greedy | Strategy::Thompson => None,
+            Strategy::InfoGain => Some(params.assumed_accuracy),
         };
+        let policies = Policies::new(&table, params.tau, assumed);
         Self {
             params,
             table,
-            softmax,
-            ln_likelihood,
+            policies,
             belief: Belief::uniform(n),
             draw: None,
         }
-    }
-
-    /// Eq. (3): Q^_goal(cell, .), from the table made at construction.
-    fn q_hat(&self, goal_index: usize, cell_index: usize) -> &[f64; 5] {
-        &self.softmax[goal_index * self.table.grid().n_cells() + cell_index]
     }
 
     /// The parameters in force.
@@ -337,16 +305,11 @@ impl GridController {
     /// rounding).
     fn gain(&self, belief: &[f64], ln_belief: &[f64], cell: Cell, action: GridAction) -> f64 {
         let grid = self.table.grid();
-        let n = grid.n_cells();
+
         let (c, a) = (grid.index(cell), action.index());
         let alpha = self.params.assumed_accuracy;
-        let ln_l = |i: usize, says_error: bool| match self.ln_likelihood.get(i * n + c) {
-            Some(t) => t[a][usize::from(!says_error)],
-            None => {
-                let p = if says_error { alpha } else { 1.0 - alpha };
-                policy_likelihood(self.q_hat(i, c)[a], p).ln()
-            }
-        };
+        let ln_l =
+            |i: usize, says_error: bool| self.policies.ln_likelihood((i, c, a), says_error, alpha);
         gain_from_logs(
             belief,
             |i| ln_belief[i],
@@ -355,7 +318,7 @@ impl GridController {
             |i, says_error| {
                 let p = if says_error { alpha } else { 1.0 - alpha };
                 (
-                    policy_likelihood(self.q_hat(i, c)[a], p),
+                    policy_likelihood(self.policies.q_hat(i, c)[a], p),
                     ln_l(i, says_error),
                 )
             },
@@ -401,9 +364,7 @@ impl GridController {
     /// Eq. (4) for every goal, indexed like the grid's cells.
     pub fn likelihoods(&self, cell: Cell, action: GridAction, p_error: f64) -> Vec<f64> {
         let c = self.table.grid().index(cell);
-        (0..self.table.grid().n_cells())
-            .map(|goal| policy_likelihood(self.q_hat(goal, c)[action.index()], p_error))
-            .collect()
+        self.policies.likelihoods(c, action.index(), p_error)
     }
 }
 

@@ -1,6 +1,7 @@
 //! The 5x5 grid world of the discrete task (sec. 4 of the paper).
 
 pub(crate) mod control;
+pub(crate) mod policy;
 pub(crate) mod qvalues;
 
 use serde::{Deserialize, Serialize};

@@ -7,7 +7,7 @@ use errp_robot::{Cell, GoalLayout, Grid, GridControlParams, GridController, Stra
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use crate::continuous_closed_loop::{goal_pose, names, run};
+use crate::epuck_closed_loop::{goal_pose, names, run};
 
 /// 60 actions of the grid controller with `strategy` from (0, 0), driven by
 /// seeded random p(error): the actions' initials, the most probable goal

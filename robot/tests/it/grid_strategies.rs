@@ -9,7 +9,7 @@ use rand_chacha::ChaCha8Rng;
 const MAX_ACTIONS: usize = 300;
 
 /// One seeded stream per consumer, derived from the episode's seed.
-fn stream(seed: u64, label: u64) -> ChaCha8Rng {
+fn seeded(seed: u64, label: u64) -> ChaCha8Rng {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     rng.set_stream(label);
     rng
@@ -36,8 +36,8 @@ fn episode(
 ) -> Episode {
     let grid = *table.grid();
     let mut c = GridController::with_table(table.clone(), Valid::new(params).unwrap());
-    let mut explore = stream(seed, 1);
-    let mut decoder = stream(seed, 2);
+    let mut explore = seeded(seed, 1);
+    let mut decoder = seeded(seed, 2);
     let mut cell = start;
     let mut not_greedy = 0;
     for n in 1..=MAX_ACTIONS {
@@ -87,7 +87,7 @@ fn measure(strategy: Strategy, accuracy: f64, n: u64) -> Summary {
         ..GridControlParams::default()
     };
     let table = QTable::compute(grid, &Valid::new(params.q()).unwrap()).unwrap();
-    let mut pairs = stream(2013, 0);
+    let mut pairs = seeded(2013, 0);
     let (mut right, mut actions, mut not_greedy) = (0, 0, 0);
     for k in 0..n {
         let start = grid.cell(pairs.random_range(0..grid.n_cells()));

@@ -4,11 +4,11 @@
 
 use errp_bci::{
     Accuracy, ContinuousCalibrationParams, ContinuousFeatures, ContinuousSetup, Detector,
-    DetectorMode, DetectorParams, EegGenerator, EegStream, GeneratorParams, HybridSource, Montage,
-    OnlineRecording, OnlineRecordingParams, OnlineStep, OnlineTarget, OnlineTargeting,
+    DetectorMode, DetectorParams, EegFeed, EegGenerator, GeneratorParams, HeldOutParams,
+    HeldOutSession, HybridSource, Montage, OnlineStep, OnlineTarget, OnlineTargeting,
     OperatingPoint, Preprocessor, ResponseSpan, SlidingWindow, SvmDecoder, SvmModel,
     TargetingParams, TargetingResult, TargetingStep, Valid, calibrate_continuous, detector_span,
-    operating_point, record_online_from, rng::derive_seed, target_continuous_accuracy,
+    operating_point, rng::derive_seed, simulate_held_out_from, target_continuous_accuracy,
     target_online,
 };
 
@@ -88,8 +88,8 @@ pub struct OnlineReport {
 impl OnlineReport {
     /// Scores `detector` at `t_e`, and the literal reading, on a held-out
     /// `recording` of the calibrated pipeline.
-    pub fn from_recording(
-        recording: &OnlineRecording,
+    pub fn from_held_out(
+        recording: &HeldOutSession,
         detector: Valid<DetectorParams>,
         t_e: f64,
     ) -> Result<Self> {
@@ -164,7 +164,7 @@ pub fn run_online_calibration(
     t_e: f64,
     progress: impl FnMut(&OnlineStep),
 ) -> Result<(ContinuousDecoder, ContinuousReport, OnlineTargeting)> {
-    let mut evaluated: Vec<(f64, ContinuousReport, OnlineRecording)> = Vec::new();
+    let mut evaluated: Vec<(f64, ContinuousReport, HeldOutSession)> = Vec::new();
     let search = target_online(
         target,
         detector,
@@ -203,7 +203,7 @@ pub fn run_online_calibration(
         .expect("the ratio found is one of the evaluations");
     let mut decoder =
         ContinuousDecoder::from_report(&report).with_closed_loop(&request.setup, request.seed)?;
-    decoder.online = Some(OnlineReport::from_recording(
+    decoder.online = Some(OnlineReport::from_held_out(
         &recording, detector, search.t_e,
     )?);
     Ok((decoder, report, search))
@@ -251,7 +251,7 @@ pub struct ContinuousDecoder {
     pub hybrid: Option<Arc<HybridSource>>,
     /// What the hybrid was made of, and the accuracy the shared control
     /// assumes (its cross-validated accuracy).
-    pub recorded: Option<Box<crate::epuck::hybrid_report::HybridReport>>,
+    pub own_eeg: Option<Box<crate::epuck::hybrid_report::HybridReport>>,
 }
 
 impl ContinuousDecoder {
@@ -266,7 +266,7 @@ impl ContinuousDecoder {
             features: ContinuousFeatures::paper(report.generator.sfreq_hz),
             online: None,
             hybrid: None,
-            recorded: None,
+            own_eeg: None,
         }
     }
 
@@ -283,15 +283,15 @@ impl ContinuousDecoder {
     }
 
     /// The held-out continuous recording of this pipeline for a calibration
-    /// seeded `seed`: [`OnlineRecordingParams::default`] of fresh EEG.
-    pub fn record_held_out(&self, seed: u64) -> Result<OnlineRecording> {
-        Ok(record_online_from(
+    /// seeded `seed`: [`HeldOutParams::default`] of fresh EEG.
+    pub fn record_held_out(&self, seed: u64) -> Result<HeldOutSession> {
+        Ok(simulate_held_out_from(
             &self.generator,
             self.hybrid.as_deref(),
             &self.montage,
             &self.preprocessor,
             &self.model,
-            &Valid::<OnlineRecordingParams>::default(),
+            &Valid::<HeldOutParams>::default(),
             held_out_seed(seed),
         )?)
     }
@@ -305,7 +305,7 @@ impl ContinuousDecoder {
         seed: u64,
     ) -> Result<()> {
         let recording = self.record_held_out(seed)?;
-        self.online = Some(OnlineReport::from_recording(&recording, detector, t_e)?);
+        self.online = Some(OnlineReport::from_held_out(&recording, detector, t_e)?);
         Ok(())
     }
 
@@ -343,8 +343,8 @@ impl ContinuousDecoder {
     /// filters settled; episode time 0 is generator time
     /// [`WARM_UP_SECS`](errp_bci::WARM_UP_SECS).
     pub fn start_stream(&self, seed: u64) -> Result<SlidingWindow> {
-        let generator: EegStream = match &self.hybrid {
-            Some(h) => h.online_stream(&self.closed_loop, seed)?.into(),
+        let generator: EegFeed = match &self.hybrid {
+            Some(h) => h.online_feed(&self.closed_loop, seed)?.into(),
             None => EegGenerator::new(&self.closed_loop, &self.montage, seed)?.into(),
         };
         Ok(SlidingWindow::start(

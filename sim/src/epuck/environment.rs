@@ -196,10 +196,11 @@ impl EpuckEnvironment {
         observer: &mut impl EpuckObserver,
     ) -> Result<EpuckFeedback> {
         if !(1..=MAX_WINDOWS_PER_ACTION).contains(&windows) {
-            return Err(SimError::Scenario(format!(
-                "windows_per_action: {windows} is out of range, expected 1 to \
-                 {MAX_WINDOWS_PER_ACTION} windows of 62.5 ms"
-            )));
+            return Err(SimError::OutOfRange {
+                name: "windows_per_action".into(),
+                given: format!("{windows} is out of range"),
+                expected: format!("1 to {MAX_WINDOWS_PER_ACTION} windows of 62.5 ms"),
+            });
         }
         let goal = self.plant.goal();
         let mut driver = Primitive {

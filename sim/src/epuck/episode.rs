@@ -6,7 +6,7 @@
 //! the window is scored against the ErrPs the user produced.
 
 use errp_bci::{Accuracy, ResponseSpan};
-use errp_robot::{ContinuousController, StepKind};
+use errp_robot::{EpuckController, StepKind};
 use serde::{Deserialize, Serialize};
 
 use crate::epuck::decoder::ContinuousDecoder;
@@ -255,18 +255,18 @@ fn run_episode(
 pub fn shared_control(
     scenario: &EpuckScenario,
     decoder: &ContinuousDecoder,
-) -> Result<ContinuousController> {
+) -> Result<EpuckController> {
     let params = &scenario.params;
     let span = decoder.detection_span();
     // A changed copy of the scenario's checked parameters, checked again.
     let control = params.control.with(|c| {
-        if let Some(r) = &decoder.recorded {
+        if let Some(r) = &decoder.own_eeg {
             c.assumed_accuracy = r.accuracy;
         }
         c.goal_hold_secs = Some(params.goal_hold_secs(&span));
         c.veto_window_secs = Some(c.veto_window_secs.unwrap_or(span.to_secs));
     })?;
-    Ok(ContinuousController::new(
+    Ok(EpuckController::new(
         control,
         scenario.layout.clone(),
         scenario.episode.start,

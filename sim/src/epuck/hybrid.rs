@@ -25,29 +25,29 @@ use crate::epuck::decoder::{ContinuousDecoder, ContinuousReport, ContinuousReque
 use crate::epuck::hybrid_report::HybridReport;
 use crate::epuck::scenario::EpuckScenario;
 use crate::error::{Result, SimError};
-use crate::recorded::{FITTED_FALSE_ALARMS_PER_MIN, RecordedEeg, load_recording};
+use crate::own_eeg::{FITTED_FALSE_ALARMS_PER_MIN, OwnEegSpec, load_own_eeg};
 
 /// Calibrates the continuous decoder of `scenario` on the recording `eeg`
 /// (a hybrid), sets T_e for the false-alarm rate, and measures the
 /// detector there. Errors name the file.
 pub fn prepare_hybrid(
     scenario: &EpuckScenario,
-    eeg: &RecordedEeg,
+    eeg: &OwnEegSpec,
 ) -> Result<(ContinuousDecoder, ContinuousReport)> {
     let request = ContinuousRequest::new(scenario.accuracy, scenario.user_seed);
     let fs = request.setup.generator.sfreq_hz;
-    let (recording, file) = load_recording(eeg, fs)?;
+    let (recording, file) = load_own_eeg(eeg, fs)?;
     let named = |e: errp_bci::BciError| SimError::Scenario(format!("{}: {e}", file.name));
     let k = errp_bci::calibration_events(eeg.part, recording.events.len()).map_err(named)?;
     let hybrid =
-        HybridSource::from_recording(&recording.montage, &recording.raw, fs, &recording.events, k)
+        HybridSource::from_own_eeg(&recording.montage, &recording.raw, fs, &recording.events, k)
             .map_err(named)?;
     let background_secs = (
         hybrid.calibration.n_samples as f64 / fs,
         hybrid.held_out.n_samples as f64 / fs,
     );
     let template_counts = hybrid.template.counts;
-    let (mut decoder, report) = calibrate_on_recording(&request, Arc::new(hybrid))?;
+    let (mut decoder, report) = calibrate_on_own_eeg(&request, Arc::new(hybrid))?;
     let accuracy = report.calibrated.accuracy.mean();
     if accuracy <= 0.5 {
         return Err(SimError::Scenario(format!(
@@ -63,8 +63,8 @@ pub fn prepare_hybrid(
         .false_alarms_per_min
         .unwrap_or(FITTED_FALSE_ALARMS_PER_MIN);
     let (t_e, _) = threshold_for_false_alarms(&held_out, detector, fa).map_err(named)?;
-    decoder.online = Some(OnlineReport::from_recording(&held_out, detector, t_e)?);
-    decoder.recorded = Some(Box::new(HybridReport {
+    decoder.online = Some(OnlineReport::from_held_out(&held_out, detector, t_e)?);
+    decoder.own_eeg = Some(Box::new(HybridReport {
         file,
         calibration_events: k,
         template_counts,
@@ -80,7 +80,7 @@ pub fn prepare_hybrid(
 /// Calibrates the continuous decoder on `hybrid` as the synthetic one is
 /// calibrated, with no targeting (the subject's response has the amplitude
 /// it has); not yet measured online.
-pub fn calibrate_on_recording(
+pub fn calibrate_on_own_eeg(
     request: &ContinuousRequest,
     hybrid: Arc<HybridSource>,
 ) -> Result<(ContinuousDecoder, ContinuousReport)> {
@@ -115,7 +115,7 @@ pub fn calibrate_on_recording(
 pub fn epuck_decoder_summary(decoder: &ContinuousDecoder, report: &ContinuousReport) -> String {
     let acc = report.calibrated.accuracy;
     let mut text = decoder
-        .recorded
+        .own_eeg
         .as_ref()
         .map(|r| format!("{r}\n"))
         .unwrap_or_default();

@@ -1,7 +1,7 @@
 //! What an e-puck hybrid was made of, as the output and a recording's
 //! provenance say it ([`crate::epuck::prepare_hybrid`]).
 
-use crate::recorded::{FITTED_FALSE_ALARMS_PER_MIN, FileDigest};
+use crate::own_eeg::{FITTED_FALSE_ALARMS_PER_MIN, FileDigest};
 
 /// What the hybrid was made of, as the output and the recording's
 /// provenance say it.

@@ -21,7 +21,7 @@ pub(crate) mod user;
 pub(crate) mod view;
 pub(crate) mod world;
 
-pub use crate::recorded::{FITTED_FALSE_ALARMS_PER_MIN, MAX_FALSE_ALARMS_PER_MIN};
+pub use crate::own_eeg::{FITTED_FALSE_ALARMS_PER_MIN, MAX_FALSE_ALARMS_PER_MIN};
 pub use decoder::{
     ContinuousDecoder, ContinuousReport, ContinuousRequest, OnlineReport, calibrate_continuous_at,
     run_continuous_calibration, run_online_calibration, target_continuous,
@@ -32,7 +32,7 @@ pub use episode::{
     shared_control,
 };
 pub use errp_robot::AvoidanceParams;
-pub use hybrid::{calibrate_on_recording, epuck_decoder_summary, prepare_hybrid};
+pub use hybrid::{calibrate_on_own_eeg, epuck_decoder_summary, prepare_hybrid};
 pub use hybrid_report::{HYBRID_LABEL, HybridReport};
 pub use observer::{
     EpisodeStart, EpuckObserver, PHASE_NAMES, PhysicsFrame, STEP_NAMES, WindowFrame,

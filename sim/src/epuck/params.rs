@@ -2,7 +2,7 @@
 //! of the task, and where an episode starts and which goal the user wants.
 
 use errp_bci::{DetectorParams, ResponseSpan};
-use errp_robot::{AvoidanceParams, ContinuousControlParams, Pose, Valid};
+use errp_robot::{AvoidanceParams, EpuckControlParams, Pose, Valid};
 use serde::{Deserialize, Serialize};
 
 use crate::epuck::tracker::TrackerParams;
@@ -13,7 +13,7 @@ use crate::epuck::user::UserParams;
 pub struct EpuckTaskParams {
     /// Shared control and motion (sec. 5.1-5.2), checked where the
     /// scenario entered.
-    pub control: Valid<ContinuousControlParams>,
+    pub control: Valid<EpuckControlParams>,
     /// The synthetic user.
     pub user: UserParams,
     /// The ceiling camera.

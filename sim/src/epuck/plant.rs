@@ -13,10 +13,10 @@
 
 use errp_bci::{
     AssessmentKind, Decision, Detector, EegBlock, SlidingWindow,
-    rng::{derive_seed, stream},
+    rng::{derive_seed, labelled},
 };
 use errp_robot::{
-    AvoidanceParams, ContinuousController, EpuckParams, Phase, Pose, WheelSpeeds, wrap_angle,
+    AvoidanceParams, EpuckController, EpuckParams, Phase, Pose, WheelSpeeds, wrap_angle,
 };
 use rand_chacha::ChaCha8Rng;
 
@@ -101,9 +101,9 @@ pub trait EpuckDriver {
 }
 
 /// The shared control drives in an episode.
-impl EpuckDriver for ContinuousController {
+impl EpuckDriver for EpuckController {
     fn phase(&self) -> usize {
-        match ContinuousController::phase(self) {
+        match EpuckController::phase(self) {
             Phase::Turning => 0,
             Phase::Driving => 1,
             Phase::Stopped { .. } => 2,
@@ -111,11 +111,11 @@ impl EpuckDriver for ContinuousController {
     }
 
     fn target(&self) -> usize {
-        ContinuousController::target(self)
+        EpuckController::target(self)
     }
 
     fn command(&mut self, tracked: &Pose, time_secs: f64) -> WheelSpeeds {
-        ContinuousController::command(self, tracked, time_secs)
+        EpuckController::command(self, tracked, time_secs)
     }
 }
 
@@ -167,10 +167,11 @@ impl EpuckPlant {
     ) -> Result<Self> {
         let n = scenario.layout.len();
         if goal >= n {
-            return Err(SimError::Scenario(format!(
-                "goal: {goal} is not a goal of the layout, expected 0 to {}",
-                n - 1
-            )));
+            return Err(SimError::OutOfRange {
+                name: "goal".into(),
+                given: format!("{goal} is not a goal of the layout"),
+                expected: format!("0 to {}", n - 1),
+            });
         }
         let params = &scenario.params;
         let t_e = decoder.detector_t_e(params, own_decoder);
@@ -180,13 +181,13 @@ impl EpuckPlant {
             scenario.episode.start,
             PHYSICS_DT_SECS,
         )?;
-        let mut tracker = CameraTracker::new(params.tracker, stream(seed, "epuck/tracker"));
+        let mut tracker = CameraTracker::new(params.tracker, labelled(seed, "epuck/tracker"));
         let pose = world.pose();
         let tracked = tracker.observe(0.0, &pose);
         Ok(Self {
             world,
             tracker,
-            wheels_rng: stream(seed, "epuck/wheels"),
+            wheels_rng: labelled(seed, "epuck/wheels"),
             user: SyntheticUser::new(params.user, &scenario.layout, goal),
             eeg: decoder.start_stream(derive_seed(seed, "epuck/eeg", 0))?,
             detector: Detector::new(params.detector, t_e)?,

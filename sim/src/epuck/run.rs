@@ -74,7 +74,7 @@ pub fn prepare_epuck_decoder(
     mut progress: impl FnMut(&TargetingStep),
     online_progress: impl FnMut(&OnlineStep),
 ) -> Result<PreparedEpuck> {
-    if let Some(eeg) = &scenario.recording {
+    if let Some(eeg) = &scenario.own_eeg {
         let (decoder, report) = crate::epuck::hybrid::prepare_hybrid(scenario, eeg)?;
         return Ok(PreparedEpuck {
             decoder,

@@ -5,7 +5,7 @@
 use std::fmt;
 
 use errp_bci::DetectorMode;
-use errp_robot::ContinuousControlParams;
+use errp_robot::EpuckControlParams;
 use serde::Deserialize;
 use serde::de::{self, SeqAccess, Visitor};
 
@@ -34,10 +34,10 @@ pub(crate) struct EpuckFile {
     pub(crate) user: UserFile,
     /// A person's recording in place of the synthetic user's EEG.
     #[serde(default)]
-    pub(crate) eeg: Option<crate::recorded::RecordedTable>,
+    pub(crate) eeg: Option<crate::own_eeg::OwnEegTable>,
     /// Straight into the robot's type: its field names are the file's.
     #[serde(default)]
-    pub(crate) control: ContinuousControlParams,
+    pub(crate) control: EpuckControlParams,
     #[serde(default)]
     pub(crate) tracker: Option<TrackerFile>,
     #[serde(default)]

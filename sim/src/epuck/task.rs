@@ -13,9 +13,10 @@ use crate::error::Result;
 use crate::key::StableKey;
 use crate::paper::PAPER_EPUCK;
 use crate::task::{
-    Column, ColumnKind, DecoderInfo, EpisodeRow, FieldError, FigureText, PaperPoint, Task,
+    ColumnKind, DecoderInfo, EpisodeColumn, EpisodeRow, FieldError, FigureText, PaperPoint, Task,
     TaskInfo, format_number, rate_field,
 };
+use crate::task_kind::TaskKind;
 
 /// One e-puck run as the task's row of `episodes.csv`: its
 /// [`TaskInfo::columns`] (cities named from `layout`), success and online
@@ -57,21 +58,21 @@ pub struct EpuckRunner {
 
 impl Task for EpuckTask {
     const INFO: TaskInfo = TaskInfo {
-        name: "epuck",
+        kind: TaskKind::Epuck,
         columns: &[
-            Column::new("goal", ColumnKind::City),
-            Column::new("committed", ColumnKind::OptCity),
-            Column::new("time_secs", ColumnKind::NonNegative),
-            Column::new("path_m", ColumnKind::NonNegative),
-            Column::new("errps", ColumnKind::Count),
-            Column::new("detected", ColumnKind::Count),
-            Column::new("false_alarms", ColumnKind::Count),
-            Column::new("missed", ColumnKind::Count),
-            Column::new("detected_turning", ColumnKind::Count),
-            Column::new("detected_driving", ColumnKind::Count),
-            Column::new("detected_on_goal", ColumnKind::Count),
-            Column::new("hit_rate", ColumnKind::OptRate),
-            Column::new("false_alarms_per_min", ColumnKind::OptNonNegative),
+            EpisodeColumn::new("goal", ColumnKind::City),
+            EpisodeColumn::new("committed", ColumnKind::OptCity),
+            EpisodeColumn::new("time_secs", ColumnKind::NonNegative),
+            EpisodeColumn::new("path_m", ColumnKind::NonNegative),
+            EpisodeColumn::new("errps", ColumnKind::Count),
+            EpisodeColumn::new("detected", ColumnKind::Count),
+            EpisodeColumn::new("false_alarms", ColumnKind::Count),
+            EpisodeColumn::new("missed", ColumnKind::Count),
+            EpisodeColumn::new("detected_turning", ColumnKind::Count),
+            EpisodeColumn::new("detected_driving", ColumnKind::Count),
+            EpisodeColumn::new("detected_on_goal", ColumnKind::Count),
+            EpisodeColumn::new("hit_rate", ColumnKind::OptRate),
+            EpisodeColumn::new("false_alarms_per_min", ColumnKind::OptNonNegative),
         ],
         cost_column: "time_secs",
         cost_label: "time (s)",
@@ -107,7 +108,7 @@ impl Task for EpuckTask {
     /// calibration itself, depend on the detector and T_e too.
     fn decoder_key(s: &EpuckScenario) -> String {
         let key = StableKey::new("epuck-decoder", 1);
-        let key = match &s.recording {
+        let key = match &s.own_eeg {
             None => key,
             Some(r) => key
                 .text("recording", &r.file.display().to_string())
@@ -140,25 +141,23 @@ impl Task for EpuckTask {
         let prepared = prepare_epuck_decoder(s, cache, |_| {}, |_| {})?;
         let a = prepared.report.calibrated.accuracy;
         let point = prepared.decoder.online.as_ref().map(|o| o.point);
-        let recorded = prepared.decoder.recorded.as_deref();
+        let own_eeg = prepared.decoder.own_eeg.as_deref();
         let info = DecoderInfo {
             // On a recording, the accuracy it gives (the control assumes it).
-            accuracy: recorded.map_or(s.accuracy.get(), |r| r.accuracy),
-            kind: if s.recording.is_some() {
+            accuracy: own_eeg.map_or(s.accuracy.get(), |r| r.accuracy),
+            kind: if s.own_eeg.is_some() {
                 "svm-hybrid".into()
             } else {
                 "svm".into()
             },
             calibration_seed: s.user_seed,
-            errp_to_noise: recorded
-                .is_none()
-                .then_some(prepared.report.targeting.ratio),
+            errp_to_noise: own_eeg.is_none().then_some(prepared.report.targeting.ratio),
             cv_correct: Some(a.correct),
             cv_error: Some(a.error),
             cv_mean: Some(a.mean()),
             online_hit_rate: point.map(|p| p.hit_rate),
             online_false_alarms_per_min: point.map(|p| p.false_alarms_per_min),
-            recording: recorded.map(|r| r.file.clone()),
+            own_eeg: own_eeg.map(|r| r.file.clone()),
             cached: prepared.cached,
         };
         Ok((prepared.decoder, info))

@@ -38,9 +38,11 @@ impl TrackerParams {
     /// Checks the ranges.
     pub fn validate(&self) -> Result<()> {
         let bad = |field: &str, v: f64, expected: &str| {
-            Err(SimError::Scenario(format!(
-                "tracker.{field} = {v} is invalid: expected {expected}"
-            )))
+            Err(SimError::InvalidParameter {
+                name: format!("tracker.{field}"),
+                value: v.to_string(),
+                expected: expected.to_string(),
+            })
         };
         if !(self.rate_hz.is_finite() && self.rate_hz > 0.0) {
             return bad("rate_hz", self.rate_hz, "a frame rate > 0");
@@ -103,12 +105,12 @@ impl CameraTracker {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use errp_bci::rng::stream;
+    use errp_bci::rng::labelled;
 
     #[test]
     fn frames_come_at_the_rate_with_the_stated_noise() {
         let params = TrackerParams::default();
-        let mut t = CameraTracker::new(params, stream(3, "tracker"));
+        let mut t = CameraTracker::new(params, labelled(3, "tracker"));
         let truth = Pose {
             x_m: 1.0,
             y_m: 1.0,

@@ -86,9 +86,11 @@ impl UserParams {
             if ok {
                 Ok(())
             } else {
-                Err(SimError::Scenario(format!(
-                    "user.{field} = {v} is invalid: expected {expected}"
-                )))
+                Err(SimError::InvalidParameter {
+                    name: format!("user.{field}"),
+                    value: v.to_string(),
+                    expected: expected.to_string(),
+                })
             }
         };
         let deg = self.fov_rad.to_degrees();

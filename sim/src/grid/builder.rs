@@ -8,10 +8,12 @@ use crate::error::Result;
 use crate::grid::p_error::PErrorChoice;
 use crate::grid::params::GridTaskParams;
 use crate::grid::scenario::{
-    ACCURACY_RANGE, DEFAULT_BANK_PER_CLASS, DecoderChoice, EegMode, GridAccuracy, GridScenario,
-    MAX_BANK_PER_CLASS, MAX_EPISODES, checked_accuracy,
+    DEFAULT_BANK_PER_CLASS, DecoderChoice, EegMode, GridAccuracy, GridScenario, MAX_BANK_PER_CLASS,
+    MAX_EPISODES, assumed_control,
 };
+use crate::rules::{self, Origin};
 use crate::scenario_file::{field_error, whole};
+use crate::task_kind::TaskKind;
 use errp_robot::Cell;
 
 /// A grid scenario made in code, field by field, and checked once by
@@ -44,7 +46,7 @@ impl GridScenario {
                 seed,
                 decoder,
                 p_error: PErrorChoice::Platt,
-                eeg: EegMode::Stream,
+                eeg: EegMode::PerAction,
                 bank_per_class: DEFAULT_BANK_PER_CLASS,
                 // Set by `build`, once checked.
                 accuracy: GridAccuracy::Requested(RequestedAccuracy::Perfect),
@@ -101,9 +103,10 @@ impl GridScenarioBuilder {
         self
     }
 
-    /// The scenario, checked as a file's values are: the accuracy against
-    /// the decoder, the bank's size, the number of episodes. The error
-    /// names the scenario and the field.
+    /// The scenario, checked as a file's values are (the accuracy against
+    /// the decoder, the bank's size, the number of episodes; the error
+    /// names the scenario and the field) and with what a file's loader
+    /// derives (the accuracy the control assumes).
     pub fn build(self) -> Result<GridScenario> {
         let Self {
             mut scenario,
@@ -112,10 +115,16 @@ impl GridScenarioBuilder {
         let path = scenario.path.clone();
         let bad =
             |field: &str, value: String, expected: &str| field_error(&path, field, value, expected);
-        scenario.accuracy = GridAccuracy::Requested(
-            checked_accuracy(accuracy, scenario.decoder)
-                .ok_or_else(|| bad("user.accuracy", accuracy.to_string(), ACCURACY_RANGE))?,
-        );
+        let oracle = scenario.decoder == DecoderChoice::Oracle;
+        scenario.accuracy = GridAccuracy::Requested(rules::accuracy_for(
+            TaskKind::Grid,
+            oracle,
+            accuracy,
+            Origin::Scenario(&path),
+        )?);
+        // What the loader derives from the accuracy, derived the same way.
+        scenario.params.control =
+            assumed_control(*scenario.params.control.get(), &scenario.accuracy, &path)?;
         whole(
             &path,
             "bank_per_class",

@@ -5,15 +5,15 @@
 use errp_bci::{
     Accuracy, ActionInformation, Assessment, AssessmentKind, Components, EegBlock, EegGenerator,
     EpochWindow, ErrorModel, GeneratorParams, LdaModel, Montage, Preprocessor, Valid,
-    rng::derive_seed, rng::stream,
+    rng::derive_seed, rng::labelled,
 };
 use rand::Rng;
 
 use crate::calibration::CalibrationReport;
 use crate::error::{Result, SimError};
+use crate::grid::own_eeg::OwnEegBank;
 use crate::grid::p_error::{PErrorChoice, PErrorMapping};
 use crate::grid::params::GridTaskParams;
-use crate::grid::recorded::RecordedBank;
 
 /// What turns the user's assessment into p(error).
 #[derive(Debug, Clone)]
@@ -37,7 +37,7 @@ pub enum AssessmentDecoder {
     EegBank(Box<EpochBank>),
     /// A decoder calibrated on a person's recording, decoding held-out
     /// epochs of the same recording (`[eeg] recording = ...`).
-    Recorded(Box<RecordedBank>),
+    OwnEeg(Box<OwnEegBank>),
 }
 
 /// Epochs per class on which [`AssessmentDecoder::information`] measures an
@@ -59,7 +59,7 @@ impl AssessmentDecoder {
     ) -> Result<ActionInformation> {
         let d = match self {
             Self::Oracle { accuracy } => {
-                let mut rng = stream(seed, "grid/information/oracle");
+                let mut rng = labelled(seed, "grid/information/oracle");
                 let mut draw = |error: bool| -> Vec<(f64, bool)> {
                     (0..per_class)
                         .map(|_| oracle_report(*accuracy, error, &mut rng))
@@ -72,12 +72,12 @@ impl AssessmentDecoder {
             Self::Eeg(d) => d.as_ref(),
             Self::EegBank(bank) => &bank.decoder,
             // The recording's epochs are what there is: every held-out one.
-            Self::Recorded(bank) => {
+            Self::OwnEeg(bank) => {
                 let [error, correct] = bank.decisions();
                 return measured(&error, &correct);
             }
         };
-        let (error, correct) = stream_classes(
+        let (error, correct) = synthesise_classes(
             d.source(),
             params,
             per_class,
@@ -130,7 +130,7 @@ impl EpochBank {
         per_class: usize,
         seed: u64,
     ) -> Result<Self> {
-        let (error, correct) = stream_pools(
+        let (error, correct) = synthesise_pools(
             decoder.source(),
             params,
             per_class,
@@ -196,7 +196,7 @@ impl EpochBankParts {
                 artifacts: !erp,
                 erp,
             };
-            stream_pools(unit, params, per_class, seed, components)
+            synthesise_pools(unit, params, per_class, seed, components)
         };
         let (noise, erp) = rayon::join(|| part(false), || part(true));
         Ok(Self {
@@ -255,14 +255,14 @@ impl EpochBankParts {
 }
 
 /// Streams the epochs of a bank with the generator's `components`.
-fn stream_pools(
+fn synthesise_pools(
     source: EegSource<'_>,
     params: &GridTaskParams,
     per_class: usize,
     seed: u64,
     components: Components,
 ) -> Result<Pools> {
-    stream_classes(
+    synthesise_classes(
         source,
         params,
         per_class,
@@ -274,7 +274,7 @@ fn stream_pools(
 
 /// Streams `per_class` epochs of each class in a seeded random order and
 /// keeps what `keep` makes of each.
-fn stream_classes<T>(
+fn synthesise_classes<T>(
     source: EegSource<'_>,
     params: &GridTaskParams,
     per_class: usize,
@@ -288,7 +288,7 @@ fn stream_classes<T>(
         ));
     }
     let mut stream_eeg = OnlineEeg::start(source, derive_seed(seed, "grid/bank", 0), components)?;
-    let mut rng = stream(seed, "grid/bank/order");
+    let mut rng = labelled(seed, "grid/bank/order");
     let mut error = Vec::with_capacity(per_class);
     let mut correct = Vec::with_capacity(per_class);
     while error.len() < per_class || correct.len() < per_class {
@@ -467,7 +467,7 @@ impl EpochBlocks {
         per_class: usize,
         seed: u64,
     ) -> Result<Self> {
-        let (error, correct) = stream_classes(
+        let (error, correct) = synthesise_classes(
             source,
             params,
             per_class,

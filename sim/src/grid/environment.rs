@@ -5,15 +5,15 @@
 
 use std::sync::Arc;
 
-use errp_bci::{EegBlock, rng::stream};
+use errp_bci::{EegBlock, rng::labelled};
 use errp_robot::{Cell, Grid, GridAction};
 use rand::Rng;
 
 use crate::error::{Result, SimError};
 use crate::grid::decoder::AssessmentDecoder;
+use crate::grid::own_eeg::own_eeg_control;
 use crate::grid::params::GridTaskParams;
 use crate::grid::plant::{GridDecoding, GridEpisodeResult, GridPlant};
-use crate::grid::recorded::recorded_control;
 
 /// What one action gave the agent.
 #[derive(Debug, Clone, PartialEq)]
@@ -59,16 +59,18 @@ impl GridEnvironment {
         seed: u64,
     ) -> Result<Self> {
         let grid = Grid::paper();
-        let mut rng_cells = stream(seed, "grid/env/cells");
+        let mut rng_cells = labelled(seed, "grid/env/cells");
         let mut draw = |given: Option<Cell>, name: &str| -> Result<Cell> {
             match given {
                 Some(c) if grid.contains(c) => Ok(c),
-                Some(c) => Err(SimError::Scenario(format!(
-                    "{name}: cell {c} is outside the {}x{} grid, expected x and y from 0 to {}",
-                    grid.width,
-                    grid.height,
-                    grid.width - 1
-                ))),
+                Some(c) => Err(SimError::OutOfRange {
+                    name: name.to_string(),
+                    given: format!(
+                        "cell {c} is outside the {}x{} grid",
+                        grid.width, grid.height
+                    ),
+                    expected: format!("x and y from 0 to {}", grid.width - 1),
+                }),
                 None => Ok(Cell::new(
                     rng_cells.random_range(0..grid.width),
                     rng_cells.random_range(0..grid.height),
@@ -80,8 +82,8 @@ impl GridEnvironment {
         let plant = GridPlant::new(grid, start, goal, &GridDecoding::Builtin(&decoder), seed)?;
         // A decoder calibrated on a recording knows its own accuracy.
         let params = match decoder.as_ref() {
-            AssessmentDecoder::Recorded(bank) => GridTaskParams {
-                control: recorded_control(&params, bank)?,
+            AssessmentDecoder::OwnEeg(bank) => GridTaskParams {
+                control: own_eeg_control(&params, bank)?,
                 ..params
             },
             _ => params,
@@ -139,8 +141,9 @@ impl GridEnvironment {
         self.plant.result(self.committed, self.params.epoch_secs)
     }
 
-    /// True if the decoder streams EEG, so that epochs can be returned.
-    pub fn streams(&self) -> bool {
+    /// True if the decoder synthesises each action's EEG, so that epochs can
+    /// be returned.
+    pub fn per_action(&self) -> bool {
         matches!(*self.decoder, AssessmentDecoder::Eeg(_))
     }
 
@@ -150,10 +153,10 @@ impl GridEnvironment {
     /// (a move against a border leaves it in place). `keep_epoch` returns
     /// the preprocessed epoch too, and needs streamed EEG.
     pub fn step(&mut self, action: GridAction, keep_epoch: bool) -> Result<GridFeedback> {
-        if keep_epoch && !self.streams() {
+        if keep_epoch && !self.per_action() {
             return Err(SimError::Scenario(
-                "observe_epoch: the epochs are only there with streamed EEG (eeg = \"stream\" \
-                 and decoder = \"eeg\" in the scenario)"
+                "observe_epoch: the epochs are only there with EEG synthesised per action (eeg = \
+                 \"per_action\" and decoder = \"eeg\" in the scenario)"
                     .into(),
             ));
         }

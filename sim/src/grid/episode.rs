@@ -2,14 +2,14 @@
 //! judges each action, the EEG generator turns the judgement into an epoch,
 //! the decoder gives p(error), the controller updates its belief and acts.
 
-use errp_bci::rng::stream;
+use errp_bci::rng::labelled;
 use errp_robot::{Cell, Grid, GridController, QTable};
 
 use crate::error::{Result, SimError};
 use crate::grid::decoder::AssessmentDecoder;
+use crate::grid::own_eeg::own_eeg_control;
 use crate::grid::params::GridTaskParams;
 use crate::grid::plant::{GridDecoding, GridEpisodeResult, GridPlant};
-use crate::grid::recorded::recorded_control;
 
 /// Runs one episode from `start` towards the user's `goal`. Everything random
 /// derives from `seed`: the same seed gives the same episode, bit for bit.
@@ -55,11 +55,11 @@ pub fn run_grid_episode_with(
     }
     // A decoder calibrated on a recording knows its own accuracy.
     let control = match &decoding {
-        GridDecoding::Builtin(AssessmentDecoder::Recorded(bank)) => recorded_control(params, bank)?,
+        GridDecoding::Builtin(AssessmentDecoder::OwnEeg(bank)) => own_eeg_control(params, bank)?,
         _ => params.control,
     };
     let mut controller = GridController::with_table(table.clone(), control);
-    let mut rng_policy = stream(seed, "grid/policy");
+    let mut rng_policy = labelled(seed, "grid/policy");
     let mut plant = GridPlant::new(grid, start, goal, &decoding, seed)?;
     if record_steps {
         plant.keep_steps();

@@ -5,11 +5,11 @@ pub(crate) mod builder;
 pub(crate) mod decoder;
 pub(crate) mod environment;
 pub(crate) mod episode;
+pub(crate) mod own_eeg;
 pub(crate) mod p_error;
 pub(crate) mod pairs;
 pub(crate) mod params;
 pub(crate) mod plant;
-pub(crate) mod recorded;
 pub(crate) mod report;
 pub(crate) mod run;
 pub(crate) mod scenario;
@@ -25,6 +25,7 @@ pub use decoder::{
 };
 pub use environment::{GridEnvironment, GridFeedback};
 pub use episode::{run_grid_episode, run_grid_episode_with};
+pub use own_eeg::{CV_REPEATS, OwnEegBank, OwnEegReport};
 pub use p_error::{PErrorChoice, PErrorMapping};
 pub use pairs::{
     CENTRAL_RUN, PAIRS_PER_SET, PairFamily, keeps_to_the_centre, manhattan, pairs_text,
@@ -35,7 +36,6 @@ pub use plant::{
     EpochDecoder, GridDecoding, GridEpisodeResult, GridStep, LiveAction, LiveDecoder,
     grid_episode_seed,
 };
-pub use recorded::{CV_REPEATS, RecordedBank, RecordedReport};
 pub use report::{GridEpisodeHeader, GridEpisodeRow, Table1Report};
 pub use run::{
     GridRunReport, GridShared, HELD_OUT_PER_CLASS, PreparedGrid, decoder_accuracy, eeg_decoder,

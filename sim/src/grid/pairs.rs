@@ -182,7 +182,7 @@ impl PairFamily {
 mod tests {
     use super::*;
     use crate::grid::{CORNER_PAIRS, FIXED_PAIRS};
-    use errp_bci::rng::stream;
+    use errp_bci::rng::labelled;
 
     #[test]
     fn the_centre_rule_reads_as_the_paper_describes_run_3() {
@@ -212,7 +212,7 @@ mod tests {
     #[test]
     fn draws_have_the_asked_length_and_keep_run_3_central() {
         let family = PairFamily::paper();
-        let mut rng = stream(7, "test");
+        let mut rng = labelled(7, "test");
         for total in family.lengths() {
             let mut patterns = std::collections::BTreeSet::new();
             for _ in 0..40 {
@@ -240,7 +240,7 @@ mod tests {
     fn draws_are_uniform_over_the_sets_of_a_length() {
         let family = PairFamily::paper();
         let total = 16;
-        let mut rng = stream(11, "test");
+        let mut rng = labelled(11, "test");
         let mut seen = [0.0f64; 5];
         let n = 4000;
         for _ in 0..n {

@@ -7,15 +7,15 @@
 //! driven by the shared control is the episode, bit for bit
 //! (`sim/tests/it/grid_identity.rs`).
 
-use errp_bci::{Accuracy, Components, EegBlock, rng::derive_seed, rng::stream};
+use errp_bci::{Accuracy, Components, EegBlock, rng::derive_seed, rng::labelled};
 use errp_robot::{Cell, Grid, GridAction};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 use crate::error::{Result, SimError, check_p_error};
 use crate::grid::decoder::{AssessmentDecoder, EegSource, OnlineEeg, decide, oracle_report};
+use crate::grid::own_eeg::OwnEegDraw;
 use crate::grid::params::GridTaskParams;
-use crate::grid::recorded::RecordedDraw;
 
 /// One action of an episode, as recorded.
 #[derive(Debug, Clone, PartialEq)]
@@ -196,7 +196,7 @@ impl GridPlant {
             grid,
             cell: start,
             goal,
-            rng_user: stream(seed, "grid/user"),
+            rng_user: labelled(seed, "grid/user"),
             decoder: ActionDecoder::start(decoding, seed)?,
             tally: GridTally::new(&grid, start),
             total_secs: 0.0,
@@ -437,7 +437,7 @@ pub(crate) struct ActionDecoder {
     online: Option<OnlineEeg>,
     rng_oracle: ChaCha8Rng,
     rng_bank: ChaCha8Rng,
-    recorded: RecordedDraw,
+    recorded: OwnEegDraw,
 }
 
 impl ActionDecoder {
@@ -469,9 +469,9 @@ impl ActionDecoder {
         };
         Ok(Self {
             online,
-            rng_oracle: stream(seed, "grid/oracle"),
-            rng_bank: stream(seed, "grid/bank/draw"),
-            recorded: RecordedDraw::new(),
+            rng_oracle: labelled(seed, "grid/oracle"),
+            rng_bank: labelled(seed, "grid/bank/draw"),
+            recorded: OwnEegDraw::new(),
         })
     }
 
@@ -528,7 +528,7 @@ impl ActionDecoder {
                 let p = pool[self.rng_bank.random_range(0..pool.len())];
                 (p, p >= 0.5, Vec::new())
             }
-            (GridDecoding::Builtin(AssessmentDecoder::Recorded(bank)), _) => {
+            (GridDecoding::Builtin(AssessmentDecoder::OwnEeg(bank)), _) => {
                 let epoch = self.recorded.draw(bank, error, &mut self.rng_bank);
                 let (p, says) = bank.decide(&epoch.features);
                 let fcz = if record_steps {

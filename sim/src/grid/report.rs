@@ -308,7 +308,7 @@ accuracy = 0.8
         let report = GridRunReport {
             scenario,
             calibration,
-            recorded: None,
+            own_eeg: None,
             episodes,
         };
         out.push_str(&report.to_string());

@@ -15,11 +15,13 @@ use crate::calibration::{CalibrationReport, CalibrationRequest, NoCache, Targeti
 use crate::error::{Result, SimError};
 use crate::grid::decoder::{AssessmentDecoder, EegDecoder, EegSource, EpochBankParts};
 use crate::grid::episode::run_grid_episode_with;
+use crate::grid::own_eeg::{OwnEegReport, prepare_own_eeg};
 use crate::grid::plant::{GridDecoding, GridEpisodeResult};
-use crate::grid::recorded::{RecordedReport, prepare_recorded};
 use crate::grid::scenario::{DecoderChoice, EegMode, GridScenario};
 use crate::key::StableKey;
+use crate::rules::{self, Origin};
 use crate::task::DecoderInfo;
+use crate::task_kind::TaskKind;
 
 /// Everything a grid run produced.
 #[derive(Debug, Clone)]
@@ -30,7 +32,7 @@ pub struct GridRunReport {
     /// recording).
     pub calibration: Option<CalibrationReport>,
     /// What a person's recording gave (`[eeg] recording = ...`).
-    pub recorded: Option<RecordedReport>,
+    pub own_eeg: Option<OwnEegReport>,
     /// One result per episode, in scenario order.
     pub episodes: Vec<GridEpisodeResult>,
 }
@@ -83,20 +85,20 @@ impl PreparedGrid {
     /// accuracy, the ratio found and the session's cross-validated rates.
     pub fn info(&self, s: &GridScenario) -> DecoderInfo {
         let calibration = self.calibration.as_ref();
-        let recorded = match &self.decoder {
-            AssessmentDecoder::Recorded(bank) => Some(&bank.report),
+        let own_eeg = match &self.decoder {
+            AssessmentDecoder::OwnEeg(bank) => Some(&bank.report),
             _ => None,
         };
         let accuracy = calibration
             .map(|c| c.calibrated.accuracy)
-            .or(recorded.map(|r| r.cross_validated));
+            .or(own_eeg.map(|r| r.cross_validated));
         DecoderInfo {
             // A recording's decoder has the accuracy it has: its
             // cross-validated one, which the control assumes.
-            accuracy: decoder_accuracy(s, recorded),
+            accuracy: decoder_accuracy(s, own_eeg),
             kind: if calibration.is_some() {
                 "lda"
-            } else if recorded.is_some() {
+            } else if own_eeg.is_some() {
                 "lda-recorded"
             } else {
                 "oracle"
@@ -109,7 +111,7 @@ impl PreparedGrid {
             cv_mean: accuracy.map(|a| a.mean()),
             online_hit_rate: None,
             online_false_alarms_per_min: None,
-            recording: recorded.map(|r| r.file.clone()),
+            own_eeg: own_eeg.map(|r| r.file.clone()),
             cached: self.cached,
         }
     }
@@ -118,9 +120,9 @@ impl PreparedGrid {
 /// The accuracy the decoder of `s` is known by: the one asked for, or
 /// (its EEG a recording) the one cross-validated on the recording's
 /// calibration part, which the control assumes. Not a number for a
-/// recording's scenario without its `recorded` report.
-pub fn decoder_accuracy(s: &GridScenario, recorded: Option<&RecordedReport>) -> f64 {
-    match (s.accuracy.requested(), recorded) {
+/// recording's scenario without its `own_eeg` report.
+pub fn decoder_accuracy(s: &GridScenario, own_eeg: Option<&OwnEegReport>) -> f64 {
+    match (s.accuracy.requested(), own_eeg) {
         (Some(a), _) => a.get(),
         (None, Some(r)) => r.cross_validated.mean(),
         (None, None) => f64::NAN,
@@ -175,7 +177,7 @@ fn build_held_out(
     setup: &Valid<CalibrationSetup>,
     session: &SessionParts,
 ) -> Result<EpochBankParts> {
-    stream_parts(
+    synthesise_parts(
         s,
         setup,
         session,
@@ -206,14 +208,14 @@ fn build_bank(
     setup: &Valid<CalibrationSetup>,
     session: &SessionParts,
 ) -> Result<EpochBankParts> {
-    stream_parts(s, setup, session, s.bank_per_class, s.seed)
+    synthesise_parts(s, setup, session, s.bank_per_class, s.seed)
 }
 
 /// `per_class` epochs of each class from `seed`, streamed at `s`'s
 /// inter-action intervals: the EEG of the user of `setup` in the closed
 /// loop that follows the calibration ([`CalibrationSetup::closed_loop_generator`])
 /// through `session`'s preprocessing.
-fn stream_parts(
+fn synthesise_parts(
     s: &GridScenario,
     setup: &Valid<CalibrationSetup>,
     session: &SessionParts,
@@ -274,10 +276,10 @@ pub fn prepare_grid_decoder(
     cache: &dyn TargetingCache,
     mut progress: impl FnMut(&TargetingStep),
 ) -> Result<PreparedGrid> {
-    if let Some(eeg) = scenario.accuracy.recorded() {
-        let bank = prepare_recorded(scenario, eeg, &grid_setup(scenario)?)?;
+    if let Some(eeg) = scenario.accuracy.own_eeg() {
+        let bank = prepare_own_eeg(scenario, eeg, &grid_setup(scenario)?)?;
         return Ok(PreparedGrid {
-            decoder: AssessmentDecoder::Recorded(Box::new(bank)),
+            decoder: AssessmentDecoder::OwnEeg(Box::new(bank)),
             calibration: None,
             cached: false,
         });
@@ -348,7 +350,7 @@ pub fn prepare_grid_decoder(
         .at_ratio(report.targeting.ratio)?
         .closed_loop_generator(scenario.seed)?;
     let decoder = match scenario.eeg {
-        EegMode::Stream => AssessmentDecoder::Eeg(Box::new(eeg)),
+        EegMode::PerAction => AssessmentDecoder::Eeg(Box::new(eeg)),
         EegMode::Bank => {
             let bank = match shared.banks.get(&bank_key(scenario)) {
                 Some(bank) => bank.bank(eeg),
@@ -403,14 +405,15 @@ pub fn online_accuracy_at(
 }
 
 /// The accuracy the EEG decoder of `scenario` is targeted at (a scenario
-/// changed after it was checked may ask a perfect one).
+/// changed after it was checked may ask a perfect one, which the rule
+/// refuses).
 fn targeted(scenario: &GridScenario) -> Result<MeanAccuracy> {
-    requested(scenario)?.targeted().ok_or_else(|| {
-        SimError::Scenario(format!(
-            "{}: the EEG decoder cannot be perfect (user.accuracy = 1 is the oracle's)",
-            scenario.path.display()
-        ))
-    })
+    let asked = requested(scenario)?;
+    let origin = Origin::Scenario(&scenario.path);
+    match rules::accuracy_for(TaskKind::Grid, false, asked.get(), origin)? {
+        RequestedAccuracy::Targeted(a) => Ok(a),
+        RequestedAccuracy::Perfect => unreachable!("the rule refuses a perfect EEG decoder"),
+    }
 }
 
 /// The accuracy `scenario` asks for (none when its EEG is a recording).

@@ -16,10 +16,12 @@ use crate::error::Result;
 use crate::grid::p_error::PErrorChoice;
 use crate::grid::params::{GridTaskParams, TimingFile, set_timing};
 pub use crate::grid::params::{MAX_ACTIONS, MAX_INTERVAL_SECS};
-use crate::recorded::{RecordedEeg, RecordedFile, RecordedTask};
+use crate::own_eeg::{OwnEegFields, OwnEegSpec};
+use crate::rules::{self, Claim, Origin};
 use crate::scenario_file::{
     Pair, checked_realism, field_error, parse_toml, robot_error, scenario_name, table_into, whole,
 };
+use crate::task_kind::TaskKind;
 
 /// Most epochs per class in an epoch bank (about 9 KB each, per level of a
 /// sweep).
@@ -103,7 +105,7 @@ fn default_p_error() -> PErrorChoice {
 #[derive(Debug)]
 enum EegFile {
     Mode(EegMode),
-    Recorded(RecordedFile),
+    OwnEeg(OwnEegFields),
 }
 
 impl<'de> Deserialize<'de> for EegFile {
@@ -113,7 +115,7 @@ impl<'de> Deserialize<'de> for EegFile {
             type Value = EegFile;
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
                 f.write_str(
-                    "\"stream\", \"bank\" or a table naming a recording \
+                    "\"per_action\", \"bank\" or a table naming a recording \
                      ([eeg] recording = \"s01.edf\")",
                 )
             }
@@ -125,8 +127,8 @@ impl<'de> Deserialize<'de> for EegFile {
                 self,
                 map: A,
             ) -> std::result::Result<EegFile, A::Error> {
-                RecordedFile::deserialize(serde::de::value::MapAccessDeserializer::new(map))
-                    .map(EegFile::Recorded)
+                OwnEegFields::deserialize(serde::de::value::MapAccessDeserializer::new(map))
+                    .map(EegFile::OwnEeg)
             }
         }
         d.deserialize_any(Visitor)
@@ -138,17 +140,19 @@ impl<'de> Deserialize<'de> for EegFile {
 #[serde(rename_all = "snake_case")]
 pub enum EegMode {
     /// Synthesised when each action happens, the whole inter-action
-    /// interval streamed (the default; faithful, ~0.7 ms per action).
-    Stream,
-    /// Drawn from a bank of epochs streamed in advance (fast, for sweeps).
+    /// interval generated (the default; faithful, ~0.7 ms per action).
+    /// Spelled `"per_action"`; `"stream"`, its former name, is still read.
+    #[serde(alias = "stream")]
+    PerAction,
+    /// Drawn from a bank of epochs synthesised in advance (fast, for sweeps).
     Bank,
 }
 
 impl EegMode {
-    /// As a scenario file spells it (`eeg = "stream"`).
+    /// As a scenario file spells it (`eeg = "per_action"`).
     pub fn key(self) -> &'static str {
         match self {
-            EegMode::Stream => "stream",
+            EegMode::PerAction => "per_action",
             EegMode::Bank => "bank",
         }
     }
@@ -193,7 +197,7 @@ pub enum GridAccuracy {
     Requested(RequestedAccuracy),
     /// Whatever a person's recording gives: the decoder is calibrated on
     /// its first part and decodes epochs of the rest.
-    Recorded(Box<RecordedEeg>),
+    OwnEeg(Box<OwnEegSpec>),
 }
 
 impl GridAccuracy {
@@ -201,15 +205,15 @@ impl GridAccuracy {
     pub fn requested(&self) -> Option<RequestedAccuracy> {
         match self {
             Self::Requested(a) => Some(*a),
-            Self::Recorded(_) => None,
+            Self::OwnEeg(_) => None,
         }
     }
 
     /// The recording, if the EEG is one.
-    pub fn recorded(&self) -> Option<&RecordedEeg> {
+    pub fn own_eeg(&self) -> Option<&OwnEegSpec> {
         match self {
             Self::Requested(_) => None,
-            Self::Recorded(r) => Some(r),
+            Self::OwnEeg(r) => Some(r),
         }
     }
 }
@@ -264,27 +268,22 @@ impl GridScenario {
     fn from_file(file: ScenarioFile, path: &Path) -> Result<Self> {
         let bad =
             |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
-        if file.task != "grid" {
-            return Err(bad(
-                "task",
-                format!("{:?}", file.task),
-                "\"grid\" or \"epuck\"",
-            ));
+        if file.task != TaskKind::Grid.as_str() {
+            return Err(bad("task", format!("{:?}", file.task), TaskKind::EXPECTED));
         }
 
         let (eeg, recorded) = match &file.eeg {
-            None => (EegMode::Stream, None),
+            None => (EegMode::PerAction, None),
             Some(EegFile::Mode(mode)) => (*mode, None),
-            Some(EegFile::Recorded(r)) => (
-                EegMode::Bank,
-                Some(r.clone().check(path, RecordedTask::Grid)?),
-            ),
+            Some(EegFile::OwnEeg(r)) => {
+                (EegMode::Bank, Some(r.clone().check(path, TaskKind::Grid)?))
+            }
         };
         let (accuracy, user) = match recorded {
             Some(r) => {
-                refuse_with_recording(&file, path)?;
+                refuse_with_own_eeg(&file, &r, path)?;
                 let user = format!("recording {}", r.written);
-                (GridAccuracy::Recorded(Box::new(r)), user)
+                (GridAccuracy::OwnEeg(Box::new(r)), user)
             }
             None => {
                 let (a, user) = user_accuracy(&file, path)?;
@@ -297,14 +296,8 @@ impl GridScenario {
         // one asked for, or (a recording) its cross-validated accuracy, set
         // when the recording is read.
         // Checked here, once: the controllers take it checked.
-        let control = GridControlParams {
-            assumed_accuracy: accuracy
-                .requested()
-                .map_or(file.control.assumed_accuracy, RequestedAccuracy::get),
-            ..file.control
-        };
         let mut params = GridTaskParams {
-            control: Valid::new(control).map_err(|e| robot_error(path, "control", e))?,
+            control: assumed_control(file.control, &accuracy, path)?,
             ..GridTaskParams::default()
         };
         set_timing(&mut params, file.timing.as_ref(), path)?;
@@ -354,14 +347,32 @@ impl GridScenario {
             params,
             realism,
         };
-        match scenario.accuracy.recorded() {
+        match scenario.accuracy.own_eeg() {
             Some(eeg) => {
                 let eeg = eeg.clone();
-                scenario.on_recording(eeg)
+                scenario.on_own_eeg(eeg)
             }
             None => Ok(scenario),
         }
     }
+}
+
+/// The control a scenario runs, as the loader and the builder both derive
+/// it: the device assumes the accuracy asked of its decoder (an own EEG's
+/// cross-validated accuracy is set when the recording is read); checked
+/// once, the controllers take it checked.
+pub(crate) fn assumed_control(
+    control: GridControlParams,
+    accuracy: &GridAccuracy,
+    path: &Path,
+) -> Result<Valid<GridControlParams>> {
+    let control = GridControlParams {
+        assumed_accuracy: accuracy
+            .requested()
+            .map_or(control.assumed_accuracy, RequestedAccuracy::get),
+        ..control
+    };
+    Valid::new(control).map_err(|e| robot_error(path, "control", e))
 }
 
 /// The user of a `[user]` table, an accuracy or a subject of Table 1 with
@@ -401,62 +412,43 @@ fn user_accuracy(file: &ScenarioFile, path: &Path) -> Result<(RequestedAccuracy,
             ));
         }
     };
-    let requested = checked_accuracy(accuracy, file.decoder)
-        .ok_or_else(|| bad("user.accuracy", accuracy.to_string(), ACCURACY_RANGE))?;
+    let oracle = file.decoder == DecoderChoice::Oracle;
+    let requested = rules::accuracy_for(TaskKind::Grid, oracle, accuracy, Origin::Scenario(path))?;
     Ok((requested, user))
 }
 
-/// Refuses what a scenario whose EEG is a recording cannot also set: a
-/// user (the recording is the user), the oracle (it has no EEG), a bank's
-/// size (the bank is the recording's held-out epochs). A `[realism]`
-/// table (a simulated user's) is not used: [`GridScenario::on_recording`].
-fn refuse_with_recording(file: &ScenarioFile, path: &Path) -> Result<()> {
-    let bad =
-        |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
-    const WHY: &str = "nothing, with a recording (eeg.recording): the decoder is calibrated on \
-                       the recording's first part and has the accuracy the recording gives; no \
-                       accuracy is targeted";
+/// What a scenario on own EEG is also given, as its file writes it, in
+/// the order [`rules::own_eeg_is_the_user`] reports them: a user (the
+/// recording is the user), the oracle (it has no EEG), a bank's size (the
+/// bank is the recording's held-out epochs). A `[realism]` table (a
+/// simulated user's) is not used: [`GridScenario::on_own_eeg`].
+fn refuse_with_own_eeg(file: &ScenarioFile, own: &OwnEegSpec, path: &Path) -> Result<()> {
+    let at = Origin::Scenario(path);
+    let goals = file
+        .user
+        .as_ref()
+        .and_then(|u| u.goals)
+        .map(|g| format!("{g:?}").to_lowercase());
+    let bank = file.bank_per_class.map(|n| n.to_string());
+    let mut claims = Vec::new();
     if let Some(u) = &file.user {
         if let Some(a) = u.accuracy {
-            return Err(bad("user.accuracy", a.to_string(), WHY));
+            claims.push((Claim::Accuracy(a), at));
         }
         if let Some(name) = &u.subject {
-            return Err(bad("user.subject", format!("{name:?}"), WHY));
+            claims.push((Claim::Subject(name), at));
         }
-        if let Some(g) = u.goals {
-            return Err(bad("user.goals", format!("{g:?}").to_lowercase(), WHY));
-        }
+    }
+    if let Some(g) = &goals {
+        claims.push((Claim::Goals(g), at));
     }
     if file.decoder == DecoderChoice::Oracle {
-        return Err(bad(
-            "decoder",
-            "\"oracle\"".into(),
-            "\"eeg\" with a recording (eeg.recording): the oracle reads no EEG",
-        ));
+        claims.push((Claim::Oracle, at));
     }
-    if let Some(n) = file.bank_per_class {
-        return Err(bad(
-            "bank_per_class",
-            n.to_string(),
-            "nothing, with a recording (eeg.recording): the bank is the recording's held-out \
-             epochs",
-        ));
+    if let Some(n) = &bank {
+        claims.push((Claim::BankPerClass(n), at));
     }
-    Ok(())
-}
-
-/// The accuracies a grid decoder may have, in words.
-pub(crate) const ACCURACY_RANGE: &str =
-    "a mean accuracy in (0.5, 1) for the EEG decoder, (0.5, 1] for the oracle";
-
-/// `accuracy` if `decoder` can have it: a real decoder is targeted at a
-/// mean accuracy; the oracle may also be perfect.
-pub(crate) fn checked_accuracy(accuracy: f64, decoder: DecoderChoice) -> Option<RequestedAccuracy> {
-    match (RequestedAccuracy::new(accuracy), decoder) {
-        (Ok(a @ RequestedAccuracy::Targeted(_)), _)
-        | (Ok(a @ RequestedAccuracy::Perfect), DecoderChoice::Oracle) => Some(a),
-        _ => None,
-    }
+    rules::own_eeg_is_the_user(Some(own.origin(path, TaskKind::Grid)), &claims)
 }
 
 impl GridScenario {
@@ -464,16 +456,13 @@ impl GridScenario {
     /// Python): its decoder calibrated on the recording's first part, its
     /// user the recording (a simulated user's `[realism]` is not used, and
     /// its user says so). Refused for the oracle, which reads no EEG.
-    pub fn on_recording(mut self, eeg: RecordedEeg) -> Result<Self> {
-        let bad = |field: &str, value: String, expected: &str| {
-            field_error(&self.path, field, value, expected)
-        };
+    pub fn on_own_eeg(mut self, eeg: OwnEegSpec) -> Result<Self> {
         if self.decoder == DecoderChoice::Oracle {
-            return Err(bad(
-                "decoder",
-                "\"oracle\"".into(),
-                "\"eeg\" with a recording: the oracle reads no EEG",
-            ));
+            let own = eeg.origin(&self.path, TaskKind::Grid);
+            rules::own_eeg_is_the_user(
+                Some(own),
+                &[(Claim::Oracle, Origin::Scenario(&self.path))],
+            )?;
         }
         self.user = format!("recording {}", eeg.written);
         if self.realism != Realism::default() {
@@ -482,7 +471,7 @@ impl GridScenario {
             self.realism = Realism::default();
         }
         self.eeg = EegMode::Bank;
-        self.accuracy = GridAccuracy::Recorded(Box::new(eeg));
+        self.accuracy = GridAccuracy::OwnEeg(Box::new(eeg));
         Ok(self)
     }
 }
@@ -528,7 +517,7 @@ fn start_goal_pairs(file: &ScenarioFile, path: &Path) -> Result<Vec<(Cell, Cell)
     }
     if let Some(free) = &file.free_goals {
         let count = whole(path, "free_goals.count", free.count, 1, MAX_PAIRS, "")?;
-        let mut rng = errp_bci::rng::stream(file.seed, "scenario/free-goals");
+        let mut rng = errp_bci::rng::labelled(file.seed, "scenario/free-goals");
         pairs.extend(free_pairs(&grid, count, &mut rng));
     }
     if pairs.is_empty() {

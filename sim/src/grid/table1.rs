@@ -128,7 +128,7 @@ pub fn run_table1(
                 GoalSet::Free => free_pairs(
                     &grid,
                     5,
-                    &mut errp_bci::rng::stream(cell_seed, "table1/free-goals"),
+                    &mut errp_bci::rng::labelled(cell_seed, "table1/free-goals"),
                 ),
             };
             let scenario = GridScenario::builder("table1", options.decoder, *accuracy, cell_seed)

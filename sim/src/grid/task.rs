@@ -14,13 +14,14 @@ use crate::grid::plant::GridEpisodeResult;
 use crate::grid::run::{GridShared, prepare_grid_decoder};
 use crate::grid::scenario::{DecoderChoice, EegMode, GridAccuracy, GridScenario};
 use crate::key::StableKey;
+use crate::task_kind::TaskKind;
 
 /// About the memory of one epoch in a bank: 312 features and the FCz
 /// trace, as f64.
 const BANK_EPOCH_BYTES: usize = 5_000;
 use crate::paper::PAPER;
 use crate::task::{
-    Column, ColumnKind, DecoderInfo, EpisodeRow, FieldError, FigureText, PaperPoint, Task,
+    ColumnKind, DecoderInfo, EpisodeColumn, EpisodeRow, FieldError, FigureText, PaperPoint, Task,
     TaskInfo, format_number, overall,
 };
 
@@ -66,21 +67,21 @@ pub struct GridRunner {
 
 impl Task for GridTask {
     const INFO: TaskInfo = TaskInfo {
-        name: "grid",
+        kind: TaskKind::Grid,
         columns: &[
-            Column::new("start_x", ColumnKind::Cell),
-            Column::new("start_y", ColumnKind::Cell),
-            Column::new("goal_x", ColumnKind::Cell),
-            Column::new("goal_y", ColumnKind::Cell),
-            Column::new("committed_x", ColumnKind::OptCell),
-            Column::new("committed_y", ColumnKind::OptCell),
-            Column::new("actions", ColumnKind::Count),
-            Column::new("net_secs", ColumnKind::NonNegative),
-            Column::new("total_secs", ColumnKind::NonNegative),
-            Column::new("errors", ColumnKind::Count),
-            Column::new("detected", ColumnKind::Count),
-            Column::new("false_alarms", ColumnKind::Count),
-            Column::new("missed", ColumnKind::Count),
+            EpisodeColumn::new("start_x", ColumnKind::Cell),
+            EpisodeColumn::new("start_y", ColumnKind::Cell),
+            EpisodeColumn::new("goal_x", ColumnKind::Cell),
+            EpisodeColumn::new("goal_y", ColumnKind::Cell),
+            EpisodeColumn::new("committed_x", ColumnKind::OptCell),
+            EpisodeColumn::new("committed_y", ColumnKind::OptCell),
+            EpisodeColumn::new("actions", ColumnKind::Count),
+            EpisodeColumn::new("net_secs", ColumnKind::NonNegative),
+            EpisodeColumn::new("total_secs", ColumnKind::NonNegative),
+            EpisodeColumn::new("errors", ColumnKind::Count),
+            EpisodeColumn::new("detected", ColumnKind::Count),
+            EpisodeColumn::new("false_alarms", ColumnKind::Count),
+            EpisodeColumn::new("missed", ColumnKind::Count),
         ],
         cost_column: "actions",
         cost_label: "actions",
@@ -118,7 +119,7 @@ impl Task for GridTask {
         let key = StableKey::new("grid-decoder", 1);
         let key = match &s.accuracy {
             GridAccuracy::Requested(a) => key.float("accuracy", a.get()),
-            GridAccuracy::Recorded(r) => key
+            GridAccuracy::OwnEeg(r) => key
                 .text("recording", &r.file.display().to_string())
                 .text("calibration", &format!("{:?}", r.part))
                 .text("error", &r.names.error)
@@ -229,7 +230,7 @@ impl Task for GridTask {
             task: "Grid task".into(),
             decoder: match s.decoder {
                 DecoderChoice::Oracle => "oracle decoder".into(),
-                DecoderChoice::Eeg => format!("EEG decoder ({:?})", s.eeg).to_lowercase(),
+                DecoderChoice::Eeg => format!("eeg decoder ({})", s.eeg.key().replace('_', " ")),
             },
             cost_label: "actions to convergence (successful episodes)".into(),
             paper: PAPER

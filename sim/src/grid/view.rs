@@ -290,7 +290,7 @@ fn log_step(
     t0: f64,
     step: &GridStep,
 ) -> rerun::RecordingStreamResult<()> {
-    let fs = 256.0;
+    let fs = errp_bci::SFREQ_HZ;
     let t = t0 + step.onset_secs;
     rec.set_duration_secs(SIM_TIME, t);
     let has_belief = step.belief.iter().all(|p| p.is_finite());

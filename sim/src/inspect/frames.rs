@@ -19,11 +19,11 @@ use re_protos::log_msg::v1alpha1::ArrowMsg;
 use rerun::external::arrow::ipc::root_as_message;
 
 /// Bytes of a stream header: `RRF2`, the Rerun version, the options.
-const STREAM_HEADER: u64 = 12;
+const RRD_HEADER: u64 = 12;
 /// Bytes of a message header: the kind and the length (u64 each).
 const MESSAGE_HEADER: u64 = 16;
 /// Bytes of the stream footer after the end-of-stream message (one entry).
-const STREAM_FOOTER: u64 = 32;
+const RRD_FOOTER: u64 = 32;
 /// The message kinds of Rerun 0.36: end of stream, store info, Arrow
 /// data, blueprint activation.
 const KIND_END: u64 = 0;
@@ -43,8 +43,8 @@ pub(crate) fn check(reader: &mut (impl Read + Seek), len: u64) -> Result<(), Str
     let mut at = 0u64;
     let mut payload = Vec::new();
     while at < len {
-        stream_header(reader, at, len)?;
-        at += STREAM_HEADER;
+        rrd_header(reader, at, len)?;
+        at += RRD_HEADER;
         loop {
             if len - at < MESSAGE_HEADER {
                 return Err(format!(
@@ -80,7 +80,7 @@ pub(crate) fn check(reader: &mut (impl Read + Seek), len: u64) -> Result<(), Str
             }
             at += MESSAGE_HEADER + size;
             if kind == KIND_END {
-                if len - at < STREAM_FOOTER {
+                if len - at < RRD_FOOTER {
                     return Err(format!(
                         "it is truncated: it ends at byte {len} inside its stream footer"
                     ));
@@ -88,10 +88,10 @@ pub(crate) fn check(reader: &mut (impl Read + Seek), len: u64) -> Result<(), Str
                 reader
                     .seek(SeekFrom::Start(at))
                     .map_err(|e| e.to_string())?;
-                let mut footer = [0u8; STREAM_FOOTER as usize];
+                let mut footer = [0u8; RRD_FOOTER as usize];
                 read_exact(reader, &mut footer, at)?;
-                stream_footer(&footer, at)?;
-                at += STREAM_FOOTER;
+                rrd_footer(&footer, at)?;
+                at += RRD_FOOTER;
                 break;
             }
         }
@@ -100,14 +100,14 @@ pub(crate) fn check(reader: &mut (impl Read + Seek), len: u64) -> Result<(), Str
 }
 
 /// Checks the stream header at `at`: `RRF2`, options this decoder reads.
-fn stream_header(reader: &mut impl Read, at: u64, len: u64) -> Result<(), String> {
-    if len - at < STREAM_HEADER {
+fn rrd_header(reader: &mut impl Read, at: u64, len: u64) -> Result<(), String> {
+    if len - at < RRD_HEADER {
         return Err(format!(
             "it is corrupt: {} byte(s) after byte {at} are not a Rerun stream",
             len - at
         ));
     }
-    let mut head = [0u8; STREAM_HEADER as usize];
+    let mut head = [0u8; RRD_HEADER as usize];
     read_exact(reader, &mut head, at)?;
     if &head[..4] != b"RRF2" {
         return Err(format!(
@@ -127,7 +127,7 @@ fn stream_header(reader: &mut impl Read, at: u64, len: u64) -> Result<(), String
 /// Checks the stream footer at `at`: one entry (20 bytes: the span of
 /// the RRD footer and its checksum), then `RRF2`, `FOOT` and the number of
 /// entries, 1 (the decoder allocates as many as that number says).
-fn stream_footer(footer: &[u8; STREAM_FOOTER as usize], at: u64) -> Result<(), String> {
+fn rrd_footer(footer: &[u8; RRD_FOOTER as usize], at: u64) -> Result<(), String> {
     let entries = u32::from_le_bytes(footer[28..].try_into().expect("4 bytes"));
     if &footer[20..24] != b"RRF2" || &footer[24..28] != b"FOOT" || entries != 1 {
         return Err(format!(
@@ -264,9 +264,9 @@ mod tests {
         let mut footer = [0u8; 32];
         footer[20..28].copy_from_slice(b"RRF2FOOT");
         footer[28] = 1;
-        stream_footer(&footer, 100).unwrap();
+        rrd_footer(&footer, 100).unwrap();
         footer[31] = 0x80;
-        let e = stream_footer(&footer, 100).unwrap_err();
+        let e = rrd_footer(&footer, 100).unwrap_err();
         assert!(e.contains("stream footer at byte 100"), "{e}");
     }
 

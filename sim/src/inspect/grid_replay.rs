@@ -1,13 +1,19 @@
 //! A grid recording's episodes recomputed from its table of actions, with
 //! the episode's own tally.
 
-#[allow(clippy::wildcard_imports, unused_imports)]
-use super::*;
-use crate::record::schema::{Actions, ActionsView, GridRuns, GridRunsView};
+use std::collections::BTreeMap;
+
+use errp_robot::{Cell, Grid, GridAction};
+
+use crate::grid::plant::GridTally;
+use crate::grid::{GridEpisodeResult, GridStep};
+use crate::inspect::rows::{check_run_order, index, run_rows};
+use crate::record::data::Table;
+use crate::record::schema::{Actions, ActionsView, Ends, EndsView, GridRuns, GridRunsView};
 
 /// The grid episodes recomputed from their actions.
 pub(super) fn grid_results(
-    tables: &std::collections::BTreeMap<String, Table>,
+    tables: &BTreeMap<String, Table>,
 ) -> Result<Vec<GridEpisodeResult>, String> {
     let grid = Grid::paper();
     let runs = GridRunsView::of(tables)?;

@@ -7,15 +7,18 @@ use std::collections::BTreeMap;
 use crate::epuck::EpuckRunRow;
 use crate::error::SimError;
 use crate::grid::GridEpisodeRow;
-use crate::inspect::{Recording, Runs, Table, run_rows};
+use crate::inspect::rows::{check_run_order, index, run_rows};
+use crate::inspect::{Recording, Runs, Table};
 use crate::live::{Fate, LiveRunStats, LoggedDecision, Received};
+use crate::pace::Speed;
 use crate::record::schema::{ActionsView, LiveDecisions, LiveDecisionsView, WindowsView};
+use crate::task_kind::TaskKind;
 
 /// The decisions of a live session, per run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LiveSession {
     /// Simulated seconds per second of the link's clock.
-    pub speed: f64,
+    pub speed: Speed,
     /// The decoder's stream, as found (`name=...`).
     pub decoder: String,
     /// Each run's decisions (arrivals on the run's clock over `speed`:
@@ -26,22 +29,21 @@ pub struct LiveSession {
     pub applied: Vec<Vec<Vec<f64>>>,
 }
 
-/// The session in `tables` of `runs` runs, live at `speed` from `decoder`;
-/// `grid` for a grid recording (decisions applied to actions, else to
+/// The session in `tables` of `runs` runs of `task`, live at `speed` from
+/// `decoder` (the grid's decisions apply to actions, the e-puck's to
 /// windows).
 pub(super) fn live_session(
     tables: &BTreeMap<String, Table>,
     runs: usize,
-    (speed, decoder): (f64, &str),
-    grid: bool,
+    (speed, decoder): (Speed, &str),
+    task: TaskKind,
 ) -> Result<LiveSession, String> {
     let d = LiveDecisionsView::of_or_empty(tables)?;
-    super::check_run_order(LiveDecisions::ENTITY, d.run)?;
+    check_run_order(LiveDecisions::ENTITY, d.run)?;
     // What each run's decisions apply to: its actions or its windows.
-    let (slots_run, slot_name) = if grid {
-        (ActionsView::of_or_empty(tables)?.run, "action")
-    } else {
-        (WindowsView::of(tables)?.run, "window")
+    let (slots_run, slot_name) = match task {
+        TaskKind::Grid => (ActionsView::of_or_empty(tables)?.run, "action"),
+        TaskKind::Epuck => (WindowsView::of(tables)?.run, "window"),
     };
     let mut session = LiveSession {
         speed,
@@ -55,7 +57,7 @@ pub(super) fn live_session(
         let mut stats = LiveRunStats::default();
         for i in run_rows(d.run, k) {
             let fate = match (d.fate[i].as_str(), d.applied_to[i]) {
-                ("applied", a) => Fate::Applied(super::index(a, slots, slot_name)?),
+                ("applied", a) => Fate::Applied(index(a, slots, slot_name)?),
                 ("late", -1) => Fate::Late,
                 ("stray", -1) => Fate::Stray,
                 (f, a) => {
@@ -80,13 +82,13 @@ pub(super) fn live_session(
                 received: Received {
                     id: d.id[i],
                     p_error: p,
-                    arrived: d.t_s[i] / speed,
+                    arrived: speed.to_link(d.t_s[i]),
                 },
                 latency_secs: d.latency_s[i],
                 fate,
             });
         }
-        if grid && applied.iter().any(|a| a.len() > 1) {
+        if task == TaskKind::Grid && applied.iter().any(|a| a.len() > 1) {
             return Err(format!(
                 "its table {} applies two decisions to one action",
                 LiveDecisions::ENTITY
@@ -159,7 +161,7 @@ impl Recording {
                 Ok(LiveReplay::of(results, &replayed, row))
             }
             Runs::Epuck { scenario, results } => {
-                let decoder = crate::live::epuck::prepare_live_epuck(scenario)?;
+                let decoder = crate::live::epuck::prepare_live_epuck(scenario, &())?;
                 let replayed = crate::live::epuck::replay_epuck(scenario, &decoder, &live.applied)?;
                 let layout = &scenario.layout;
                 let row = |index, result: &_| {

@@ -9,6 +9,7 @@ use crate::epuck::{EpuckRunsTable, EpuckSummaryReport, summarise};
 use crate::grid::{GridEpisodeHeader, GridEpisodeRow, GridRunReport};
 use crate::inspect::{Recording, Runs, phase_secs};
 use crate::stats::{fixed_or_dash, median};
+use crate::task_kind::TaskKind;
 
 /// One line on a recording: its file, task, scenario, runs and maker.
 pub struct RecordingHeadline<'a>(pub &'a Recording);
@@ -44,7 +45,7 @@ fn headline(r: &Recording) -> String {
     format!(
         "{}: {} recording of `{}`, {} run(s), seed {}, by errp {} (commit {})",
         r.path.display(),
-        if p.task == "epuck" { "e-puck" } else { "grid" },
+        p.task.label(),
         p.scenario_name,
         p.runs,
         p.seed,
@@ -59,7 +60,7 @@ fn describe(f: &mut fmt::Formatter<'_>, r: &Recording) -> fmt::Result {
     let p = &r.provenance;
     writeln!(f, "{}", headline(r))?;
     writeln!(f, "  made by:  {}", p.command.join(" "))?;
-    let runs = if p.task == "epuck" {
+    let runs = if p.task == TaskKind::Epuck {
         format!(" --runs {}", p.runs)
     } else {
         String::new()
@@ -136,14 +137,14 @@ fn describe(f: &mut fmt::Formatter<'_>, r: &Recording) -> fmt::Result {
             let report = GridRunReport {
                 scenario: (**scenario).clone(),
                 calibration: None,
-                recorded: None,
+                own_eeg: None,
                 episodes: results.clone(),
             };
             write!(f, "{report}")?;
         }
     }
     if let Some(live) = &r.live {
-        let windows = matches!(r.runs, Runs::Epuck { .. });
+        let windows = r.runs.kind() == TaskKind::Epuck;
         writeln!(f)?;
         writeln!(
             f,

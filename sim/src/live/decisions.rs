@@ -4,6 +4,7 @@
 //! decoder keeps ([`Silence`]).
 
 use crate::error::{Result, SimError};
+use crate::pace::Speed;
 
 /// A decision as the decoder sent it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -104,10 +105,13 @@ impl LiveRunStats {
     /// and those missed, late and stray; `windows` for the e-puck's (a
     /// latency from the window's last sample; a device window without a
     /// decision).
-    pub fn timing(&self, windows: bool, speed: Option<f64>) -> String {
-        let ms = |q: f64, k: f64| {
-            self.latency_quantile(q)
-                .map_or("-".into(), |v| format!("{:.0}", v * 1000.0 * k))
+    pub fn timing(&self, windows: bool, speed: Option<Speed>) -> String {
+        // Milliseconds of the link's clock, or of simulated time.
+        let ms = |q: f64, speed: Option<Speed>| {
+            self.latency_quantile(q).map_or("-".into(), |v| {
+                let link = v * 1000.0;
+                format!("{:.0}", speed.map_or(link, |k| k.to_sim(link)))
+            })
         };
         let (from, missed) = if windows {
             ("the window's end", "device windows without one")
@@ -115,14 +119,18 @@ impl LiveRunStats {
             ("the action's onset", "missed")
         };
         let simulated = speed.map_or(String::new(), |k| {
-            format!(" (simulated: {} / {} ms)", ms(0.5, k), ms(0.95, k))
+            format!(
+                " (simulated: {} / {} ms)",
+                ms(0.5, Some(k)),
+                ms(0.95, Some(k))
+            )
         });
         format!(
             "{} applied, latency from {from} median {} ms, 95th percentile {} ms{simulated}; {} \
              {missed}, {} late, {} stray",
             self.latencies_secs().len(),
-            ms(0.5, 1.0),
-            ms(0.95, 1.0),
+            ms(0.5, None),
+            ms(0.95, None),
             self.missed,
             self.late(),
             self.stray()

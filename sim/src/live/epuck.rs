@@ -14,17 +14,18 @@
 
 use errp_bci::rng::derive_seed;
 use errp_bci::{ContinuousCalibrationParams, EegGenerator, Protocol, continuous_schedule};
-use serde_json::json;
 
 use crate::epuck::{
     ContinuousDecoder, EpuckEpisodeResult, EpuckScenario, LiveWindow, PHASE_NAMES, epuck_run_seed,
-    prepare_continuous_decoder, run_epuck_episode_live,
+    prepare_continuous_decoder_with, run_epuck_episode_live,
 };
 use crate::error::{Result, SimError};
-use crate::live::{
-    LiveLink, LiveObserver, LiveOptions, LiveRunStats, Streamer, WindowTracker, begin_control,
-    end_session, stream_calibration, wait_for_decoder,
+use crate::live::contract::{Marker, State};
+use crate::live::session::{Sink, check_rate};
+use crate::live::streamer::{
+    CalibrationMark, begin_control, end_session, stream_calibration, wait_for_decoder,
 };
+use crate::live::{LiveLink, LiveObserver, LiveOptions, LiveRunStats, Streamer, WindowTracker};
 
 /// One run of a live e-puck session.
 #[derive(Debug, Clone, PartialEq)]
@@ -38,30 +39,32 @@ pub struct EpuckLiveRun {
 }
 
 /// Prepares the decoder of `scenario` (the simulated user's EEG model at
-/// the scenario's accuracy), refusing a scenario on a recording.
-pub fn prepare_live_epuck(scenario: &EpuckScenario) -> Result<ContinuousDecoder> {
-    if scenario.recording.is_some() {
-        return Err(SimError::Scenario(format!(
-            "{}: errp stream streams the simulated user's EEG; a scenario on a recording \
-             ([eeg] recording) cannot be streamed",
-            scenario.path.display()
-        )));
-    }
-    Ok(prepare_continuous_decoder(scenario, |_| {})?.0)
+/// the scenario's accuracy), each step of its calibration shown to
+/// `observer`.
+pub fn prepare_live_epuck(
+    scenario: &EpuckScenario,
+    observer: &dyn LiveObserver,
+) -> Result<ContinuousDecoder> {
+    let decoder = prepare_continuous_decoder_with(
+        scenario,
+        |step| observer.targeting(step),
+        |step| observer.online_step(step),
+    )?;
+    Ok(decoder.0)
 }
 
 /// Runs the first `runs` runs of `scenario` live on `link`, after the
 /// calibration session; `decoder` names the decoder's stream in messages.
-pub fn run_epuck_live(
+pub(crate) fn run_epuck_live(
     scenario: &EpuckScenario,
     link: &mut dyn LiveLink,
     options: LiveOptions,
     runs: usize,
     decoder: &str,
-    observer: &mut dyn LiveObserver<EpuckLiveRun>,
+    sink: &mut Sink<'_>,
 ) -> Result<Vec<EpuckLiveRun>> {
-    observer.note("calibrating the simulated user at the scenario's accuracy");
-    let prepared = prepare_live_epuck(scenario)?;
+    sink.note("calibrating the simulated user at the scenario's accuracy");
+    let prepared = prepare_live_epuck(scenario, sink.observer())?;
     let mut protocol = crate::epuck::run::continuous_request(scenario)?
         .setup
         .calibration
@@ -70,8 +73,9 @@ pub fn run_epuck_live(
         protocol.per_class = n / 2;
     }
     let fs = prepared.generator.sfreq_hz;
+    check_rate(fs)?;
     let seed = scenario.user_seed;
-    observer.note(&format!(
+    sink.note(&format!(
         "waiting up to {} s for a program to read the EEG",
         options.timeout_secs
     ));
@@ -83,20 +87,20 @@ pub fn run_epuck_live(
         WindowTracker::new(decoder, options.timeout_secs),
     );
 
-    stream_epuck_calibration(&mut s, &prepared, &protocol, seed, options.speed, observer)?;
+    stream_epuck_calibration(&mut s, &prepared, &protocol, seed, sink)?;
 
     let mut rest = EegGenerator::new(
         &prepared.closed_loop,
         &prepared.montage,
         derive_seed(seed, "live/rest", 0),
     )?;
-    wait_for_decoder(&mut s, &mut rest, options, decoder, observer)?;
+    wait_for_decoder(&mut s, &mut rest, options, decoder, sink)?;
     begin_control(&mut s, runs)?;
 
     let mut out = Vec::with_capacity(runs);
     for k in 0..runs {
-        let run = live_run(&mut s, scenario, &prepared, k, observer)?;
-        observer.run(k, &run);
+        let run = live_run(&mut s, scenario, &prepared, k, sink)?;
+        sink.epuck_run(k, &run)?;
         out.push(run);
     }
     end_session(&mut s, &mut rest)?;
@@ -110,15 +114,15 @@ fn stream_epuck_calibration(
     prepared: &ContinuousDecoder,
     protocol: &ContinuousCalibrationParams,
     seed: u64,
-    speed: f64,
-    observer: &mut dyn LiveObserver<EpuckLiveRun>,
+    sink: &mut Sink<'_>,
 ) -> Result<()> {
     let (actions, presses) = continuous_schedule(protocol, seed);
     let secs = protocol.duration_secs() - protocol.eog_session_secs;
-    observer.note(&format!(
+    let speed = s.pace().speed();
+    sink.note(&format!(
         "calibration: {} examples, {secs:.0} s of EEG ({:.0} s at speed {})",
         actions.len(),
-        secs / speed,
+        speed.to_link(secs),
         speed
     ));
     let mut eeg = EegGenerator::new(
@@ -126,7 +130,7 @@ fn stream_epuck_calibration(
         &prepared.montage,
         derive_seed(seed, "live/calibration", 0),
     )?;
-    stream_calibration(s, &mut eeg, &actions, "calibration_example", |i| {
+    stream_calibration(s, &mut eeg, &actions, CalibrationMark::Example, |i| {
         presses[i] - actions[i].onset_secs
     })
 }
@@ -138,13 +142,14 @@ fn live_run(
     scenario: &EpuckScenario,
     prepared: &ContinuousDecoder,
     k: usize,
-    observer: &mut dyn LiveObserver<EpuckLiveRun>,
+    sink: &mut Sink<'_>,
 ) -> Result<EpuckLiveRun> {
     let names = scenario.layout.goals();
     let goal = scenario.episode.goal;
-    s.marker(&json!({
-        "event": "run_start", "run": k, "goal": names[goal].name,
-    }))?;
+    s.marker(&Marker::EpuckRunStart {
+        run: k,
+        goal: &names[goal].name,
+    })?;
     let mut decisions = Vec::new();
     let mut phase = None;
     let mut decide = |w: &LiveWindow<'_>| -> Result<Vec<f64>> {
@@ -157,29 +162,35 @@ fn live_run(
             phase = Some(w.phase);
             let stamp = s.now_stamp();
             s.tracker.phase_began(stamp);
-            s.marker(&json!({
-                "event": "phase", "run": k, "phase": PHASE_NAMES[w.phase],
-                "target": names[w.target].name,
-            }))?;
+            s.marker(&Marker::Phase {
+                run: k,
+                phase: PHASE_NAMES[w.phase],
+                target: &names[w.target].name,
+            })?;
         }
         let p = &w.tracked;
-        s.state(&json!({
-            "run": k, "time": w.time_secs, "pose": [p.x_m, p.y_m, p.heading_rad],
-            "target": w.target, "goal": goal, "belief": w.belief,
-        }))?;
+        s.state(&State::Epuck {
+            run: k,
+            time: w.time_secs,
+            pose: [p.x_m, p.y_m, p.heading_rad],
+            target: w.target,
+            goal,
+            belief: w.belief,
+        })?;
         s.stream(w.raw)?;
         let got = s.tracker.take();
         decisions.push(got.clone());
         Ok(got)
     };
     let seed = epuck_run_seed(scenario.seed, k);
-    let mut watch = observer.watch(k, seed);
+    let mut watch = sink.watch(k, seed);
     let result = run_epuck_episode_live(scenario, prepared, seed, &mut decide, &mut watch)?;
-    s.marker(&json!({
-        "event": "run_end", "run": k, "reached": result.reached(),
-        "committed": result.committed.map(|j| names[j].name.clone()),
-        "time": result.time_secs,
-    }))?;
+    s.marker(&Marker::EpuckRunEnd {
+        run: k,
+        reached: result.reached(),
+        committed: result.committed.map(|j| names[j].name.as_str()),
+        time: result.time_secs,
+    })?;
     Ok(EpuckLiveRun {
         result,
         stats: s.tracker.take_run(),

@@ -14,17 +14,18 @@
 use errp_bci::rng::derive_seed;
 use errp_bci::{Assessment, AssessmentKind, CalibrationSetup, EegGenerator, Protocol, schedule};
 use errp_robot::{Cell, Grid, GridControlParams, QTable};
-use serde_json::json;
 
 use crate::error::{Result, SimError};
 use crate::grid::{
     AssessmentDecoder, GridDecoding, GridEpisodeResult, GridScenario, LiveAction,
     grid_episode_seed, prepare_decoder, run_grid_episode_with,
 };
-use crate::live::{
-    DecisionTracker, LiveLink, LiveObserver, LiveOptions, LiveRunStats, Streamer, begin_control,
-    end_session, stream_calibration, wait_for_decoder,
+use crate::live::contract::{CellXy, Marker, State};
+use crate::live::session::{Sink, check_rate};
+use crate::live::streamer::{
+    CalibrationMark, begin_control, end_session, stream_calibration, wait_for_decoder,
 };
+use crate::live::{DecisionTracker, LiveLink, LiveOptions, LiveRunStats, Streamer};
 
 /// One run of a live grid session.
 #[derive(Debug, Clone, PartialEq)]
@@ -37,29 +38,24 @@ pub struct GridLiveRun {
     pub decisions: Vec<Option<f64>>,
 }
 
-fn cell(c: Cell) -> serde_json::Value {
-    json!([c.x, c.y])
+fn cell(c: Cell) -> CellXy {
+    [c.x, c.y]
 }
 
 /// Runs the first `runs` episodes of `scenario` live on `link`, after the
-/// calibration session; `decoder` names the decoder's stream in messages.
-pub fn run_grid_live(
+/// calibration session; `decoder` names the decoder's stream in messages
+/// ([`crate::live::LiveSession`] refused a scenario on own EEG).
+pub(crate) fn run_grid_live(
     scenario: &GridScenario,
     link: &mut dyn LiveLink,
     options: LiveOptions,
     runs: usize,
     decoder: &str,
-    observer: &mut dyn LiveObserver<GridLiveRun>,
+    sink: &mut Sink<'_>,
 ) -> Result<Vec<GridLiveRun>> {
-    if scenario.accuracy.recorded().is_some() {
-        return Err(SimError::Scenario(format!(
-            "{}: errp stream streams the simulated user's EEG; a scenario on a recording \
-             ([eeg] recording) cannot be streamed",
-            scenario.path.display()
-        )));
-    }
-    observer.note("calibrating the simulated user at the scenario's accuracy");
-    let (prepared, report) = prepare_decoder(scenario, |_| {})?;
+    sink.note("calibrating the simulated user at the scenario's accuracy");
+    let observer = sink.observer();
+    let (prepared, report) = prepare_decoder(scenario, |step| observer.targeting(step))?;
     let (closed_loop, report) = match (&prepared, report) {
         (AssessmentDecoder::Eeg(d), Some(r)) => (d.generator.clone(), r),
         (AssessmentDecoder::EegBank(b), Some(r)) => (b.decoder.generator.clone(), r),
@@ -76,8 +72,9 @@ pub fn run_grid_live(
         setup.calibration.n_actions = n;
     }
     let fs = setup.generator.sfreq_hz;
+    check_rate(fs)?;
     let seed = scenario.seed;
-    observer.note(&format!(
+    sink.note(&format!(
         "waiting up to {} s for a program to read the EEG",
         options.timeout_secs
     ));
@@ -89,7 +86,7 @@ pub fn run_grid_live(
         DecisionTracker::new(decoder, options.timeout_secs),
     );
 
-    stream_grid_calibration(&mut s, &setup, seed, options.speed, observer)?;
+    stream_grid_calibration(&mut s, &setup, seed, sink)?;
 
     // Rest until the decoder's stream appears, from a generator of its
     // own: however long the wait, the control's EEG is the same.
@@ -98,7 +95,7 @@ pub fn run_grid_live(
         &setup.montage,
         derive_seed(seed, "live/rest", 0),
     )?;
-    wait_for_decoder(&mut s, &mut rest, options, decoder, observer)?;
+    wait_for_decoder(&mut s, &mut rest, options, decoder, sink)?;
     let mut eeg = EegGenerator::new(
         &closed_loop,
         &setup.montage,
@@ -121,7 +118,7 @@ pub fn run_grid_live(
             (start, goal),
             options,
         )?;
-        observer.run(k, &run);
+        sink.grid_run(k, &run)?;
         out.push(run);
     }
     end_session(&mut s, &mut eeg)?;
@@ -134,25 +131,25 @@ fn stream_grid_calibration(
     s: &mut Streamer<'_, DecisionTracker>,
     setup: &CalibrationSetup,
     seed: u64,
-    speed: f64,
-    observer: &mut dyn LiveObserver<GridLiveRun>,
+    sink: &mut Sink<'_>,
 ) -> Result<()> {
     let protocol = &setup.calibration;
     let actions = schedule(protocol, seed);
     // No EOG session is streamed: the decoder regresses the EOG on the
     // calibration itself.
     let secs = protocol.duration_secs() - protocol.eog_session_secs;
-    observer.note(&format!(
+    let speed = s.pace().speed();
+    sink.note(&format!(
         "calibration: {} actions, {secs:.0} s of EEG ({:.0} s at speed {speed})",
         actions.len(),
-        secs / speed,
+        speed.to_link(secs),
     ));
     let mut eeg = EegGenerator::new(
         &setup.generator,
         &setup.montage,
         derive_seed(seed, "live/calibration", 0),
     )?;
-    stream_calibration(s, &mut eeg, &actions, "calibration_action", |_| 0.0)
+    stream_calibration(s, &mut eeg, &actions, CalibrationMark::Action, |_| 0.0)
 }
 
 /// Run `k` of `scenario`, from `start` to `goal`, live on `s`, the EEG
@@ -167,21 +164,29 @@ fn live_run(
     options: LiveOptions,
 ) -> Result<GridLiveRun> {
     let fs = eeg.params().sfreq_hz;
-    s.marker(&json!({
-        "event": "run_start", "run": k, "start": cell(start), "goal": cell(goal),
-    }))?;
+    s.marker(&Marker::GridRunStart {
+        run: k,
+        start: cell(start),
+        goal: cell(goal),
+    })?;
     s.stream(&eeg.generate((options.rest_secs * fs).round() as usize))?;
     let mut decisions = Vec::new();
     let mut decide = |a: &LiveAction<'_>| -> Result<Option<f64>> {
-        s.state(&json!({
-            "run": k, "cursor": cell(a.from), "goal": cell(goal), "belief": a.belief,
-        }))?;
+        s.state(&State::Grid {
+            run: k,
+            cursor: cell(a.from),
+            goal: cell(goal),
+            belief: a.belief,
+        })?;
         let onset = s.now_stamp();
         let id = s.tracker.announce(onset);
-        s.marker(&json!({
-            "event": "action", "run": k, "action": id, "name": a.action.name(),
-            "from": cell(a.from), "to": cell(a.to),
-        }))?;
+        s.marker(&Marker::Action {
+            run: k,
+            action: id,
+            name: a.action.name(),
+            from: cell(a.from),
+            to: cell(a.to),
+        })?;
         eeg.schedule(Assessment {
             onset_secs: eeg.now_secs(),
             kind: if a.error {
@@ -204,10 +209,12 @@ fn live_run(
         grid_episode_seed(scenario.seed, k),
         true,
     )?;
-    s.marker(&json!({
-        "event": "run_end", "run": k, "reached": result.reached(),
-        "committed": result.committed.map(cell), "actions": result.actions,
-    }))?;
+    s.marker(&Marker::GridRunEnd {
+        run: k,
+        reached: result.reached(),
+        committed: result.committed.map(cell),
+        actions: result.actions,
+    })?;
     Ok(GridLiveRun {
         result,
         stats: s.tracker.take_run(),

@@ -1,12 +1,14 @@
 //! Real time: the simulated user and device on the wall clock, with a
 //! decoder outside the process in the loop (`errp stream`).
 //!
-//! The loop publishes the user's raw EEG, markers and the device's state
-//! through a [`LiveLink`] (Lab Streaming Layer in `errp stream`; anything
-//! with a clock in the tests) and takes the decoder's decisions back from
-//! it. Simulated time runs `speed` times faster than the link's clock: the
-//! sample `n` carries the timestamp `origin + n / (fs * speed)` and is
-//! published once that time has passed, 16 samples (62.5 ms) at a time.
+//! A [`LiveSession`] publishes the user's raw EEG, markers and the
+//! device's state through a [`LiveLink`] (Lab Streaming Layer in `errp
+//! stream`, [`LslLink`]; anything with a clock in the tests) and takes the
+//! decoder's decisions back from it, all as the stream contract says
+//! ([`contract`]). Simulated time runs `speed` times faster than the
+//! link's clock ([`crate::pace`]): the sample `n` carries the timestamp `origin +
+//! n / (fs * speed)` and is published once that time has passed, 16
+//! samples (62.5 ms) at a time.
 //!
 //! Timing has rules ([`DecisionTracker`]): an action's decision must come
 //! before the next action; one that comes later is counted late and not
@@ -14,21 +16,30 @@
 
 use errp_bci::EegBlock;
 
-use crate::epuck::EpuckObserver;
 use crate::error::{Result, SimError};
+use crate::live::epuck::EpuckLiveRun;
+use crate::live::grid::GridLiveRun;
+use crate::names::Names;
+use crate::pace::{self, Speed};
+use crate::runner::RunObserver;
 
+pub mod contract;
 mod decisions;
 pub mod epuck;
 pub mod grid;
+mod lsl;
 #[cfg(feature = "rerun")]
 pub mod save;
+mod session;
+mod streamer;
 
 pub use decisions::{
     DecisionTracker, Decisions, Fate, LiveRunStats, LoggedDecision, Received, WindowTracker,
 };
+pub use lsl::LslLink;
+pub use session::{LiveOutcome, LiveRequest, LiveSession};
+pub use streamer::Streamer;
 
-/// The fastest a live loop runs: 100 times the wall clock.
-pub const MAX_SPEED: f64 = 100.0;
 /// The longest wait for a silent decoder (s).
 pub const MAX_TIMEOUT_SECS: f64 = 3600.0;
 /// Samples published at once: 62.5 ms at 256 Hz.
@@ -37,9 +48,8 @@ pub const HOP_SAMPLES: usize = 16;
 /// How a live loop runs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LiveOptions {
-    /// Simulated seconds per second of the link's clock, in (0,
-    /// [`MAX_SPEED`]].
-    pub speed: f64,
+    /// Simulated seconds per second of the link's clock.
+    pub speed: Speed,
     /// Seconds of the link's clock the loop waits for a decoder that has
     /// not appeared or has gone silent before it stops, in (0,
     /// [`MAX_TIMEOUT_SECS`]].
@@ -60,7 +70,7 @@ pub const MAX_CALIBRATION_ACTIONS: usize = 4000;
 impl Default for LiveOptions {
     fn default() -> Self {
         Self {
-            speed: 1.0,
+            speed: Speed::REAL_TIME,
             timeout_secs: 30.0,
             rest_secs: 3.0,
             calibration_actions: None,
@@ -69,35 +79,47 @@ impl Default for LiveOptions {
 }
 
 impl LiveOptions {
-    /// Checks the speed, the timeout and the calibration's length; errors
-    /// name `names` (the flags).
-    pub fn check(&self, names: [&str; 3]) -> Result<()> {
-        if let Some(n) = self.calibration_actions
+    /// The options a front end gives: the calibration's length, the speed
+    /// and the timeout, checked in that order; errors name them as `names`
+    /// does.
+    pub fn new(
+        speed: f64,
+        timeout_secs: f64,
+        calibration_actions: Option<usize>,
+        names: &Names,
+    ) -> Result<Self> {
+        if let Some(n) = calibration_actions
             && !(MIN_CALIBRATION_ACTIONS..=MAX_CALIBRATION_ACTIONS).contains(&n)
         {
-            return Err(SimError::Scenario(format!(
-                "{}: {n} actions, expected {MIN_CALIBRATION_ACTIONS} to \
-                 {MAX_CALIBRATION_ACTIONS} (the paper: 400)",
-                names[2]
-            )));
+            return Err(SimError::OutOfRange {
+                name: names.calibration_actions.into(),
+                given: format!("{n} actions"),
+                expected: format!(
+                    "{MIN_CALIBRATION_ACTIONS} to {MAX_CALIBRATION_ACTIONS} (the paper: 400)"
+                ),
+            });
         }
-        if !(self.speed.is_finite() && self.speed > 0.0 && self.speed <= MAX_SPEED) {
-            return Err(SimError::Scenario(format!(
-                "{}: {} is not a speed, expected a factor > 0 and at most {MAX_SPEED} (1: real \
-                 time)",
-                names[0], self.speed
-            )));
+        let speed = Speed::new(speed).ok_or_else(|| SimError::OutOfRange {
+            name: names.speed.into(),
+            given: format!("{speed} is not a speed"),
+            expected: format!(
+                "a factor > 0 and at most {} (1: real time)",
+                pace::MAX_SPEED
+            ),
+        })?;
+        if !(timeout_secs.is_finite() && timeout_secs > 0.0 && timeout_secs <= MAX_TIMEOUT_SECS) {
+            return Err(SimError::OutOfRange {
+                name: names.timeout.into(),
+                given: format!("{timeout_secs} is not a timeout"),
+                expected: format!("seconds > 0 and at most {MAX_TIMEOUT_SECS}"),
+            });
         }
-        if !(self.timeout_secs.is_finite()
-            && self.timeout_secs > 0.0
-            && self.timeout_secs <= MAX_TIMEOUT_SECS)
-        {
-            return Err(SimError::Scenario(format!(
-                "{}: {} is not a timeout, expected seconds > 0 and at most {MAX_TIMEOUT_SECS}",
-                names[1], self.timeout_secs
-            )));
-        }
-        Ok(())
+        Ok(Self {
+            speed,
+            timeout_secs,
+            calibration_actions,
+            ..Self::default()
+        })
     }
 }
 
@@ -125,221 +147,39 @@ pub trait LiveLink: Send {
     fn wait(&mut self, until: f64) -> Result<Vec<Received>>;
 }
 
-/// What a live session tells its caller as it goes.
-pub trait LiveObserver<R> {
+/// What a live session tells its front end as it goes: what a run tells
+/// offline ([`RunObserver`]: the calibration's steps), and the session's
+/// own notes and runs.
+pub trait LiveObserver: RunObserver {
     /// A line about the session (its phase, what it waits for).
-    fn note(&mut self, text: &str);
-    /// Run `k` ended.
-    fn run(&mut self, k: usize, run: &R);
-    /// What watches the e-puck's run `k` (seed `seed`) step by step as it
-    /// runs (a recording), if anything; the grid's runs carry their steps.
-    fn watch(&mut self, _k: usize, _seed: u64) -> Option<&mut dyn EpuckObserver> {
-        None
-    }
+    fn note(&mut self, _text: &str) {}
+    /// Grid run `k` ended.
+    fn grid_run(&mut self, _k: usize, _run: &GridLiveRun) {}
+    /// E-puck run `k` ended.
+    fn epuck_run(&mut self, _k: usize, _run: &EpuckLiveRun) {}
 }
 
-/// After the calibration: rest EEG from `eeg` until the decoder's stream
-/// appears (or `options.timeout_secs` pass: an error naming `decoder`).
-pub(crate) fn wait_for_decoder<D: Decisions, R>(
-    s: &mut Streamer<'_, D>,
-    eeg: &mut errp_bci::EegGenerator,
-    options: LiveOptions,
-    decoder: &str,
-    observer: &mut dyn LiveObserver<R>,
-) -> Result<()> {
-    let fs = eeg.params().sfreq_hz;
-    observer.note(&format!(
-        "calibration sent; waiting up to {} s for the decoder stream {decoder:?}",
-        options.timeout_secs
-    ));
-    let waited_from = s.link().clock();
-    loop {
-        s.stream(&eeg.generate((0.25 * fs * options.speed).round().max(1.0) as usize))?;
-        if s.link().connect(0.2)? {
-            observer.note("decoder found; control starts");
-            return Ok(());
-        }
-        if s.link().clock() - waited_from > options.timeout_secs {
-            return Err(SimError::Live(format!(
-                "no decoder stream {decoder:?} appeared within {} s after the calibration \
-                 (--timeout): is the decoder running, and does its stream have that name?",
-                options.timeout_secs
-            )));
-        }
-    }
-}
-
-/// Streams a calibration session: `eeg` up to each assessment of
-/// `schedule`, the assessment scheduled at its onset and its marker
-/// (`event`, with its index and label) stamped `lag_secs(i)` after the
-/// onset (a button press); then 2 s more, between the markers
-/// `calibration_start` and `calibration_end`.
-pub(crate) fn stream_calibration<D: Decisions>(
-    s: &mut Streamer<'_, D>,
-    eeg: &mut errp_bci::EegGenerator,
-    schedule: &[errp_bci::Assessment],
-    event: &str,
-    lag_secs: impl Fn(usize) -> f64,
-) -> Result<()> {
-    let fs = eeg.params().sfreq_hz;
-    s.marker(&serde_json::json!({"event": "calibration_start", "count": schedule.len()}))?;
-    for (i, a) in schedule.iter().enumerate() {
-        let due = (a.onset_secs * fs).round() as i64 - (s.now_secs() * fs).round() as i64;
-        s.stream(&eeg.generate(due.max(0) as usize))?;
-        let error = a.kind == errp_bci::AssessmentKind::Error;
-        let at = s.now_secs() + lag_secs(i);
-        s.marker_at(
-            at,
-            &serde_json::json!({
-                "event": event,
-                "index": i,
-                "label": if error { "error" } else { "correct" },
-            }),
-        )?;
-        eeg.schedule(errp_bci::Assessment {
-            onset_secs: eeg.now_secs(),
-            kind: a.kind,
-        });
-    }
-    s.stream(&eeg.generate((2.0 * fs) as usize))?;
-    s.marker(&serde_json::json!({"event": "calibration_end"}))
-}
-
-/// The control starts: silence counts from now, and the marker says how
-/// many runs follow.
-pub(crate) fn begin_control<D: Decisions>(s: &mut Streamer<'_, D>, runs: usize) -> Result<()> {
-    let now = s.link().clock();
-    s.tracker.start(now);
-    s.marker(&serde_json::json!({"event": "control_start", "runs": runs}))
-}
-
-/// The session ends: the decoder's stream let go, the `end` marker, and 1
-/// s more of `eeg` so that a reader sees the marker inside the EEG.
-pub(crate) fn end_session<D: Decisions>(
-    s: &mut Streamer<'_, D>,
-    eeg: &mut errp_bci::EegGenerator,
-) -> Result<()> {
-    s.link().disconnect();
-    s.marker(&serde_json::json!({"event": "end"}))?;
-    let fs = eeg.params().sfreq_hz;
-    s.stream(&eeg.generate(fs as usize))
-}
-
-/// Publishes the EEG on the link's clock, `speed` times faster than it,
-/// and keeps the decisions coming in the meantime.
-pub struct Streamer<'l, D> {
-    link: &'l mut dyn LiveLink,
-    origin: f64,
-    speed: f64,
-    fs: f64,
-    sent: u64,
-    /// The decisions.
-    pub tracker: D,
-}
-
-impl<'l, D: Decisions> Streamer<'l, D> {
-    /// Starts the clock now: sample 0 is stamped with the link's time.
-    pub fn new(link: &'l mut dyn LiveLink, fs: f64, speed: f64, tracker: D) -> Self {
-        let origin = link.clock();
-        Self {
-            link,
-            origin,
-            speed,
-            fs,
-            sent: 0,
-            tracker,
-        }
-    }
-
-    /// The link.
-    pub fn link(&mut self) -> &mut dyn LiveLink {
-        self.link
-    }
-
-    /// The timestamp of simulated second `secs`.
-    pub fn stamp(&self, secs: f64) -> f64 {
-        self.origin + secs / self.speed
-    }
-
-    /// The simulated time of the next sample (s).
-    pub fn now_secs(&self) -> f64 {
-        self.sent as f64 / self.fs
-    }
-
-    /// The timestamp of the next sample.
-    pub fn now_stamp(&self) -> f64 {
-        self.stamp(self.now_secs())
-    }
-
-    /// Publishes a marker at the next sample.
-    pub fn marker(&mut self, value: &serde_json::Value) -> Result<()> {
-        let stamp = self.now_stamp();
-        self.link.marker(&value.to_string(), stamp)
-    }
-
-    /// Publishes a marker at simulated second `secs`.
-    pub fn marker_at(&mut self, secs: f64, value: &serde_json::Value) -> Result<()> {
-        let stamp = self.stamp(secs);
-        self.link.marker(&value.to_string(), stamp)
-    }
-
-    /// Publishes the state at the next sample.
-    pub fn state(&mut self, value: &serde_json::Value) -> Result<()> {
-        let stamp = self.now_stamp();
-        self.link.state(&value.to_string(), stamp)
-    }
-
-    /// Publishes `block`, [`HOP_SAMPLES`] at a time, each once its last
-    /// sample's time has come, taking the decisions that came meanwhile.
-    pub fn stream(&mut self, block: &EegBlock) -> Result<()> {
-        let period = 1.0 / (self.fs * self.speed);
-        let n = block.n_samples;
-        let mut start = 0;
-        while start < n {
-            let end = (start + HOP_SAMPLES).min(n);
-            let due = self.stamp((self.sent + end as u64) as f64 / self.fs);
-            let got = self.link.wait(due)?;
-            let now = self.link.clock();
-            self.tracker.receive(&got, now)?;
-            let first = self.stamp((self.sent + start as u64) as f64 / self.fs);
-            self.link.eeg(&block.samples(start..end), first, period)?;
-            let last = self.stamp((self.sent + end as u64 - 1) as f64 / self.fs);
-            self.tracker.published(last);
-            errp_bci::stop::check()?;
-            start = end;
-        }
-        self.sent += n as u64;
-        Ok(())
-    }
-}
-
+impl LiveObserver for () {}
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn options_name_their_flags() {
-        let bad = LiveOptions {
-            speed: 0.0,
-            ..LiveOptions::default()
-        };
-        let names = ["--speed", "--timeout", "--calibration-actions"];
-        let e = bad.check(names).unwrap_err().to_string();
+        let names = &Names::CLI;
+        let e = LiveOptions::new(0.0, 30.0, None, names)
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("--speed: 0 is not a speed"), "{e}");
-        let bad = LiveOptions {
-            timeout_secs: f64::NAN,
-            ..LiveOptions::default()
-        };
-        assert!(bad.check(names).is_err());
-        let bad = LiveOptions {
-            calibration_actions: Some(39),
-            ..LiveOptions::default()
-        };
-        let e = bad.check(names).unwrap_err().to_string();
+        assert!(LiveOptions::new(1.0, f64::NAN, None, names).is_err());
+        let e = LiveOptions::new(0.0, 30.0, Some(39), names)
+            .unwrap_err()
+            .to_string();
         assert!(
             e.starts_with("--calibration-actions: 39 actions, expected 40"),
             "{e}"
         );
-        LiveOptions::default().check(names).unwrap();
+        let ok = LiveOptions::new(1.0, 30.0, None, names).unwrap();
+        assert_eq!(ok, LiveOptions::default());
     }
 }

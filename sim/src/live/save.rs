@@ -11,6 +11,7 @@ use crate::grid::{GridRecorder, GridScenario};
 use crate::live::epuck::EpuckLiveRun;
 use crate::live::grid::GridLiveRun;
 use crate::live::{Fate, LiveRunStats};
+use crate::pace::Speed;
 use crate::record::RrdFile;
 use crate::record::data::{LiveProvenance, Provenance};
 use crate::record::schema::LiveDecisions;
@@ -29,7 +30,7 @@ pub struct LiveRecording {
     task: Task,
     provenance: Provenance,
     /// Simulated seconds per second of the link's clock.
-    speed: f64,
+    speed: Speed,
     runs: usize,
 }
 
@@ -133,13 +134,13 @@ fn send_decisions(
     file: &RrdFile,
     k: usize,
     t0: f64,
-    speed: f64,
+    speed: Speed,
     stats: &LiveRunStats,
 ) -> Result<()> {
     let d = &stats.decisions;
     let t_s: Vec<f64> = d
         .iter()
-        .map(|d| (d.received.arrived - stats.origin) * speed)
+        .map(|d| speed.to_sim(d.received.arrived - stats.origin))
         .collect();
     let times: Vec<f64> = t_s.iter().map(|t| t0 + t).collect();
     LiveDecisions {

@@ -99,8 +99,8 @@ fn background(s: &GridScenario) -> Result<Vec<(&'static str, f64)>> {
             erp: false,
             ..Components::default()
         });
-    let raw = g.generate(RESTING_SECS * 256);
     let fs = setup.generator.sfreq_hz;
+    let raw = g.generate(RESTING_SECS * fs as usize);
     let cz = raw.channel(montage.index("Cz")?);
     let oz = raw.channel(montage.index("Oz")?);
     let (f, p) = welch(cz, fs);
@@ -117,7 +117,7 @@ fn background(s: &GridScenario) -> Result<Vec<(&'static str, f64)>> {
     amplitudes.sort_by(f64::total_cmp);
     let median = amplitudes[amplitudes.len() / 2];
     let cz_band = band(cz, fs);
-    let blocks: Vec<f64> = cz_band.chunks_exact(10 * 256).map(sd).collect();
+    let blocks: Vec<f64> = cz_band.chunks_exact(10 * fs as usize).map(sd).collect();
     let spread = sd(&blocks) / (blocks.iter().sum::<f64>() / blocks.len() as f64);
     Ok(vec![
         ("aperiodic_exponent", exponent),

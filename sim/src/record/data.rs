@@ -12,7 +12,9 @@
 use rerun::RecordingStream;
 use serde::{Deserialize, Serialize};
 
+use crate::pace::Speed;
 use crate::record::{RrdFile, paths, record_error};
+use crate::task_kind::TaskKind;
 
 /// [`Provenance::format`] of the recordings this build writes.
 pub const FORMAT: &str = "errp-recording";
@@ -30,8 +32,8 @@ pub struct Provenance {
     pub errp_version: String,
     /// The source commit it was built from ("unknown" outside git).
     pub commit: String,
-    /// `"epuck"` or `"grid"`.
-    pub task: String,
+    /// The task (`"epuck"` or `"grid"`).
+    pub task: TaskKind,
     /// The scenario's name.
     pub scenario_name: String,
     /// The scenario file as run: its text with the command line's overrides
@@ -50,10 +52,14 @@ pub struct Provenance {
     /// drove them. Each run's seed is in `/errp/runs`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub agent: Option<String>,
-    /// Set when the EEG was a person's recording (`[eeg] recording =
-    /// ...`): the file's name, size and SHA-256.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub eeg_recording: Option<crate::files::FileDigest>,
+    /// Set when the EEG was the user's own (`[eeg] recording = ...`): the
+    /// file's name, size and SHA-256 (under the key `eeg_recording`).
+    #[serde(
+        default,
+        rename = "eeg_recording",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub own_eeg: Option<crate::files::FileDigest>,
     /// Set when a decoder outside the process decided, live (`errp
     /// stream`): how. The decisions are in `/errp/decisions`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -64,20 +70,20 @@ pub struct Provenance {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LiveProvenance {
     /// Simulated seconds per second of the link's clock.
-    pub speed: f64,
+    pub speed: Speed,
     /// The decoder's stream, as `--decisions` found it (`name=...`).
     pub decoder: String,
 }
 
 impl Provenance {
     /// The provenance of a recording of `task` made now by this build.
-    pub fn new(task: &str, scenario_name: &str, scenario_text: String, seed: u64) -> Self {
+    pub fn new(task: TaskKind, scenario_name: &str, scenario_text: String, seed: u64) -> Self {
         Self {
             format: FORMAT.into(),
             format_version: FORMAT_VERSION,
             errp_version: env!("CARGO_PKG_VERSION").into(),
             commit: "unknown".into(),
-            task: task.into(),
+            task,
             scenario_name: scenario_name.into(),
             scenario_text,
             seed,
@@ -85,7 +91,7 @@ impl Provenance {
             command: Vec::new(),
             decoder_summary: String::new(),
             agent: None,
-            eeg_recording: None,
+            own_eeg: None,
             live: None,
         }
     }

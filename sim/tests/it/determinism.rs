@@ -46,7 +46,7 @@ fn table1_gives_the_same_results_on_one_and_two_threads() {
         repeats: 1,
         seed: 4,
         decoder: errp_sim::grid::DecoderChoice::Oracle,
-        eeg: errp_sim::grid::EegMode::Stream,
+        eeg: errp_sim::grid::EegMode::PerAction,
         params: GridTaskParams::default(),
         realism: errp_bci::Realism::published(),
     };

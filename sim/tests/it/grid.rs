@@ -159,7 +159,7 @@ fn an_accuracy_override_reaches_the_info_gain_planner() {
             keys: vec![("user.accuracy".into(), toml::Value::Float(accuracy))],
             ..errp_sim::ScenarioInput::new(errp_sim::ScenarioSource::File(path.into()))
         }
-        .load(&errp_sim::FILE_KEYS)
+        .load(&errp_sim::Names::FILE)
         .map(|loaded| loaded.scenario)
     };
     match with(&grid, 0.9).unwrap() {

@@ -267,7 +267,7 @@ fn a_grid_episode_is_the_environment_driven_by_the_shared_control() {
                 GridEnvironment::new(decoder.clone(), params, Some(start), Some(goal), seed)
                     .unwrap();
             let mut controller = GridController::with_table(t.clone(), params.control);
-            let mut rng_policy = errp_bci::rng::stream(seed, "grid/policy");
+            let mut rng_policy = errp_bci::rng::labelled(seed, "grid/policy");
             for _ in 0..params.max_actions {
                 let from = env.cell();
                 let action = controller.choose(from, &mut rng_policy);

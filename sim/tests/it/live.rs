@@ -3,12 +3,19 @@
 //! replay of the decisions applied, and the session recorded and replayed
 //! from its file.
 
+use std::path::{Path, PathBuf};
+
 use errp_bci::EegBlock;
 use errp_sim::grid::GridScenario;
 use errp_sim::live::epuck::EpuckLiveRun;
-use errp_sim::live::grid::{GridLiveRun, replay_grid, run_grid_live};
-use errp_sim::live::{Fate, LiveLink, LiveObserver, LiveOptions, Received};
-use errp_sim::{Result, SimError};
+use errp_sim::live::grid::{GridLiveRun, replay_grid};
+use errp_sim::live::{
+    Fate, LiveLink, LiveObserver, LiveOptions, LiveOutcome, LiveRequest, LiveSession, Received,
+};
+use errp_sim::pace::Speed;
+use errp_sim::{
+    Names, Result, RunObserver, RunProvenance, ScenarioInput, ScenarioSource, SimError,
+};
 use serde_json::Value;
 
 /// A link on a virtual clock: waiting moves the clock; the decoder answers
@@ -110,22 +117,59 @@ impl LiveLink for VirtualLink {
     }
 }
 
-struct Quiet;
-
-impl LiveObserver<GridLiveRun> for Quiet {
-    fn note(&mut self, _text: &str) {}
-    fn run(&mut self, _k: usize, _run: &GridLiveRun) {}
+/// Keeps every run of a session, as the front end sees them.
+#[derive(Debug, Default)]
+struct Runs {
+    grid: Vec<GridLiveRun>,
+    epuck: Vec<EpuckLiveRun>,
 }
 
-impl LiveObserver<EpuckLiveRun> for Quiet {
-    fn note(&mut self, _text: &str) {}
-    fn run(&mut self, _k: usize, _run: &EpuckLiveRun) {}
+impl RunObserver for Runs {}
+
+impl LiveObserver for Runs {
+    fn grid_run(&mut self, _k: usize, run: &GridLiveRun) {
+        self.grid.push(run.clone());
+    }
+
+    fn epuck_run(&mut self, _k: usize, run: &EpuckLiveRun) {
+        self.epuck.push(run.clone());
+    }
+}
+
+fn grid_path() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/grid_fixed_goals.toml")
 }
 
 fn scenario() -> GridScenario {
-    let path =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/grid_fixed_goals.toml");
+    let path = grid_path();
     GridScenario::parse(&std::fs::read_to_string(&path).unwrap(), &path).unwrap()
+}
+
+/// A session of the scenario at `path`, `runs` of its runs at `options`,
+/// recorded at `save` if given, run on `link`: its outcome and its runs.
+fn session(
+    path: &Path,
+    options: LiveOptions,
+    runs: u64,
+    save: Option<&Path>,
+    link: &mut dyn LiveLink,
+) -> Result<(LiveOutcome, Runs)> {
+    let loaded = ScenarioInput::new(ScenarioSource::File(path.to_path_buf())).load(&Names::CLI)?;
+    let request = LiveRequest {
+        options,
+        runs: Some(runs),
+        decoder: "name=virtual",
+        save,
+        provenance: &RunProvenance::default(),
+        names: &Names::CLI,
+    };
+    let mut seen = Runs::default();
+    let outcome = LiveSession::new(loaded, request)?.run(link, &mut seen)?;
+    Ok((outcome, seen))
+}
+
+fn speed(k: f64) -> Speed {
+    Speed::new(k).unwrap()
 }
 
 #[test]
@@ -133,16 +177,18 @@ fn the_decisions_applied_replay_to_the_same_runs() {
     let s = scenario();
     let mut link = VirtualLink::new(7);
     let options = LiveOptions {
-        speed: 50.0,
+        speed: speed(50.0),
         ..LiveOptions::default()
     };
     // Recorded as `errp stream --save` records, when the crate records.
-    #[cfg(feature = "rerun")]
-    let mut observer = saved::Saving::grid(&s, 50.0);
-    #[cfg(not(feature = "rerun"))]
-    let mut observer = Quiet;
-    let runs = run_grid_live(&s, &mut link, options, 2, "virtual", &mut observer).unwrap();
+    let save = cfg!(feature = "rerun").then(|| scratch("grid").join("live.rrd"));
+    let (outcome, seen) = session(&grid_path(), options, 2, save.as_deref(), &mut link).unwrap();
+    let runs = seen.grid;
     assert_eq!(runs.len(), 2);
+    assert_eq!(
+        outcome.reached,
+        runs.iter().map(|r| r.result.reached()).collect::<Vec<_>>()
+    );
     // The calibration: 400 labelled actions, then the control's actions
     // with no label; the EEG at 256 Hz x 50.
     let labelled = link
@@ -194,20 +240,19 @@ fn the_decisions_applied_replay_to_the_same_runs() {
     let e = replay_grid(&s, &short).unwrap_err().to_string();
     assert!(e.contains("more decisions than the 1 recorded"), "{e}");
     #[cfg(feature = "rerun")]
-    saved::check_grid(observer, &runs);
+    saved::check_grid(&outcome, &runs);
 }
 
 #[test]
 fn a_decoder_that_never_answers_stops_the_loop() {
-    let s = scenario();
     let mut link = VirtualLink::new(0);
     link.answers = false;
     let options = LiveOptions {
-        speed: 50.0,
+        speed: speed(50.0),
         timeout_secs: 2.0,
         ..LiveOptions::default()
     };
-    let e = run_grid_live(&s, &mut link, options, 1, "virtual", &mut Quiet).unwrap_err();
+    let e = session(&grid_path(), options, 1, None, &mut link).unwrap_err();
     assert!(matches!(e, SimError::Live(_)), "{e}");
     assert!(
         e.to_string().contains("\"virtual\" sent nothing for"),
@@ -217,14 +262,13 @@ fn a_decoder_that_never_answers_stops_the_loop() {
 
 #[test]
 fn a_decoder_always_late_decides_nothing() {
-    let s = scenario();
     let mut link = VirtualLink::new(1);
     let options = LiveOptions {
-        speed: 50.0,
+        speed: speed(50.0),
         ..LiveOptions::default()
     };
-    let runs = run_grid_live(&s, &mut link, options, 1, "virtual", &mut Quiet).unwrap();
-    let r = &runs[0];
+    let (_, seen) = session(&grid_path(), options, 1, None, &mut link).unwrap();
+    let r = &seen.grid[0];
     // Never applied: the belief never moves and the run fails.
     assert!(r.decisions.iter().all(Option::is_none));
     assert_eq!(r.result.committed, None);
@@ -298,7 +342,7 @@ impl LiveLink for WindowLink {
 #[test]
 fn the_epuck_windows_applied_replay_to_the_same_runs() {
     use errp_sim::epuck::EpuckScenario;
-    use errp_sim::live::epuck::{prepare_live_epuck, replay_epuck, run_epuck_live};
+    use errp_sim::live::epuck::{prepare_live_epuck, replay_epuck};
 
     let scenario_path = path_of_scenario();
     let s = EpuckScenario::parse(
@@ -314,16 +358,13 @@ fn the_epuck_windows_applied_replay_to_the_same_runs() {
         phases: 0,
     };
     let options = LiveOptions {
-        speed: 10.0,
+        speed: speed(10.0),
         calibration_actions: Some(40),
         ..LiveOptions::default()
     };
-    #[cfg(feature = "rerun")]
-    let mut observer = saved::Saving::epuck(&s, 10.0);
-    #[cfg(not(feature = "rerun"))]
-    let mut observer = Quiet;
-    let runs = run_epuck_live(&s, &mut link, options, 1, "virtual", &mut observer).unwrap();
-    let r = &runs[0];
+    let save = cfg!(feature = "rerun").then(|| scratch("epuck").join("live.rrd"));
+    let (outcome, seen) = session(&scenario_path, options, 1, save.as_deref(), &mut link).unwrap();
+    let r = &seen.epuck[0];
     assert!(link.phases >= 2, "{} phase markers", link.phases);
     // Each decision came 20 ms after its window: applied at the next
     // window, 0.2 s of simulated time later at speed 10.
@@ -334,93 +375,43 @@ fn the_epuck_windows_applied_replay_to_the_same_runs() {
     let applied: usize = r.decisions.iter().map(Vec::len).sum();
     assert_eq!(applied, r.stats.latencies_secs().len());
     assert!(r.result.detected_errors > 0, "{:?}", r.result);
-    let decoder = prepare_live_epuck(&s).unwrap();
+    let decoder = prepare_live_epuck(&s, &()).unwrap();
     let again = replay_epuck(&s, &decoder, std::slice::from_ref(&r.decisions)).unwrap();
     assert_eq!(again[0], r.result);
     #[cfg(feature = "rerun")]
-    saved::check_epuck(observer, r, &s);
+    saved::check_epuck(&outcome, r, &s);
+    #[cfg(not(feature = "rerun"))]
+    let _ = outcome;
 }
 
 fn path_of_scenario() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/mexico_to_pisa.toml")
 }
 
+/// An empty directory of this test process.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("errp-live-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
 /// The sessions recorded as `errp stream --save` records them, read back
 /// and replayed.
 #[cfg(feature = "rerun")]
 mod saved {
-    use std::path::{Path, PathBuf};
-
-    use errp_sim::epuck::{EpuckObserver, EpuckScenario};
-    use errp_sim::grid::GridScenario;
+    use errp_sim::epuck::EpuckScenario;
     use errp_sim::inspect::Recording;
     use errp_sim::live::epuck::EpuckLiveRun;
     use errp_sim::live::grid::GridLiveRun;
-    use errp_sim::live::save::LiveRecording;
-    use errp_sim::live::{LiveObserver, LiveRunStats};
-    use errp_sim::record::data::{LiveProvenance, Provenance};
+    use errp_sim::live::{LiveOutcome, LiveRunStats};
 
-    /// Records a session as `errp stream --save` does.
-    pub(super) struct Saving {
-        recording: Option<LiveRecording>,
-        dir: PathBuf,
-    }
-
-    impl Saving {
-        pub(super) fn grid(s: &GridScenario, speed: f64) -> Self {
-            Self::new("grid", (&s.path, s.seed, speed), |path, p, live| {
-                LiveRecording::grid(path, s, p, live)
-            })
-        }
-
-        pub(super) fn epuck(s: &EpuckScenario, speed: f64) -> Self {
-            Self::new("epuck", (&s.path, s.seed, speed), |path, p, live| {
-                LiveRecording::epuck(path, s, p, live)
-            })
-        }
-
-        /// A recording of `task` from the scenario file at `scenario`, in a
-        /// directory of its own.
-        fn new(
-            task: &str,
-            (scenario, seed, speed): (&Path, u64, f64),
-            open: impl FnOnce(&Path, Provenance, LiveProvenance) -> errp_sim::Result<LiveRecording>,
-        ) -> Self {
-            let dir = scratch(task);
-            let text = std::fs::read_to_string(scenario).unwrap();
-            let p = Provenance::new(task, "test", text, seed);
-            let live = LiveProvenance {
-                speed,
-                decoder: "name=virtual".into(),
-            };
-            let recording = open(&dir.join("live.rrd"), p, live).unwrap();
-            Self {
-                recording: Some(recording),
-                dir,
-            }
-        }
-
-        fn finish(&mut self) -> Recording {
-            let path = self.recording.take().unwrap().finish().unwrap();
-            Recording::open(path).unwrap()
-        }
-    }
-
-    impl LiveObserver<GridLiveRun> for Saving {
-        fn note(&mut self, _text: &str) {}
-        fn run(&mut self, k: usize, run: &GridLiveRun) {
-            self.recording.as_mut().unwrap().grid_run(k, run).unwrap();
-        }
-    }
-
-    impl LiveObserver<EpuckLiveRun> for Saving {
-        fn note(&mut self, _text: &str) {}
-        fn run(&mut self, k: usize, run: &EpuckLiveRun) {
-            self.recording.as_mut().unwrap().epuck_run(k, run).unwrap();
-        }
-        fn watch(&mut self, k: usize, seed: u64) -> Option<&mut dyn EpuckObserver> {
-            self.recording.as_mut().unwrap().epuck_watch(k, seed)
-        }
+    /// The session's recording, read back (and its directory removed).
+    fn read(outcome: &LiveOutcome) -> Recording {
+        let path = outcome.recording.as_ref().expect("a recording");
+        let rec = Recording::open(path).unwrap();
+        std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
+        rec
     }
 
     /// The decisions a recording read back holds: those received, each with
@@ -442,22 +433,13 @@ mod saved {
         }
     }
 
-    /// An empty directory of this test process.
-    fn scratch(name: &str) -> std::path::PathBuf {
-        let dir = std::env::temp_dir().join(format!("errp-live-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
-    }
-
-    /// The grid session's recording holds the decisions as received; its runs
-    /// replayed from it give the table the session printed.
-    pub(super) fn check_grid(mut saving: Saving, runs: &[GridLiveRun]) {
-        // The recording holds the decisions as received; its runs replayed
-        // from it give the table the session printed.
-        let rec = saving.finish();
+    /// The grid session's recording holds the decisions as received; its
+    /// runs replayed from it give the table the session printed.
+    pub(super) fn check_grid(outcome: &LiveOutcome, runs: &[GridLiveRun]) {
+        let rec = read(outcome);
         let live = rec.live.as_ref().expect("a live recording");
-        assert_eq!(live.speed, 50.0);
+        assert_eq!(live.speed.get(), 50.0);
+        assert_eq!(live.decoder, "name=virtual");
         assert_recorded(
             &live.runs,
             &runs.iter().map(|r| &r.stats).collect::<Vec<_>>(),
@@ -471,16 +453,13 @@ mod saved {
         assert_eq!(replay.recorded, printed);
         assert_eq!(replay.replayed, printed);
         assert_eq!(replay.first_difference(), None);
-        std::fs::remove_dir_all(&saving.dir).unwrap();
     }
 
     /// The e-puck session's recording: the decisions as received, each
-    /// window's as applied, and the run replayed from the file as the session
-    /// printed it.
-    pub(super) fn check_epuck(mut saving: Saving, r: &EpuckLiveRun, s: &EpuckScenario) {
-        // The recording: the decisions as received, each window's as applied,
-        // and the run replayed from the file as the session printed it.
-        let rec = saving.finish();
+    /// window's as applied, and the run replayed from the file as the
+    /// session printed it.
+    pub(super) fn check_epuck(outcome: &LiveOutcome, r: &EpuckLiveRun, s: &EpuckScenario) {
+        let rec = read(outcome);
         let live = rec.live.as_ref().expect("a live recording");
         assert_recorded(&live.runs, &[&r.stats]);
         assert_eq!(live.applied[0], r.decisions);
@@ -493,6 +472,5 @@ mod saved {
         .to_string();
         assert_eq!(replay.recorded, std::slice::from_ref(&printed));
         assert_eq!(replay.replayed, [printed]);
-        std::fs::remove_dir_all(&saving.dir).unwrap();
     }
 }

@@ -8,8 +8,8 @@ mod epuck;
 mod grid;
 mod hooks;
 mod live;
+mod own_eeg;
 mod realism;
-mod recorded;
 #[cfg(feature = "rerun")]
 mod recordings;
 mod scenario_fuzz;

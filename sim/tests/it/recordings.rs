@@ -5,28 +5,21 @@
 use errp_sim::grid::DecoderChoice;
 use errp_sim::inspect::Recording;
 use errp_sim::{
-    RunOptions, RunProvenance, ScenarioInput, ScenarioSource, SetterNames, run_scenario,
+    Names, RunOptions, RunProvenance, ScenarioInput, ScenarioSource, TaskKind, run_scenario,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use re_protos::external::prost::Message as _;
 use re_protos::log_msg::v1alpha1::ArrowMsg;
 
-const NAMES: SetterNames = SetterNames {
-    accuracy: "accuracy",
-    seed: "seed",
-    runs: "runs",
-    decoder: "decoder",
-    eeg: "eeg",
-    save: "save",
-};
+const NAMES: Names = Names::PYTHON;
 
 /// The built-in grid scenario recorded (oracle decoder), as bytes.
 fn recording(dir: &std::path::Path) -> Vec<u8> {
     let path = dir.join("good.rrd");
     let input = ScenarioInput {
         decoder: Some(DecoderChoice::Oracle),
-        ..ScenarioInput::new(ScenarioSource::file_or_built_in(None, false))
+        ..ScenarioInput::new(ScenarioSource::built_in(TaskKind::Grid))
     };
     let options = RunOptions {
         save: Some(&path),

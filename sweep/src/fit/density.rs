@@ -113,11 +113,11 @@ pub fn resample(runs: &[SimRun], rng: &mut impl Rng) -> Vec<SimRun> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use errp_bci::rng::stream;
+    use errp_bci::rng::labelled;
     use rand_distr::{Distribution, Normal};
 
     fn runs(n: usize, mean_ln_t: f64, mean_d: f64, reached: f64, seed: u64) -> Vec<SimRun> {
-        let mut rng = stream(seed, "test");
+        let mut rng = labelled(seed, "test");
         let t = Normal::new(mean_ln_t, 0.3).unwrap();
         let d = Normal::new(mean_d, 3.0).unwrap();
         (0..n)
@@ -179,7 +179,7 @@ mod tests {
             r.calibration = 1;
         }
         v.append(&mut w);
-        let mut rng = stream(9, "boot");
+        let mut rng = labelled(9, "boot");
         let shares: Vec<f64> = (0..400)
             .map(|_| {
                 let b = resample(&v, &mut rng);

@@ -82,14 +82,14 @@ fn epuck_fit(f: &mut fmt::Formatter<'_>, fit: &EpuckFit) -> fmt::Result {
         f,
         "Estimate: accuracy {:.3}; 95 % likelihood-ratio interval {:.3}{}-{:.3}{}; Monte Carlo \
          spread of the estimate (5-95 % over {} bootstrap replicates) {:.3}-{:.3}.",
-        fit.estimate,
-        fit.interval_95.0,
-        edge(fit.interval_at_edge.0),
-        fit.interval_95.1,
-        edge(fit.interval_at_edge.1),
+        fit.estimate.value,
+        fit.estimate.interval_95.0,
+        edge(fit.estimate.interval_at_edge.0),
+        fit.estimate.interval_95.1,
+        edge(fit.estimate.interval_at_edge.1),
         fit.spec.bootstrap,
-        fit.mc_interval_90.0,
-        fit.mc_interval_90.1
+        fit.estimate.mc_interval_90.0,
+        fit.estimate.mc_interval_90.1
     )?;
     for (i, h) in fit.held_out.iter().enumerate() {
         let (_, _, t, d) = &fit.observations[i];
@@ -205,14 +205,14 @@ fn grid_estimates(f: &mut fmt::Formatter<'_>, fit: &GridFit) -> fmt::Result {
         f,
         "Estimate: goal reward {}; 95 % likelihood-ratio interval {}{}-{}{}; Monte Carlo spread \
          of the estimate (5-95 % over {} bootstrap replicates) {}-{}.",
-        num(fit.estimate),
-        num(fit.interval_95.0),
-        edge(fit.interval_at_edge.0),
-        num(fit.interval_95.1),
-        edge(fit.interval_at_edge.1),
+        num(fit.estimate.value),
+        num(fit.estimate.interval_95.0),
+        edge(fit.estimate.interval_at_edge.0),
+        num(fit.estimate.interval_95.1),
+        edge(fit.estimate.interval_at_edge.1),
         fit.spec.bootstrap,
-        num(round3(fit.mc_interval_90.0)),
-        num(round3(fit.mc_interval_90.1))
+        num(round3(fit.estimate.mc_interval_90.0)),
+        num(round3(fit.estimate.mc_interval_90.1))
     )?;
     let own: Vec<String> = fit
         .fixed

@@ -3,7 +3,15 @@
 //! bar), the estimate as a vertical line, its interval shaded, and the
 //! paper's values as horizontal reference lines.
 
-use super::*;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::chart::{Bar, record_obstacles};
+use super::legend::{LegendCorner, draw_legend};
+use super::panels::{format_tick, nice_step, panel};
+use super::render::{Figure, PlotError, draw_error, render_png, render_svg, titled};
+use super::series::draw_series;
+use super::style::colour;
 
 /// One grid point of a curve: y with an error bar from `lo` to `hi`.
 #[derive(Debug, Clone, Copy, PartialEq)]

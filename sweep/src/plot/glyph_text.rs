@@ -1,6 +1,9 @@
 //! A drawing backend that sets text with the embedded font, glyph by glyph.
 
-use super::*;
+use ab_glyph::{Font, FontRef, ScaleFont, point};
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, VPos};
+use plotters_backend::{BackendColor, BackendCoord, DrawingErrorKind, FontTransform};
 
 /// A bitmap backend that sets text itself with `ab_glyph`, glyph by glyph at
 /// its advance, kerning and side bearing; everything else goes to `inner`.

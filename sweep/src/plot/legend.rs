@@ -1,6 +1,12 @@
 //! Legends: their entries, and the corner where they cover the fewest marks.
 
-use super::*;
+use plotters::element::MultiLineText;
+use plotters::prelude::*;
+
+use super::chart::Chart;
+use super::render::{PlotError, draw_error};
+use super::style::{LEGEND_GLYPH, LEGEND_MARGIN, LEGEND_SIZE, font};
+use super::sweep::SweepPlot;
 
 /// The non-empty legend entries of a panel: the series' labels, then the
 /// paper's if `with_paper`.
@@ -8,32 +14,6 @@ pub(super) fn legend_labels(plot: &SweepPlot, with_paper: bool) -> Vec<&str> {
     let series = plot.series.iter().map(|s| s.label.as_str());
     let paper = with_paper.then_some(plot.paper_label.as_str());
     series.chain(paper).filter(|l| !l.is_empty()).collect()
-}
-
-/// Records the backend pixels covered by the markers, error bars and line
-/// segments of `bars`, for choosing where the legend goes.
-pub(super) fn record_obstacles<'a, DB: DrawingBackend + 'a>(
-    chart: &Chart<'a, DB>,
-    bars: &[Bar],
-    obstacles: &mut Vec<(i32, i32)>,
-) {
-    const STEPS: usize = 24;
-    for b in bars {
-        for k in 0..=STEPS {
-            let t = k as f64 / STEPS as f64;
-            if b.lo.is_finite() && b.hi.is_finite() {
-                obstacles.push(chart.backend_coord(&(b.x, b.lo + t * (b.hi - b.lo))));
-            }
-        }
-    }
-    for w in bars.windows(2) {
-        for k in 0..=STEPS {
-            let t = k as f64 / STEPS as f64;
-            let x = w[0].x + t * (w[1].x - w[0].x);
-            let y = w[0].y + t * (w[1].y - w[0].y);
-            obstacles.push(chart.backend_coord(&(x, y)));
-        }
-    }
 }
 
 /// The corners a legend may go in.

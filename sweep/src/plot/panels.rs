@@ -1,16 +1,18 @@
-//! The two panels of a sweep figure: axes, ticks, the success and cost series.
+//! The figure of a sweep drawn: its two panels (axes, ticks, the success
+//! and cost series), to SVG or PNG.
 
-use super::*;
+use plotters::coord::Shift;
+use plotters::prelude::*;
 
-/// How an axis writes its tick labels.
-pub(super) type TickFormat<'a> = &'a dyn Fn(&f64) -> String;
+use super::chart::{Bar, Chart, TickFormat};
+use super::legend::{LegendCorner, draw_legend, legend_labels};
+use super::render::{Figure, PlotError, draw_error, render_png, render_svg, titled};
+use super::series::{draw_paper, draw_series, sorted};
+use super::style::{AXIS_DESC_SIZE, CAPTION_SIZE, TICK_SIZE, WIDTH, font};
+use super::sweep::SweepPlot;
 
 /// The x axis of a sweep's panels.
 const ACCURACY_DESC: &str = "decoder accuracy (mean of per-class rates)";
-
-/// A panel's chart type: accuracy (or another parameter) against a
-/// real-valued y.
-pub(super) type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
 /// Builds a panel's axes, grid and labels.
 pub(super) fn panel<'a, DB: DrawingBackend + 'a>(
@@ -190,5 +192,151 @@ pub(super) fn format_tick(y: f64) -> String {
     } else {
         let s = format!("{y:.2}");
         s.trim_end_matches('0').trim_end_matches('.').to_string()
+    }
+}
+
+impl Figure for SweepPlot {
+    fn width(&self) -> u32 {
+        WIDTH
+    }
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), PlotError> {
+        draw(root, self)
+    }
+}
+
+/// Renders the figure as an SVG document.
+///
+/// Text is left as `<text>` elements with `font-family="sans-serif"`, so the
+/// viewer's sans-serif font sets it.
+pub fn svg(plot: &SweepPlot) -> Result<String, PlotError> {
+    render_svg(plot)
+}
+
+/// Renders the figure as a PNG file (8-bit RGB), text set in the embedded
+/// DejaVu Sans.
+pub fn png(plot: &SweepPlot) -> Result<Vec<u8>, PlotError> {
+    render_png(plot)
+}
+
+/// Draws the whole figure on `root`.
+fn draw<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    plot: &SweepPlot,
+) -> Result<(), PlotError> {
+    let body = titled(root, &plot.title)?;
+
+    let (left, right) = body.split_horizontally(WIDTH / 2);
+    let x_range = x_range(plot);
+    draw_success_panel(&left, plot, x_range.clone())?;
+    draw_cost_panel(&right, plot, x_range)?;
+    Ok(())
+}
+
+/// The shared x range: [0.5, 1] widened to hold every point.
+fn x_range(plot: &SweepPlot) -> std::ops::Range<f64> {
+    let xs = plot
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.accuracy))
+        .chain(plot.paper.iter().map(|p| p.accuracy))
+        .filter(|x| x.is_finite());
+    let (lo, hi) = xs.fold((0.5f64, 1.0f64), |(lo, hi), x| (lo.min(x), hi.max(x)));
+    let pad = 0.02 * (hi - lo);
+    (lo - pad)..(hi + pad)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plot::style::TITLE_BAND;
+    use crate::plot::sweep::{LevelPoint, Series};
+    use errp_sim::task::PaperPoint;
+
+    fn level(accuracy: f64, rate: f64, mean: f64) -> LevelPoint {
+        LevelPoint {
+            accuracy,
+            success_rate: rate,
+            success_lo: (rate - 0.1).max(0.0),
+            success_hi: (rate + 0.1).min(1.0),
+            mean,
+            sd: 0.2 * mean,
+            median: mean,
+            n: 100,
+        }
+    }
+
+    fn example() -> SweepPlot {
+        SweepPlot {
+            title: "test".to_string(),
+            cost_label: "actions to convergence".to_string(),
+            series: vec![
+                Series {
+                    label: "a".to_string(),
+                    points: vec![level(0.6, 0.4, 80.0), level(0.8, 0.9, 20.0)],
+                },
+                Series {
+                    label: String::new(),
+                    points: vec![level(0.7, 0.0, f64::NAN), level(0.9, 1.0, 10.0)],
+                },
+            ],
+            paper: vec![PaperPoint {
+                label: "S1".to_string(),
+                accuracy: 0.83,
+                value: 16.0,
+                sd: Some(2.0),
+            }],
+            paper_label: "paper".to_string(),
+        }
+    }
+
+    #[test]
+    fn svg_is_deterministic_and_names_the_font_family() {
+        let plot = example();
+        let a = svg(&plot).unwrap();
+        assert_eq!(a, svg(&plot).unwrap());
+        assert!(a.starts_with("<svg"));
+        assert!(a.contains("font-family=\"sans-serif\""));
+        assert!(a.contains("actions to convergence"));
+    }
+
+    #[test]
+    fn png_is_deterministic_and_has_text() {
+        let plot = example();
+        let a = png(&plot).unwrap();
+        assert_eq!(a, png(&plot).unwrap());
+        assert_eq!(&a[..8], b"\x89PNG\r\n\x1a\n");
+        // The title band holds nothing but the title: some pixel there must
+        // be dark if text was rendered.
+        let mut reader = png::Decoder::new(std::io::Cursor::new(&a))
+            .read_info()
+            .unwrap();
+        let mut pixels = vec![0; reader.output_buffer_size().unwrap()];
+        reader.next_frame(&mut pixels).unwrap();
+        let band = &pixels[..(WIDTH * TITLE_BAND * 3) as usize];
+        assert!(band.iter().any(|&v| v < 100));
+    }
+
+    #[test]
+    fn empty_and_degenerate_plots_render() {
+        let mut plot = example();
+        plot.series.clear();
+        plot.paper.clear();
+        svg(&plot).unwrap();
+        png(&plot).unwrap();
+        plot.series = vec![Series {
+            label: "only failures".to_string(),
+            points: vec![level(0.55, 0.0, f64::NAN)],
+        }];
+        svg(&plot).unwrap();
+        png(&plot).unwrap();
+    }
+
+    #[test]
+    fn nice_steps() {
+        assert_eq!(nice_step(34.4), 50.0);
+        assert_eq!(nice_step(0.3), 0.5);
+        assert_eq!(nice_step(2.0), 2.0);
+        assert_eq!(format_tick(150.0), "150");
+        assert_eq!(format_tick(0.25), "0.25");
     }
 }

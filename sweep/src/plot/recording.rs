@@ -3,7 +3,13 @@
 //! each detected error, its start and goal) and Fig. 4 (the grid's visit
 //! frequencies, with the paths).
 
-use super::*;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
+use super::chart::Chart;
+use super::render::{Figure, PlotError, draw_error, render_png, render_svg, titled};
+use super::style::{AXIS_DESC_SIZE, HEIGHT, TICK_SIZE, font};
 
 /// A path in the plane of the figure, with its run's detections.
 #[derive(Debug, Clone, PartialEq)]

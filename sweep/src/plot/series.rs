@@ -1,15 +1,13 @@
 //! Markers, error bars and lines of the series and the paper's points.
 
-use super::*;
+use plotters::element::{Drawable, PointCollection};
+use plotters::prelude::*;
+use plotters_backend::{BackendCoord, DrawingErrorKind};
 
-/// A point with a vertical error bar, in data coordinates.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct Bar {
-    pub(super) x: f64,
-    pub(super) y: f64,
-    pub(super) lo: f64,
-    pub(super) hi: f64,
-}
+use super::chart::{Bar, Chart, record_obstacles};
+use super::render::{PlotError, draw_error};
+use super::style::{PAPER_COLOUR, colour};
+use super::sweep::LevelPoint;
 
 /// The points of a series sorted by accuracy.
 pub(super) fn sorted(points: &[LevelPoint]) -> impl Iterator<Item = &LevelPoint> {

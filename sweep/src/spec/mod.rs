@@ -5,116 +5,34 @@
 //! validated, so every scenario field can be swept and a bad value gets the
 //! same error as in a scenario file.
 
-use std::fmt;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 use toml::{Table, Value};
 
-use errp_bci::RequestedAccuracy;
-use errp_sim::epuck::EpuckTask;
-use errp_sim::grid::GridTask;
 use errp_sim::parse_toml;
-pub use errp_sim::task::format_number;
-use errp_sim::task::{Task, TaskInfo};
-use errp_sim::{AnyScenario, FILE_KEYS, ScenarioInput, ScenarioSource, is_epuck};
+use errp_sim::rules::{self, Claim, Origin, OwnEegFrom};
+use errp_sim::task::format_number;
+use errp_sim::{AnyScenario, Names, ScenarioInput, ScenarioSource, TaskKind};
 use errp_sim::{Result, SimError};
 
-mod parse;
+mod axis;
+mod scenario;
+mod shard;
+mod values;
 
-#[allow(unused_imports)]
-pub use parse::*;
-
-/// The two tasks a sweep can run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum SweepTask {
-    /// The discrete 5x5 grid (sec. 4): the cost is actions to convergence.
-    Grid,
-    /// The continuous e-puck (sec. 5): the cost is seconds to convergence.
-    Epuck,
-}
-
-impl SweepTask {
-    /// The task's columns, labels and sweepable parameters.
-    pub fn info(self) -> &'static TaskInfo {
-        match self {
-            SweepTask::Grid => &GridTask::INFO,
-            SweepTask::Epuck => &EpuckTask::INFO,
-        }
-    }
-}
-
-impl fmt::Display for SweepTask {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.info().name)
-    }
-}
-
-/// A slice of a sweep: episode `g` of the sweep (counted over all levels)
-/// belongs to shard `g % count + 1`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub struct Shard {
-    /// 1-based index of this shard.
-    pub index: usize,
-    /// Number of shards.
-    pub count: usize,
-}
-
-impl Shard {
-    /// The whole sweep.
-    pub const ALL: Shard = Shard { index: 1, count: 1 };
-
-    /// Parses `K/N` with 1 <= K <= N.
-    pub fn parse(text: &str) -> Result<Self> {
-        let bad = || {
-            SimError::Sweep(format!(
-                "--shard {text:?} is invalid: expected K/N with 1 <= K <= N, e.g. 3/8"
-            ))
-        };
-        let (k, n) = text.split_once('/').ok_or_else(bad)?;
-        let index: usize = k.trim().parse().map_err(|_| bad())?;
-        let count: usize = n.trim().parse().map_err(|_| bad())?;
-        if count == 0 || index == 0 || index > count {
-            return Err(bad());
-        }
-        Ok(Self { index, count })
-    }
-
-    /// True if episode `g` of the sweep is this shard's.
-    pub fn owns(&self, g: usize) -> bool {
-        g % self.count == self.index - 1
-    }
-
-    /// True for the whole sweep.
-    pub fn is_all(&self) -> bool {
-        self.count == 1
-    }
-}
-
-impl fmt::Display for Shard {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}/{}", self.index, self.count)
-    }
-}
-
-/// One swept scenario parameter.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Axis {
-    /// The name as given (`tau`), used for the CSV column.
-    pub name: String,
-    /// Where it goes in the scenario file (`control.tau`).
-    pub key: String,
-    /// Its values, in sweep order.
-    pub values: Vec<Value>,
-}
+pub use axis::{Axis, aliases, parse_axis, sweepable};
+pub use scenario::{read_task, sweep_fixed, sweep_scenario};
+pub use shard::Shard;
+use values::repeated;
+pub use values::{parse_accuracies, parse_values, value_text};
 
 /// Everything that defines a sweep's results. Two sweeps with equal specs
 /// write equal files.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SweepSpec {
     /// Which task the scenario is.
-    pub task: SweepTask,
+    pub task: TaskKind,
     /// The scenario file, as given.
     pub scenario_path: PathBuf,
     /// The scenario file's text: what was run, even if the file changes.
@@ -167,15 +85,6 @@ pub struct Level {
     pub scenario: AnyScenario,
 }
 
-/// A value as written in the CSV files and labels.
-pub fn value_text(v: &Value) -> String {
-    match v {
-        Value::String(s) => s.clone(),
-        Value::Float(x) => format_number(*x),
-        other => other.to_string(),
-    }
-}
-
 /// Most episodes per level.
 pub const MAX_EPISODES: usize = 1_000_000;
 
@@ -184,7 +93,7 @@ pub const MAX_LEVELS: usize = 1000;
 
 /// The key of a recording in a scenario, and the axis that sweeps
 /// recordings (`--param eeg.recording=a.edf,b.edf`).
-pub const RECORDING_KEY: &str = "eeg.recording";
+pub const OWN_EEG_KEY: &str = "eeg.recording";
 
 impl SweepSpec {
     /// True if `self` and `other` are one sweep: the same scenario text
@@ -216,13 +125,8 @@ impl SweepSpec {
     /// (`[eeg] recording = ...`) or swept (`--param eeg.recording=a.edf,b.edf`):
     /// its levels then have no accuracy set, each decoder the accuracy its
     /// recording gives.
-    pub fn on_recordings(&self) -> bool {
-        let written = toml::from_str::<Table>(&self.scenario_toml).is_ok_and(|t| {
-            t.get("eeg")
-                .and_then(Value::as_table)
-                .is_some_and(|e| e.contains_key("recording"))
-        });
-        written || self.axes.iter().any(|a| a.key == RECORDING_KEY)
+    pub fn on_own_eeg(&self) -> bool {
+        toml::from_str::<Table>(&self.scenario_toml).is_ok_and(|t| self.own_eeg(&t).is_some())
     }
 
     /// The seed of episode `k` of `level`: at its accuracy
@@ -286,7 +190,7 @@ impl SweepSpec {
     /// Checks the sweep's size and that no level is given twice: the
     /// episodes per level, the number of levels, and axes that are distinct
     /// parameters.
-    pub fn check(&self, names: &InputNames) -> Result<()> {
+    pub fn check(&self, names: &Names) -> Result<()> {
         let (accuracy, param) = (names.accuracy, names.param);
         if !(1..=MAX_EPISODES).contains(&self.episodes) {
             return Err(SimError::Sweep(format!(
@@ -294,7 +198,7 @@ impl SweepSpec {
                 names.episodes, self.episodes
             )));
         }
-        if self.accuracies.is_empty() && !self.on_recordings() {
+        if self.accuracies.is_empty() && !self.on_own_eeg() {
             return Err(SimError::Sweep(format!("{accuracy} gives no level")));
         }
         let levels = self
@@ -358,52 +262,76 @@ impl SweepSpec {
     /// [`run_sweep`](crate::run_sweep) and
     /// [`prepare_sweep`](crate::prepare_sweep) take it. Errors name the
     /// inputs as `names` does.
-    pub fn checked(self, names: &InputNames) -> Result<CheckedSweep> {
+    pub fn checked(self, names: &Names) -> Result<CheckedSweep> {
         let levels = self.levels(names)?;
         Ok(CheckedSweep { spec: self, levels })
     }
 
-    /// Checks a sweep over a person's recordings (`[eeg] recording = ...`
-    /// in the file, or `eeg.recording` swept): no accuracy levels (a
-    /// recording's decoder has the accuracy it gives) and no EEG mode set
-    /// for every level (the `[eeg]` table is the recording's).
-    fn check_recordings(&self, names: &InputNames) -> Result<()> {
-        if !self.on_recordings() {
-            return Ok(());
+    /// Sets what the caller gave for every level: the accuracy levels
+    /// (`accuracy`, none on own EEG) and the grid's EEG mode (`per_action`;
+    /// otherwise the bank, but on own EEG, whose EEG is the recording's).
+    /// What own EEG cannot take is refused when the levels are checked, by
+    /// the rule ([`rules::own_eeg_is_the_user`]), naming `names`' inputs.
+    pub fn set_levels(
+        &mut self,
+        accuracy: Option<&str>,
+        per_action: Option<bool>,
+        names: &Names,
+    ) -> Result<()> {
+        if let Some(a) = accuracy {
+            self.accuracies = parse_accuracies(a, names)?;
         }
-        let what = if self.axes.iter().any(|a| a.key == RECORDING_KEY) {
-            format!("the swept {RECORDING_KEY}")
-        } else {
-            format!(
-                "{}: its EEG is a recording ({RECORDING_KEY})",
-                self.scenario_path.display()
-            )
-        };
-        if !self.accuracies.is_empty() {
-            return Err(SimError::Sweep(format!(
-                "{} with {what}: a recording's decoder is calibrated on its first part and has \
-                 the accuracy the recording gives (the sweep reports it per level); no accuracy \
-                 is targeted: leave out {}",
-                names.accuracy, names.accuracy
-            )));
-        }
-        if let Some((_, v)) = self.fixed.iter().find(|(k, _)| k == "eeg") {
-            return Err(SimError::Sweep(format!(
-                "{} {} with {what}: the recording is the EEG; leave it out",
-                names.eeg,
-                value_text(v)
-            )));
+        if !self.on_own_eeg() || per_action.is_some() {
+            self.fixed = sweep_fixed(self.task, &self.scenario_path, per_action, names)?;
         }
         Ok(())
     }
 
+    /// Where the sweep's own EEG comes from, if it runs on one: swept
+    /// (`--param eeg.recording=a.edf,b.edf`) or the scenario's (`[eeg]
+    /// recording = ...`).
+    fn own_eeg<'a>(&'a self, table: &'a Table) -> Option<OwnEegFrom<'a>> {
+        if self.axes.iter().any(|a| a.key == OWN_EEG_KEY) {
+            return Some(OwnEegFrom::Swept);
+        }
+        let recording = table
+            .get("eeg")
+            .and_then(Value::as_table)
+            .and_then(|e| e.get("recording"))?;
+        Some(OwnEegFrom::Scenario {
+            path: &self.scenario_path,
+            recording: recording.as_str().unwrap_or_default(),
+        })
+    }
+
+    /// Checks a sweep over a person's own EEG by the rule
+    /// ([`rules::own_eeg_is_the_user`]): no accuracy levels (a recording's
+    /// decoder has the accuracy it gives) and no EEG mode set for every
+    /// level (the `[eeg]` table is the recording's).
+    fn check_own_eeg(&self, table: &Table, names: &Names) -> Result<()> {
+        let at = Origin::Sweep(names);
+        let mode = self
+            .fixed
+            .iter()
+            .find(|(k, _)| k == "eeg")
+            .map(|(_, v)| value_text(v));
+        let mut claims = Vec::new();
+        if let Some(&a) = self.accuracies.first() {
+            claims.push((Claim::Accuracy(a), at));
+        }
+        if let Some(m) = &mode {
+            claims.push((Claim::EegMode(m), at));
+        }
+        rules::own_eeg_is_the_user(self.own_eeg(table), &claims)
+    }
+
     /// Builds and validates every level's scenario. An invalid swept value
     /// is reported with the level and the scenario's own field error.
-    pub(crate) fn levels(&self, names: &InputNames) -> Result<Vec<Level>> {
+    pub(crate) fn levels(&self, names: &Names) -> Result<Vec<Level>> {
         self.check(names)?;
         // The file's own errors quote its lines.
-        let _: Table = parse_toml(&self.scenario_toml, &self.scenario_path)?;
-        self.check_recordings(names)?;
+        let table: Table = parse_toml(&self.scenario_toml, &self.scenario_path)?;
+        self.check_own_eeg(&table, names)?;
         let recordings = self.accuracies.is_empty();
         (0..self.n_levels())
             .map(|index| {
@@ -439,7 +367,7 @@ impl SweepSpec {
                     })
                 };
                 let scenario = input
-                    .load(&FILE_KEYS)
+                    .load(&Names::FILE)
                     .map_err(|e| context(e.to_string()))?
                     .scenario;
                 Ok(Level {
@@ -490,40 +418,40 @@ mod tests {
             let e = parse_values(text, "--accuracy").unwrap_err().to_string();
             assert!(e.contains(needle), "{text}: {e}");
         }
-        let e = parse_accuracies("1.7", &InputNames::CLI)
+        let e = parse_accuracies("1.7", &Names::CLI)
             .unwrap_err()
             .to_string();
         assert!(e.contains("1.7") && e.contains("(0.5, 1)"), "{e}");
-        assert!(parse_accuracies("0.5", &InputNames::CLI).is_err());
-        assert!(parse_accuracies("NaN", &InputNames::CLI).is_err());
+        assert!(parse_accuracies("0.5", &Names::CLI).is_err());
+        assert!(parse_accuracies("NaN", &Names::CLI).is_err());
     }
 
     #[test]
     fn params_resolve_short_names_and_refuse_the_accuracy() {
-        let a = parse_axis(SweepTask::Grid, "tau=0.1:0.3:0.1", &InputNames::CLI).unwrap();
+        let a = parse_axis(TaskKind::Grid, "tau=0.1:0.3:0.1", &Names::CLI).unwrap();
         assert_eq!(a.key, "control.tau");
         assert_eq!(a.values.len(), 3);
         assert_eq!(
-            parse_axis(SweepTask::Epuck, "t_e=0.7,0.8", &InputNames::CLI)
+            parse_axis(TaskKind::Epuck, "t_e=0.7,0.8", &Names::CLI)
                 .unwrap()
                 .key,
             "control.t_e"
         );
         assert_eq!(
-            parse_axis(SweepTask::Grid, "timing.max_actions=50", &InputNames::CLI)
+            parse_axis(TaskKind::Grid, "timing.max_actions=50", &Names::CLI)
                 .unwrap()
                 .key,
             "timing.max_actions"
         );
-        let e = parse_axis(SweepTask::Grid, "t_e=0.8", &InputNames::CLI)
+        let e = parse_axis(TaskKind::Grid, "t_e=0.8", &Names::CLI)
             .unwrap_err()
             .to_string();
         assert!(
             e.contains("not a grid scenario parameter") && e.contains("tau"),
             "{e}"
         );
-        assert!(parse_axis(SweepTask::Grid, "user.accuracy=0.7", &InputNames::CLI).is_err());
-        assert!(parse_axis(SweepTask::Grid, "tau", &InputNames::CLI).is_err());
+        assert!(parse_axis(TaskKind::Grid, "user.accuracy=0.7", &Names::CLI).is_err());
+        assert!(parse_axis(TaskKind::Grid, "tau", &Names::CLI).is_err());
     }
 
     #[test]
@@ -547,12 +475,12 @@ mod tests {
             if let Err(e) = parse_values(&text, "--param x") {
                 proptest::prop_assert!(e.to_string().contains("--param x"));
             }
-            match parse_accuracies(&text, &InputNames::CLI) {
+            match parse_accuracies(&text, &Names::CLI) {
                 Ok(v) => proptest::prop_assert!(v.iter().all(|a| *a > 0.5 && *a <= 1.0) && v.len() <= 10_000),
                 Err(e) => proptest::prop_assert!(e.to_string().contains("--accuracy")),
             }
-            for task in [SweepTask::Grid, SweepTask::Epuck] {
-                if let Err(e) = parse_axis(task, &text, &InputNames::CLI) {
+            for task in [TaskKind::Grid, TaskKind::Epuck] {
+                if let Err(e) = parse_axis(task, &text, &Names::CLI) {
                     proptest::prop_assert!(e.to_string().contains("--param"), "{}", e);
                 }
             }
@@ -567,7 +495,7 @@ mod tests {
         // A scenario's `[user] seed` (the city scenarios share one) is the
         // sweep's to set: each sweep seed is another simulated user.
         let spec = SweepSpec {
-            task: SweepTask::Epuck,
+            task: TaskKind::Epuck,
             scenario_path: "scenarios/lisbon_to_tokyo.toml".into(),
             scenario_toml: include_str!("../../../scenarios/lisbon_to_tokyo.toml").into(),
             accuracies: vec![0.8],
@@ -576,7 +504,7 @@ mod tests {
             episodes: 1,
             seed: 7,
         };
-        let levels = spec.levels(&InputNames::CLI).unwrap();
+        let levels = spec.levels(&Names::CLI).unwrap();
         let AnyScenario::Epuck(s) = &levels[0].scenario else {
             panic!("an e-puck scenario")
         };
@@ -587,11 +515,11 @@ mod tests {
     #[test]
     fn levels_vary_accuracy_fastest() {
         let spec = SweepSpec {
-            task: SweepTask::Grid,
+            task: TaskKind::Grid,
             scenario_path: "x.toml".into(),
             scenario_toml: String::new(),
             accuracies: vec![0.6, 0.8],
-            axes: vec![parse_axis(SweepTask::Grid, "tau=0.1,0.3,0.5", &InputNames::CLI).unwrap()],
+            axes: vec![parse_axis(TaskKind::Grid, "tau=0.1,0.3,0.5", &Names::CLI).unwrap()],
             fixed: vec![],
             episodes: 10,
             seed: 1,

@@ -5,8 +5,8 @@ use std::path::Path;
 
 use errp_bci::stop::WindDown;
 use errp_sweep::fit::{
-    EpuckFitSpec, FitOutcome, GridFitOutcome, GridFitSpec, Provenance, paper_runs, run_epuck_fit,
-    run_grid_fit,
+    EpuckFitSpec, FitOutcome, FitProvenance, GridFitOutcome, GridFitSpec, paper_runs,
+    run_epuck_fit, run_grid_fit,
 };
 
 use errp_robot::Cell;
@@ -18,8 +18,8 @@ fn repo(path: &str) -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(path)
 }
 
-fn provenance() -> Provenance {
-    Provenance {
+fn provenance() -> FitProvenance {
+    FitProvenance {
         command: "test".into(),
         errp_version: "test".into(),
         commit: "test".into(),
@@ -143,7 +143,7 @@ fn a_small_fit_writes_its_files_resumes_to_the_same_bytes_and_guards_its_directo
     assert_eq!(files.len(), 4);
     assert_eq!(fit.stats.len(), 2);
     assert!(fit.stats.iter().flatten().all(|s| s.runs == 5));
-    assert!(spec.accuracies.contains(&fit.estimate));
+    assert!(spec.accuracies.contains(&fit.estimate.value));
     let first = std::fs::read(out.join("fit.json")).unwrap();
     let csv = std::fs::read_to_string(out.join("surface.csv")).unwrap();
     assert_eq!(csv.lines().count(), 3, "{csv}");
@@ -212,11 +212,12 @@ fn median_time_to_goal(rows: &[(bool, f64)]) -> f64 {
 #[test]
 #[ignore = "slow (2500 e-puck runs, about 3 minutes): .ci/run runs it"]
 fn the_median_time_to_pisa_does_not_rise_with_accuracy() {
-    use errp_sweep::{Shard, SweepOptions, SweepSpec, SweepTask, run_sweep, sweep_fixed};
+    use errp_sim::TaskKind;
+    use errp_sweep::{Shard, SweepOptions, SweepSpec, run_sweep, sweep_fixed};
     let out = temp_dir("monotonic");
-    let names = errp_sweep::InputNames::CLI;
+    let names = errp_sim::Names::CLI;
     let spec = SweepSpec {
-        task: SweepTask::Epuck,
+        task: TaskKind::Epuck,
         // The idealised user: one calibration per accuracy, whose online
         // operating point varies less than the realistic user's.
         scenario_path: "scenarios/variants/mexico_to_pisa_ideal.toml".into(),
@@ -224,7 +225,13 @@ fn the_median_time_to_pisa_does_not_rise_with_accuracy() {
             .to_string(),
         accuracies: vec![0.75, 0.8, 0.85, 0.9, 0.95],
         axes: vec![],
-        fixed: sweep_fixed(SweepTask::Epuck, None, names).unwrap(),
+        fixed: sweep_fixed(
+            TaskKind::Epuck,
+            std::path::Path::new("mexico_to_pisa_ideal.toml"),
+            None,
+            &names,
+        )
+        .unwrap(),
         episodes: 500,
         seed: 1,
     };
@@ -247,7 +254,7 @@ fn the_median_time_to_pisa_does_not_rise_with_accuracy() {
         levels[f[lv].parse::<usize>().unwrap()].push((f[ok] == "1", f[t].parse::<f64>().unwrap()));
     }
     // Monte Carlo error of each median: the sd over 200 bootstrap samples.
-    let mut rng = errp_bci::rng::stream(1, "test/bootstrap");
+    let mut rng = errp_bci::rng::labelled(1, "test/bootstrap");
     let stats: Vec<(f64, f64, f64)> = levels
         .iter()
         .map(|rows| {
@@ -449,7 +456,7 @@ fn a_small_grid_fit_writes_its_files_and_refuses_bad_settings() {
         panic!("not interrupted")
     };
     assert_eq!(files.len(), 4);
-    assert!(spec.goal_rewards.contains(&fit.estimate));
+    assert!(spec.goal_rewards.contains(&fit.estimate.value));
     // 4 subjects x 2 points, 2 groups of 5 runs each.
     assert_eq!(fit.fixed_stats.len(), 4);
     assert!(

@@ -113,7 +113,7 @@ fn run(spec: &SweepSpec, out: &Path, shard: Shard, repair: bool) -> errp_sim::Re
     let mut opts = options(out, shard, 7);
     opts.repair = repair;
     run_sweep(
-        &spec.clone().checked(&errp_sweep::InputNames::CLI)?,
+        &spec.clone().checked(&errp_sim::Names::CLI)?,
         &opts,
         &WindDown::new(),
         &(),
@@ -264,7 +264,7 @@ fn a_directory_in_use_or_holding_other_files_is_refused_untouched() {
     // task does not match the scenario.
     let fresh = temp_dir("refused-fresh");
     let wrong = SweepSpec {
-        task: errp_sweep::SweepTask::Epuck,
+        task: errp_sim::TaskKind::Epuck,
         ..spec.clone()
     };
     assert!(run(&wrong, &fresh, Shard::ALL, false).is_err());

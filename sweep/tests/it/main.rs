@@ -7,15 +7,17 @@
 
 mod fit;
 mod integrity;
-mod recorded;
+mod own_eeg;
 mod results;
 
 use std::path::{Path, PathBuf};
 
 use errp_bci::stop::WindDown;
+use errp_sim::Names;
+use errp_sim::TaskKind;
 use errp_sweep::{
-    InputNames, Shard, SweepOptions, SweepOutcome, SweepSpec, SweepTask, TargetCache,
-    parse_accuracies, parse_axis, run_sweep,
+    Shard, SweepOptions, SweepOutcome, SweepSpec, TargetCache, parse_accuracies, parse_axis,
+    run_sweep,
 };
 
 /// A grid scenario with the EEG decoder on a small epoch bank.
@@ -61,13 +63,13 @@ pub(crate) fn cache() -> TargetCache {
 
 pub(crate) fn spec(text: &str, accuracy: &str, params: &[&str], episodes: usize) -> SweepSpec {
     SweepSpec {
-        task: SweepTask::Grid,
+        task: TaskKind::Grid,
         scenario_path: "test.toml".into(),
         scenario_toml: text.into(),
-        accuracies: parse_accuracies(accuracy, &InputNames::CLI).unwrap(),
+        accuracies: parse_accuracies(accuracy, &Names::CLI).unwrap(),
         axes: params
             .iter()
-            .map(|p| parse_axis(SweepTask::Grid, p, &InputNames::CLI).unwrap())
+            .map(|p| parse_axis(TaskKind::Grid, p, &Names::CLI).unwrap())
             .collect(),
         fixed: vec![],
         episodes,
@@ -93,7 +95,7 @@ pub(crate) fn complete(spec: &SweepSpec, out: &Path, shard: Shard, threads: usiz
         .unwrap();
     let outcome = pool
         .install(|| {
-            let sweep = spec.clone().checked(&InputNames::CLI).unwrap();
+            let sweep = spec.clone().checked(&Names::CLI).unwrap();
             run_sweep(&sweep, &options(out, shard, 7), &WindDown::new(), &())
         })
         .unwrap();

@@ -82,7 +82,7 @@ fn an_interrupted_or_crashed_sweep_resumes_to_the_same_files() {
         after: 30,
         wind_down: &wind_down,
     };
-    let sweep = spec.clone().checked(&errp_sweep::InputNames::CLI).unwrap();
+    let sweep = spec.clone().checked(&errp_sim::Names::CLI).unwrap();
     let outcome = run_sweep(&sweep, &options(&resumed, Shard::ALL, 7), &wind_down, &stop).unwrap();
     let SweepOutcome::Interrupted { done, total } = outcome else {
         panic!("{outcome:?}")
@@ -123,7 +123,7 @@ fn an_interrupted_or_crashed_sweep_resumes_to_the_same_files() {
     // The same directory with other parameters is refused, untouched.
     let other = spec_with_seed(&spec, 6);
     let e = run_sweep(
-        &other.checked(&errp_sweep::InputNames::CLI).unwrap(),
+        &other.checked(&errp_sim::Names::CLI).unwrap(),
         &options(&resumed, Shard::ALL, 7),
         &WindDown::new(),
         &(),
@@ -197,7 +197,7 @@ fn a_sweep_calibrates_like_errp_run() {
     let out = temp_dir("same-calibration");
     complete(&spec, &out, Shard::ALL, 2);
     let manifest = Manifest::read(&out).unwrap();
-    let sweep = spec.checked(&errp_sweep::InputNames::CLI).unwrap();
+    let sweep = spec.checked(&errp_sim::Names::CLI).unwrap();
     for (level, info) in sweep.levels().iter().zip(&manifest.decoders) {
         let errp_sim::AnyScenario::Grid(scenario) = &level.scenario else {
             panic!("a grid level");

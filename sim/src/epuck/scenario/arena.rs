@@ -1,54 +1,18 @@
-//! The scenario's camera tracker, obstacles and arena, checked and in SI units.
+//! The scenario's arena: its size, walls and obstacles, and where the
+//! e-puck starts, checked and in SI units.
 
-#[allow(clippy::wildcard_imports, unused_imports)]
-use super::*;
+use std::path::Path;
 
-/// The ceiling camera of a `[tracker]` table, on the defaults.
-pub(super) fn tracker_params(t: Option<&TrackerFile>, path: &Path) -> Result<TrackerParams> {
-    let bad =
-        |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
-    let mut tracker = TrackerParams::default();
-    if let Some(t) = t {
-        if let Some(v) = t.rate_hz {
-            if !(v.is_finite() && (1.0..=MAX_TRACKER_HZ).contains(&v)) {
-                return Err(bad(
-                    "tracker.rate_hz",
-                    v.to_string(),
-                    &format!("a frame rate from 1 to {MAX_TRACKER_HZ} Hz (default 30)"),
-                ));
-            }
-            tracker.rate_hz = v;
-        }
-        if let Some(v) = t.position_noise_cm {
-            if !(v.is_finite() && (0.0..=50.0).contains(&v)) {
-                return Err(bad(
-                    "tracker.position_noise_cm",
-                    v.to_string(),
-                    "a standard deviation from 0 to 50 cm (default 0.2)",
-                ));
-            }
-            tracker.position_noise_m = v / 100.0;
-        }
-        if let Some(v) = t.heading_noise_deg {
-            if !(v.is_finite() && (0.0..=180.0).contains(&v)) {
-                return Err(bad(
-                    "tracker.heading_noise_deg",
-                    v.to_string(),
-                    "a standard deviation from 0 to 180 degrees (default 1)",
-                ));
-            }
-            tracker.heading_noise_rad = v.to_radians();
-        }
-    }
-    tracker
-        .validate()
-        .map_err(|e| SimError::Scenario(format!("{}: {e}", path.display())))?;
-    Ok(tracker)
-}
+use errp_robot::{GoalLayout, Pose};
+
+use crate::epuck::schema::{EpuckFile, ObstacleFile, StartFile};
+use crate::epuck::world::{ArenaSpec, Obstacle};
+use crate::error::Result;
+use crate::scenario_file::field_error;
 
 /// Obstacle `k` of `[[arena.obstacle]]`: a box or a circle whose centre is
 /// inside an arena of `size_cm`, in metres.
-pub(super) fn obstacle(k: usize, o: &ObstacleFile, size_cm: f64, path: &Path) -> Result<Obstacle> {
+fn obstacle(k: usize, o: &ObstacleFile, size_cm: f64, path: &Path) -> Result<Obstacle> {
     let bad =
         |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
     let field = |f: &str| format!("arena.obstacle[{k}].{f}");
@@ -210,4 +174,61 @@ pub(super) fn arena(
         arena.obstacles.push(obstacle);
     }
     Ok(arena)
+}
+
+/// Most obstacles in the arena.
+pub const MAX_OBSTACLES: usize = 100;
+
+/// Where the e-puck starts: a city or a position inside the arena (the
+/// body clear of the walls), and its heading.
+pub(super) fn start_pose(
+    file: &EpuckFile,
+    layout: &GoalLayout,
+    radius_m: f64,
+    path: &Path,
+) -> Result<Pose> {
+    let bad =
+        |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
+    let size_cm = layout.arena_size_m() * 100.0;
+    let cities = || layout.names().join(", ");
+    let (sx, sy) = match &file.start {
+        StartFile::City(name) => {
+            let i = layout.index_of(name).ok_or_else(|| {
+                bad(
+                    "start",
+                    format!("{name:?}"),
+                    &format!("a city ({}) or a position [x_cm, y_cm]", cities()),
+                )
+            })?;
+            (layout.goals()[i].x_m, layout.goals()[i].y_m)
+        }
+        StartFile::Cm([x, y]) => {
+            let lo = radius_m * 100.0;
+            let inside = |v: f64| v.is_finite() && v >= lo && v <= size_cm - lo;
+            if !(inside(*x) && inside(*y)) {
+                return Err(bad(
+                    "start",
+                    format!("[{x}, {y}]"),
+                    &format!(
+                        "a position [x_cm, y_cm] with both in [{lo:.1}, {:.1}] so the \
+                         e-puck's body is inside the {size_cm} cm arena",
+                        size_cm - lo
+                    ),
+                ));
+            }
+            (x / 100.0, y / 100.0)
+        }
+    };
+    if !file.start_heading_deg.is_finite() {
+        return Err(bad(
+            "start_heading_deg",
+            file.start_heading_deg.to_string(),
+            "an angle in degrees (0 = +x, 90 = up)",
+        ));
+    }
+    Ok(Pose {
+        x_m: sx,
+        y_m: sy,
+        heading_rad: errp_robot::wrap_angle(file.start_heading_deg.to_radians()),
+    })
 }

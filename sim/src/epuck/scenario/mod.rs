@@ -5,54 +5,37 @@
 
 use std::path::{Path, PathBuf};
 
-use errp_bci::{DetectorMode, DetectorParams, MeanAccuracy, OnlineTarget, Realism};
-use errp_robot::{ContinuousControlParams, GoalLayout, Pose, Valid};
+use errp_bci::{MeanAccuracy, OnlineTarget, Realism};
+use errp_robot::{EpuckControlParams, GoalLayout, Valid};
 
 use crate::epuck::hybrid_report::HYBRID_LABEL;
 use crate::epuck::params::{EpuckEpisode, EpuckTaskParams};
-use crate::epuck::schema::{
-    DetectorFile, EpuckFile, ObstacleFile, StartFile, TrackerFile, UserFile,
-};
-use crate::epuck::tracker::TrackerParams;
-use crate::epuck::user::UserParams;
-use crate::epuck::world::{ArenaSpec, Obstacle};
-use crate::error::{Result, SimError};
-use crate::recorded::{RecordedEeg, RecordedTask};
+use crate::epuck::schema::EpuckFile;
+use crate::epuck::world::ArenaSpec;
+use crate::error::Result;
+use crate::own_eeg::OwnEegSpec;
 use crate::scenario_file::{
     checked_realism, field_error, parse_toml, robot_error, scenario_name, table_into, whole,
 };
+use crate::task_kind::TaskKind;
 
 mod arena;
+mod decoder;
+mod tracker;
+mod user;
 
-#[allow(unused_imports)]
-pub use arena::*;
+pub use arena::MAX_OBSTACLES;
+use arena::{arena, start_pose};
+use decoder::{OWN_EEG_PLACEHOLDER_ACCURACY, decoder_target, detector_params, refuse_with_own_eeg};
+pub use tracker::MAX_TRACKER_HZ;
+use tracker::tracker_params;
+use user::user_params;
+pub use user::{MAX_REACTION_LATENCY_MS, MAX_REELICIT_SECS};
 
 /// Most runs of one e-puck scenario.
 pub const MAX_RUNS: u64 = 100_000;
 /// The longest time-out of a run, s.
 pub const MAX_RUN_SECS: f64 = 3600.0;
-/// Most obstacles in the arena.
-pub const MAX_OBSTACLES: usize = 100;
-/// The longest reaction latency of the synthetic user, ms.
-pub const MAX_REACTION_LATENCY_MS: f64 = 2000.0;
-/// The longest time before a persisting error elicits another ErrP, s.
-pub const MAX_REELICIT_SECS: f64 = 60.0;
-/// The fastest overhead camera, frames per second.
-pub const MAX_TRACKER_HZ: f64 = 1000.0;
-
-/// A parameter error of `errp_bci` as a field error of the scenario's
-/// `[table]`.
-fn table_error(path: &Path, table: &str, e: errp_bci::BciError) -> SimError {
-    match e {
-        errp_bci::BciError::InvalidParameter {
-            name,
-            value,
-            expected,
-        } => field_error(path, &format!("{table}.{name}"), value, &expected),
-        other => SimError::Scenario(format!("{}: [{table}] {other}", path.display())),
-    }
-}
-
 /// A validated e-puck scenario, loaded through
 /// [`crate::ScenarioInput`]; it cannot be written as a struct
 /// literal outside this crate.
@@ -94,7 +77,7 @@ pub struct EpuckScenario {
     pub realism: Realism,
     /// A person's recording in place of the synthetic user's EEG (`[eeg]`):
     /// the decoder is calibrated and run on a hybrid of it.
-    pub recording: Option<Box<RecordedEeg>>,
+    pub own_eeg: Option<Box<OwnEegSpec>>,
 }
 
 impl EpuckScenario {
@@ -108,7 +91,7 @@ impl EpuckScenario {
     /// The decoder in words, as `errp run` prints it and its recording
     /// shows it: "decoder accuracy 75.00 %", or the online target.
     pub fn decoder_text(&self) -> String {
-        if let Some(r) = &self.recording {
+        if let Some(r) = &self.own_eeg {
             return format!("{HYBRID_LABEL} (recording {})", r.written);
         }
         match self.online_target {
@@ -128,10 +111,10 @@ impl EpuckScenario {
     /// recording's first part with no accuracy targeted and T_e set for a
     /// false-alarm rate (a simulated user's `[realism]` and decoder target
     /// are not used).
-    pub fn on_recording(mut self, eeg: RecordedEeg) -> Self {
+    pub fn on_own_eeg(mut self, eeg: OwnEegSpec) -> Self {
         self.realism = Realism::default();
         self.online_target = None;
-        self.recording = Some(Box::new(eeg));
+        self.own_eeg = Some(Box::new(eeg));
         self
     }
 
@@ -154,8 +137,9 @@ impl EpuckScenario {
         let given = |table: &str, key: &str| raw.get(table).and_then(|t| t.get(key)).is_some();
         let bad =
             |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
-        if file.task != "epuck" {
-            return Err(bad("task", format!("{:?}", file.task), "\"epuck\""));
+        if file.task != TaskKind::Epuck.as_str() {
+            let expected = format!("{:?}", TaskKind::Epuck.as_str());
+            return Err(bad("task", format!("{:?}", file.task), &expected));
         }
         let layout = GoalLayout::cities();
         let cities = || layout.names().join(", ");
@@ -178,15 +162,15 @@ impl EpuckScenario {
             ));
         }
         let recording = match file.eeg.clone() {
-            Some(r) => Some(Box::new(r.0.check(path, RecordedTask::Epuck)?)),
+            Some(r) => Some(Box::new(r.0.check(path, TaskKind::Epuck)?)),
             None => None,
         };
         let (online_target, accuracy) = match &recording {
-            Some(_) => {
-                refuse_with_recording(&file.user, given("control", "t_e"), path)?;
+            Some(r) => {
+                refuse_with_own_eeg(&file.user, given("control", "t_e"), r, path)?;
                 // Not targeted: the accuracy the control assumes is the
                 // recording's, set once it is calibrated.
-                (None, MeanAccuracy::new(RECORDING_PLACEHOLDER_ACCURACY)?)
+                (None, MeanAccuracy::new(OWN_EEG_PLACEHOLDER_ACCURACY)?)
             }
             None => decoder_target(&file.user, given("control", "t_e"), path)?,
         };
@@ -195,7 +179,7 @@ impl EpuckScenario {
             params.detector = detector_params(d, path)?;
         }
         // The device knows its decoder's accuracy from the calibration.
-        let control = ContinuousControlParams {
+        let control = EpuckControlParams {
             assumed_accuracy: accuracy.get(),
             ..file.control.clone()
         };
@@ -240,236 +224,9 @@ impl EpuckScenario {
             layout,
             params,
             realism,
-            recording,
+            own_eeg: recording,
         })
     }
-}
-
-/// The accuracy an e-puck scenario on a recording holds until its decoder
-/// is calibrated (nothing reads it: the control assumes the recording's).
-const RECORDING_PLACEHOLDER_ACCURACY: f64 = 0.75;
-
-/// Refuses what a scenario whose EEG is a recording cannot also set: a
-/// decoder target (the recording has the accuracy it gives) and T_e (set
-/// for a false-alarm rate on the recording).
-fn refuse_with_recording(u: &UserFile, t_e_given: bool, path: &Path) -> Result<()> {
-    let bad =
-        |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
-    const WHY: &str = "nothing, with a recording (eeg.recording): the decoder is calibrated on \
-                       the recording's first part and has the accuracy the recording gives; no \
-                       accuracy is targeted";
-    for (field, value) in [
-        ("user.accuracy", u.accuracy),
-        ("user.hit_rate", u.hit_rate),
-        ("user.false_alarms_per_min", u.false_alarms_per_min),
-    ] {
-        if let Some(v) = value {
-            return Err(bad(field, v.to_string(), WHY));
-        }
-    }
-    if t_e_given {
-        return Err(bad(
-            "control.t_e",
-            "given".into(),
-            "no t_e with a recording (eeg.recording): T_e is set on the recording for \
-             eeg.false_alarms_per_min",
-        ));
-    }
-    Ok(())
-}
-
-/// Where the e-puck starts: a city or a position inside the arena (the
-/// body clear of the walls), and its heading.
-fn start_pose(file: &EpuckFile, layout: &GoalLayout, radius_m: f64, path: &Path) -> Result<Pose> {
-    let bad =
-        |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
-    let size_cm = layout.arena_size_m() * 100.0;
-    let cities = || layout.names().join(", ");
-    let (sx, sy) = match &file.start {
-        StartFile::City(name) => {
-            let i = layout.index_of(name).ok_or_else(|| {
-                bad(
-                    "start",
-                    format!("{name:?}"),
-                    &format!("a city ({}) or a position [x_cm, y_cm]", cities()),
-                )
-            })?;
-            (layout.goals()[i].x_m, layout.goals()[i].y_m)
-        }
-        StartFile::Cm([x, y]) => {
-            let lo = radius_m * 100.0;
-            let inside = |v: f64| v.is_finite() && v >= lo && v <= size_cm - lo;
-            if !(inside(*x) && inside(*y)) {
-                return Err(bad(
-                    "start",
-                    format!("[{x}, {y}]"),
-                    &format!(
-                        "a position [x_cm, y_cm] with both in [{lo:.1}, {:.1}] so the \
-                         e-puck's body is inside the {size_cm} cm arena",
-                        size_cm - lo
-                    ),
-                ));
-            }
-            (x / 100.0, y / 100.0)
-        }
-    };
-    if !file.start_heading_deg.is_finite() {
-        return Err(bad(
-            "start_heading_deg",
-            file.start_heading_deg.to_string(),
-            "an angle in degrees (0 = +x, 90 = up)",
-        ));
-    }
-    Ok(Pose {
-        x_m: sx,
-        y_m: sy,
-        heading_rad: errp_robot::wrap_angle(file.start_heading_deg.to_radians()),
-    })
-}
-
-/// The decoder a `[user]` table asks for: a cross-validated accuracy, or an
-/// online operating point (a hit rate and, optionally, false alarms per
-/// minute, when the file sets no `control.t_e`: `t_e_given`), with the
-/// accuracy the device assumes (info gain).
-fn decoder_target(
-    u: &UserFile,
-    t_e_given: bool,
-    path: &Path,
-) -> Result<(Option<Valid<OnlineTarget>>, MeanAccuracy)> {
-    let bad =
-        |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
-    // The accuracy the device assumes (info gain): the cross-validated
-    // accuracy, or the targeted hit rate.
-    match (u.accuracy, u.hit_rate, u.false_alarms_per_min) {
-        (Some(a), None, None) => {
-            let a = MeanAccuracy::new(a).map_err(|_| {
-                bad(
-                    "user.accuracy",
-                    a.to_string(),
-                    "a mean accuracy strictly between 0.5 (chance) and 1, e.g. 0.95 \
-                         (the mean of the decoder's two cross-validated class rates)",
-                )
-            })?;
-            Ok((None, a))
-        }
-        (None, Some(h), fa) => {
-            let target = OnlineTarget {
-                hit_rate: h,
-                false_alarms_per_min: fa,
-            };
-            // Checked here, once: the search takes it checked.
-            let target = Valid::new(target).map_err(|e| table_error(path, "user", e))?;
-            if fa.is_some() && t_e_given {
-                return Err(bad(
-                    "control.t_e",
-                    "given".into(),
-                    "no t_e when user.false_alarms_per_min is given: T_e is then \
-                     calibrated to meet that false-alarm rate",
-                ));
-            }
-            // A hit rate is below 1, so this is a mean accuracy.
-            let assumed = MeanAccuracy::new(h.max(0.51))
-                .map_err(|_| bad("user.hit_rate", h.to_string(), "a hit rate in (0, 1)"))?;
-            Ok((Some(target), assumed))
-        }
-        (None, None, Some(f)) => Err(bad(
-            "user.false_alarms_per_min",
-            f.to_string(),
-            "user.hit_rate beside it (an online operating point is a hit rate and, \
-                 optionally, a false-alarm rate)",
-        )),
-        (None, None, None) => Err(bad(
-            "user.accuracy",
-            "missing".into(),
-            "the decoder: accuracy = A (cross-validated mean accuracy in (0.5, 1)) or \
-                 hit_rate = H [and false_alarms_per_min = F] (the online operating point)",
-        )),
-        (Some(a), _, _) => Err(bad(
-            "user.accuracy",
-            a.to_string(),
-            "either accuracy or hit_rate [and false_alarms_per_min], not both",
-        )),
-    }
-}
-
-/// The synthetic user of a `[user]` table: field of view, reaction latency,
-/// re-elicitation, on the defaults.
-fn user_params(u: &UserFile, path: &Path) -> Result<UserParams> {
-    let bad =
-        |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
-    let mut user = UserParams::default();
-    if let Some(v) = u.fov_deg {
-        user.fov_rad = v.to_radians();
-    }
-    if let Some(v) = u.reaction_latency_ms {
-        if !(v.is_finite() && (0.0..=MAX_REACTION_LATENCY_MS).contains(&v)) {
-            return Err(bad(
-                "user.reaction_latency_ms",
-                v.to_string(),
-                &format!(
-                    "a delay from 0 to {MAX_REACTION_LATENCY_MS} ms (default {})",
-                    user.reaction_latency_secs * 1000.0
-                ),
-            ));
-        }
-        user.reaction_latency_secs = v / 1000.0;
-    }
-    if let Some(v) = u.reelicit_secs {
-        if !(v.is_finite() && (0.5..=MAX_REELICIT_SECS).contains(&v)) {
-            return Err(bad(
-                "user.reelicit_secs",
-                v.to_string(),
-                &format!(
-                    "a time from 0.5 s (an ErrP lasts about that long) to \
-                     {MAX_REELICIT_SECS} s (default {})",
-                    user.reelicit_secs
-                ),
-            ));
-        }
-        user.reelicit_secs = v;
-    }
-    user.validate()
-        .map_err(|e| SimError::Scenario(format!("{}: {e}", path.display())))?;
-    Ok(user)
-}
-
-/// The detector of a `[detector]` table (literal or smoothed, on the
-/// defaults), checked once.
-fn detector_params(d: &DetectorFile, path: &Path) -> Result<Valid<DetectorParams>> {
-    let bad =
-        |field: &str, value: String, expected: &str| field_error(path, field, value, expected);
-    let mut p = DetectorParams::default();
-    if let Some(m) = d.mode {
-        p = match m {
-            DetectorMode::Literal => DetectorParams::literal().into_inner(),
-            DetectorMode::Smoothed => DetectorParams::default(),
-        };
-    }
-    if let Some(n) = d.smooth_windows {
-        p.smooth_windows = whole(
-            path,
-            "detector.smooth_windows",
-            n,
-            1,
-            16,
-            " windows (up to 1 s of 62.5 ms steps)",
-        )?;
-    }
-    if let Some(r) = d.refractory_secs {
-        p.refractory_secs = r;
-    }
-    if p.mode == DetectorMode::Literal
-        && (d.smooth_windows.is_some() || d.refractory_secs.is_some())
-    {
-        return Err(bad(
-            "detector.mode",
-            "\"literal\"".into(),
-            "\"smoothed\" when smooth_windows or refractory_secs is given (the \
-             literal reading compares each window with T_e on its own)",
-        ));
-    }
-    // Checked here, once: episodes and detectors take it checked.
-    Valid::new(p).map_err(|e| table_error(path, "detector", e))
 }
 
 #[cfg(test)]
@@ -631,7 +388,7 @@ accuracy = 0.7438
             assert!(e.contains(value), "{value}: {e}");
             assert!(e.contains("expected"), "{e}");
         }
-        // Ranges are the robot's own (ContinuousControlParams::validate),
+        // Ranges are the robot's own (EpuckControlParams::validate),
         // reported under the file's name for the field.
         let e = err(&format!("{OK}[control]\nt_e = 1.5\n"));
         assert!(

@@ -1,7 +1,10 @@
 //! The e-puck recording's tidy tables: runs, trajectory, detections, belief, ErrPs and events.
 
-#[allow(clippy::wildcard_imports, unused_imports)]
-use super::*;
+use crate::epuck::{EpuckEpisodeResult, PHASE_NAMES, STEP_NAMES};
+use crate::inspect::Recording;
+use crate::inspect::tables::{CsvTable, name_of, phase_secs};
+use crate::record::data::Column;
+use crate::record::schema::{ErrpsView, EventsView, FramesView, WindowsView};
 
 pub(super) fn epuck_tables(
     rec: &Recording,

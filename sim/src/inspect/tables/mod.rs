@@ -6,15 +6,14 @@ use std::fmt::Write as _;
 
 use errp_robot::Grid;
 
-use crate::epuck::{EpuckEpisodeResult, PHASE_NAMES, PHYSICS_DT_SECS, STEP_NAMES};
+use crate::epuck::PHYSICS_DT_SECS;
 use crate::inspect::{Recording, Runs};
 use crate::record::data::Column;
-use crate::record::schema::{ErrpsView, EventsView, FramesView, WindowsView};
+use crate::record::schema::FramesView;
 
 mod epuck;
 
-#[allow(unused_imports)]
-pub use epuck::*;
+use epuck::epuck_tables;
 
 /// One tidy table.
 #[derive(Debug, Clone, PartialEq)]

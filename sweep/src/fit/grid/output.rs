@@ -1,7 +1,13 @@
 //! The fit's files: `fit.json`, `surface.csv` and the figure.
 
-#[allow(clippy::wildcard_imports)]
-use super::*;
+use std::path::{Path, PathBuf};
+
+use errp_sim::Result;
+
+use super::paper::PaperRow;
+use super::result::{CellStats, GridFit, REACHED_LEVEL};
+use crate::fit::files;
+use crate::plot::{Curve, CurvePoint, FitPanel, FitPlot};
 
 pub(super) fn write_fit(fit: &GridFit, out: &Path) -> Result<Vec<PathBuf>> {
     files::write_fit_files(out, fit, grid_surface_csv(fit), &grid_fit_plot(fit))
@@ -120,12 +126,12 @@ pub fn grid_fit_plot(fit: &GridFit) -> FitPlot {
         };
     let (fixed_curves, fixed_refs) = actions(&fit.fixed, &fit.fixed_stats);
     let (free_curves, free_refs) = actions(&fit.free, &fit.free_stats);
-    let (lo, hi) = fit.interval_95;
+    let (lo, hi) = fit.estimate.interval_95;
     FitPlot {
         title: format!(
             "Grid fit to Table 1's fixed goals: goal reward {} (95 % LR {lo}-{hi}), {} keeps \
              the paper's 40/40 (P >= {REACHED_LEVEL}){}",
-            errp_sim::task::format_number(fit.estimate),
+            errp_sim::task::format_number(fit.estimate.value),
             fit.reached_estimate
                 .map_or("none".into(), errp_sim::task::format_number),
             fit.pairs.as_ref().map_or(String::new(), |p| format!(
@@ -134,8 +140,8 @@ pub fn grid_fit_plot(fit: &GridFit) -> FitPlot {
             ))
         ),
         x_desc: "goal reward (Q-value scale at tau = 0.3)".into(),
-        estimate: fit.estimate,
-        interval: fit.interval_95,
+        estimate: fit.estimate.value,
+        interval: fit.estimate.interval_95,
         panels: vec![
             FitPanel {
                 caption: "Log-likelihood, fixed goals (± Monte Carlo sd)".into(),
