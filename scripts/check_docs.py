@@ -19,7 +19,13 @@ every docs/guide/*.md, and checks that:
   such as `docs/figures/epuck_*.txt` must match at least one such figure;
   a NAME in capitals only is a placeholder and skipped);
 * every chapter of docs/guide/ is linked from docs/guide/README.md, and
-  docs/guide/README.md from README.md.
+  docs/guide/README.md from README.md;
+* ARCHITECTURE.md's tables match the tree: under each crate's heading
+  (### `name` (`dir/`)), a table row for every source file of the crate
+  (`dir/src/**/*.rs`; the Python package: `python/rust/*.rs` and
+  `python/src/errp/*`), and no row for a file that does not exist; in its
+  folder and script tables, every folder named exists, every folder of
+  scenarios/ has a row and every script of scripts/ is named.
 
 Prints each problem as FILE:LINE: message and exits 1 if there is any;
 otherwise prints a one-line summary and exits 0. Runs from any directory.
@@ -143,6 +149,87 @@ def figure_names():
     return names
 
 
+ARCH = Path("ARCHITECTURE.md")
+CRATE_HEADING = re.compile(r"^### `([a-z_]+)` \(`([a-z_]+)/`\)")
+ROW = re.compile(r"^\|\s*`([^`]+)`")
+
+
+def crate_files(folder):
+    """The source files a crate's table must list, relative to `folder`."""
+    if folder == "python":
+        files = [f"rust/{p.name}" for p in Path("python/rust").glob("*.rs")]
+        files += [f"src/errp/{p.name}" for p in Path("python/src/errp").iterdir()
+                  if p.suffix in (".py", ".pyi")]
+        return set(files)
+    base = Path(folder) / "src"
+    return {str(p.relative_to(base)) for p in base.rglob("*.rs")}
+
+
+def check_architecture(problems):
+    """ARCHITECTURE.md's module, folder and script tables against the tree;
+    returns the number of module rows checked."""
+    if not ARCH.is_file():
+        return 0
+    lines = ARCH.read_text(encoding="utf-8").splitlines()
+    sections = []  # (crate, folder, line, {file: line})
+    current = None
+    in_code = False
+    named = set()  # every backticked path in a table's first cell
+    for n, line in enumerate(lines, 1):
+        if FENCE.match(line):
+            in_code = not in_code
+            continue
+        if in_code:
+            continue
+        m = CRATE_HEADING.match(line)
+        if m:
+            current = (m.group(1), "." if m.group(2) == "src" else m.group(2), n, {})
+            sections.append(current)
+            continue
+        if line.startswith("#"):
+            current = None
+            continue
+        m = ROW.match(line)
+        if not m:
+            continue
+        for cell in re.findall(r"`([^`]+)`", line.split("|")[1]):
+            named.add(cell)
+        if current is not None:
+            current[3][m.group(1)] = n
+    checked = 0
+    if not sections:
+        problems.append(f"{ARCH}:1: no crate table (### `name` (`dir/`))")
+    for crate, folder, at, rows in sections:
+        want = crate_files(folder) if folder != "." else {
+            str(p.relative_to("src")) for p in Path("src").rglob("*.rs")}
+        if not want:
+            problems.append(f"{ARCH}:{at}: {crate}: no source files under {folder}/")
+        for f, n in rows.items():
+            checked += 1
+            if f not in want:
+                problems.append(f"{ARCH}:{n}: {crate}: {f} is no source file of the crate")
+        for f in sorted(want - set(rows)):
+            problems.append(f"{ARCH}:{at}: {crate}: {f} has no row in the table")
+    # The folder and script tables.
+    for cell in sorted(named):
+        path = cell.split(" ")[0]
+        if path.endswith("/") or path.startswith("scripts/") or path.startswith(".ci/"):
+            if "*" in path:
+                if not list(Path(".").glob(path.rstrip("/"))):
+                    problems.append(f"{ARCH}:1: {path} matches nothing")
+            elif not Path(path).exists():
+                problems.append(f"{ARCH}:1: {path} does not exist")
+    for d in sorted(p for p in Path("scenarios").iterdir() if p.is_dir()):
+        if f"{d}/" not in named:
+            problems.append(f"{ARCH}:1: the folder {d}/ has no row")
+    text = ARCH.read_text(encoding="utf-8")
+    for p in sorted(Path("scripts").iterdir()):
+        name = p.name + ("/" if p.is_dir() else "")
+        if not re.search(r"`(scripts/)?" + re.escape(name) + r"`", text):
+            problems.append(f"{ARCH}:1: scripts/{name} is not named")
+    return checked
+
+
 def main():
     os.chdir(ROOT)
     problems = []
@@ -247,14 +334,16 @@ def main():
         if index not in from_readme and GUIDE not in from_readme:
             problems.append(f"README.md:1: the guide's index {index} is not linked")
 
+    modules_checked = check_architecture(problems)
+
     for p in problems:
         print(p)
     if problems:
         print(f"check_docs: {len(problems)} problem(s)", file=sys.stderr)
         return 1
     print(f"check_docs: {len(files)} files, {links_checked} relative links "
-          f"({anchors_checked} with anchors) and {figures_checked} figure mentions checked; "
-          f"all good")
+          f"({anchors_checked} with anchors), {figures_checked} figure mentions and "
+          f"ARCHITECTURE.md's {modules_checked} module rows checked; all good")
     return 0
 
 

@@ -14,7 +14,7 @@ import argparse
 import sys
 from pathlib import Path
 
-DIRS = ["bci/src", "robot/src", "sim/src", "sweep/src", "src", "valid/src", "python/rust"]
+DIRS = ["bci/src", "robot/src", "sim/src", "sweep/src", "src", "valid/src", "python/rust", "lsl/src"]
 
 
 def code_lines(path: Path) -> int:

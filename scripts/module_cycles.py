@@ -8,7 +8,8 @@
   or through other files, is reported with its files.
 - No glue: no `use super::*` outside a `#[cfg(test)]` module, no
   `#[allow(unused_imports)]` or `#[allow(clippy::wildcard_imports)]`
-  outside tests.
+  outside tests; every other `#[allow(...)]` outside tests says why
+  (`reason = "..."`), and there are at most eight.
 - With --layers FILE, each crate is checked against the floor plan in FILE
   (ARCHITECTURE.md): a fenced ```layers block with one line per crate,
   `DIR: a b | c | d e`, the top-level modules from the bottom layer up. A
@@ -264,15 +265,24 @@ def circles(graph: dict[tuple[str, ...], set[tuple[str, ...]]]) -> list[list[tup
     return out
 
 
-def glue(crate: Crate) -> list[str]:
-    out = []
+MAX_ALLOWS = 8
+
+
+def glue(crate: Crate) -> tuple[list[str], int]:
+    """The glue a crate's files hold outside tests, and its `#[allow]`s."""
+    out, allows = [], 0
     for mod, code in sorted(crate.code.items()):
         path = crate.files[mod]
         if re.search(r"\buse\s+super::\*\s*;", code):
             out.append(f"{path}: `use super::*` outside a test module: import what the module uses")
         if re.search(r"#\[allow\([^)]*(unused_imports|wildcard_imports)", code):
             out.append(f"{path}: an allowed unused or wildcard import outside tests")
-    return out
+        # (Strings are blanked: a reason reads `reason = ""`.)
+        for m in re.finditer(r"#!?\[allow\(([^\]]*)\)\]", code):
+            allows += 1
+            if "reason" not in m.group(1):
+                out.append(f"{path}: #[allow({m.group(1).strip()})] without a reason")
+    return out, allows
 
 
 def read_layers(path: str) -> dict[str, list[set[str]]]:
@@ -323,6 +333,7 @@ if __name__ == "__main__":
         args = args[2:]
     bad = 0
     files = 0
+    allows = 0
     for root in args:
         crate = Crate(root)
         files += len(crate.files)
@@ -331,7 +342,9 @@ if __name__ == "__main__":
             names = ", ".join(crate.files[m] for m in c)
             print(f"{root}: import circle between {names}", file=sys.stderr)
             bad += 1
-        for e in glue(crate):
+        problems, n = glue(crate)
+        allows += n
+        for e in problems:
             print(e, file=sys.stderr)
             bad += 1
         if plan is not None:
@@ -342,6 +355,12 @@ if __name__ == "__main__":
             for e in layer_errors(root, graph, plan[root]):
                 print(e, file=sys.stderr)
                 bad += 1
+    if allows > MAX_ALLOWS:
+        print(f"{allows} #[allow]s outside tests, more than {MAX_ALLOWS}", file=sys.stderr)
+        bad += 1
     if not bad:
-        print(f"module_cycles: {files} files in {len(args)} crates, no import circle, no glue")
+        print(
+            f"module_cycles: {files} files in {len(args)} crates, no import circle, no glue, "
+            f"{allows} #[allow]s each with a reason"
+        )
     sys.exit(1 if bad else 0)

@@ -3,7 +3,7 @@
 
     python3 scripts/table1_seeds.py [--errp PATH (default $ERRP or target/release/errp)] [--seeds 10]
 
-Runs `errp table1 --seed S` for S = 1..N (streamed EEG, the defaults) and
+Runs `errp table1 --seed S` for S = 1..N (EEG per action, the defaults) and
 prints, per subject and goal set, our mean actions over the N x 5 runs
 against the paper's, in standard errors: z = (ours - paper) / sqrt(paper
 sd^2 / 5 + our sd^2 / (5 N)); the accuracy row (the mean over runs, as the paper's)

@@ -56,19 +56,30 @@ pub(crate) enum DecoderArg {
 
 #[derive(Clone, Copy, ValueEnum)]
 pub(crate) enum EegArg {
-    /// Synthesise each action's EEG when it happens (`stream`, its former
-    /// name, is still accepted).
-    #[value(name = "per_action", alias = "stream")]
+    /// Synthesise each action's EEG when it happens.
+    #[value(name = "per_action")]
     PerAction,
     /// Draw preprocessed epochs from a bank synthesised in advance.
     Bank,
+    /// The former name of per_action, still read.
+    #[value(hide = true)]
+    Stream,
 }
 
 impl EegArg {
     pub(crate) fn mode(self) -> EegMode {
         match self {
-            EegArg::PerAction => EegMode::PerAction,
+            EegArg::PerAction | EegArg::Stream => EegMode::PerAction,
             EegArg::Bank => EegMode::Bank,
+        }
+    }
+
+    /// As it was given (`stream` for its former name), for what is set in
+    /// a scenario and named in errors.
+    pub(crate) fn word(self) -> &'static str {
+        match self {
+            EegArg::Stream => "stream",
+            e => e.mode().key(),
         }
     }
 }

@@ -3,6 +3,7 @@
 //! Thin glue: parse arguments, call the libraries, print, write files.
 
 // No function over 100 lines of code (clippy.toml) outside the tests.
+#![forbid(unsafe_code)]
 #![cfg_attr(not(test), warn(clippy::too_many_lines))]
 
 mod cli;

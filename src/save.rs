@@ -7,7 +7,6 @@ use std::path::Path;
 use anyhow::{Result, bail};
 
 use crate::cli::check_extension;
-#[cfg(feature = "rerun")]
 use crate::out::outln;
 
 /// Checks `--save` before any work: the file name, and that this build can
@@ -29,7 +28,6 @@ pub(crate) fn check_save(save: Option<&Path>) -> Result<()> {
 }
 
 /// Prints where a recording went.
-#[cfg(feature = "rerun")]
 pub(crate) fn wrote(path: &Path) -> Result<()> {
     outln!(
         "Wrote {} (open with: rerun {})",

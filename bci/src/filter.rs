@@ -94,7 +94,7 @@ impl FilterChain {
         Self { sections, state }
     }
 
-    /// Clears the state (as at the start of a recording).
+    /// Clears the state (as at the start of a signal).
     pub fn reset(&mut self) {
         for s in &mut self.state {
             *s = [0.0; 2];
@@ -118,7 +118,7 @@ impl FilterChain {
         }
     }
 
-    /// Zero-phase filtering of a whole recording (forward, then backward,
+    /// Zero-phase filtering of a whole signal (forward, then backward,
     /// from rest), as offline ERP analysis does; squares the magnitude
     /// response. Not causal: for display and grand averages only.
     pub fn filtfilt(&self, x: &mut [f64]) {

@@ -19,11 +19,11 @@
 //!   ([`calibrate_continuous`]) and accuracy targeting
 //!   ([`target_continuous_accuracy`]), and its online side: the sliding
 //!   window ([`SlidingWindow`]), the asynchronous [`Detector`] and its
-//!   operating point on a held-out recording ([`operating_point`]);
+//!   operating point on a held-out session ([`operating_point`]);
 //! * the information one decoded action carries about the user's verdict
 //!   ([`ActionInformation`]);
 //! * the subjects of Table 1 ([`subject`]), EDF+ export ([`EdfWriter`]);
-//! * a person's own recording in place of the synthetic EEG: EDF, EDF+,
+//! * a person's own EEG in place of the synthetic EEG: EDF, EDF+,
 //!   BDF and BDF+ read and checked ([`EdfFile`]), matched to the montage
 //!   ([`OwnEeg`]) and split into a calibration part and held-out epochs
 //!   ([`split_own_eeg`]).
@@ -41,6 +41,7 @@
 //! assert_eq!(s1.fixed_goals_pct, 83.14);
 //! ```
 
+#![forbid(unsafe_code)]
 #![warn(clippy::unwrap_used, clippy::print_stdout, clippy::iter_over_hash_type)]
 // No function over 100 lines of code (clippy.toml) outside the tests.
 #![cfg_attr(not(test), warn(clippy::too_many_lines))]

@@ -24,7 +24,7 @@ pub struct Channel {
     pub position: [f64; 3],
 }
 
-/// The recording montage: all EEG channels first, then the EOG channels.
+/// The montage: all EEG channels first, then the EOG channels.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Montage {
     channels: Vec<Channel>,
@@ -85,7 +85,7 @@ impl Montage {
     }
 
     /// The channels at `keep` (increasing indices), EEG still first: the
-    /// part of the montage a recording has.
+    /// part of the montage own EEG has.
     pub fn subset(&self, keep: &[usize]) -> Result<Self> {
         if !keep.windows(2).all(|w| w[0] < w[1]) || keep.iter().any(|&i| i >= self.len()) {
             return Err(BciError::InvalidParameter {

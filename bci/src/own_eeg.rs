@@ -1,4 +1,4 @@
-//! A person's own recording in place of the synthetic EEG: its channels
+//! A person's own EEG in place of the synthetic EEG: its channels
 //! matched by name to the montage, its events read from annotations, and
 //! its split into a calibration part, on which the discrete decoder is
 //! trained as on a synthetic session, and a held-out part, whose epochs the
@@ -8,8 +8,8 @@
 //! ends where the last of their epochs ends. Held-out epochs start after
 //! that, so no sample a decoder was trained on (nor the preprocessing
 //! fitted on) is ever decoded online. The EOG regression, which a synthetic
-//! session fits on a separate EOG recording, is fitted on the calibration
-//! part itself: a recorded session rarely comes with one.
+//! session fits on a separate EOG session, is fitted on the calibration
+//! part itself: a person's file rarely comes with one.
 
 use errp_valid::Valid;
 use nalgebra::DMatrix;
@@ -50,11 +50,11 @@ impl Default for EventNames {
     }
 }
 
-/// A recording matched to the montage: the channels the decoder needs, in
+/// Own EEG matched to the montage: the channels the decoder needs, in
 /// the montage's order, in µV, and its labelled events.
 #[derive(Debug, Clone)]
 pub struct OwnEeg {
-    /// The standard montage's channels found in the recording (EEG first).
+    /// The standard montage's channels found in the file (EEG first).
     pub montage: Montage,
     /// The samples, `(montage.len(), n)`, in µV.
     pub raw: EegBlock,
@@ -78,7 +78,7 @@ impl OwnEeg {
     /// at `sfreq_hz`) to the standard montage: the eight decoding channels
     /// and the six EOG ones must be there, every other EEG channel found
     /// joins the common average reference. `events` are sorted by onset
-    /// and must lie inside the recording.
+    /// and must lie inside the data.
     pub fn new(
         labels: &[&str],
         data: &EegBlock,
@@ -148,7 +148,7 @@ impl OwnEeg {
         })
     }
 
-    /// The recording in an EDF or BDF file, at the decoder's `sfreq_hz`:
+    /// Own EEG from an EDF or BDF file, at the decoder's `sfreq_hz`:
     /// its channels matched as [`OwnEeg::new`] matches them (each a
     /// voltage, at `sfreq_hz`), its events the annotations `names` gives.
     pub fn from_edf(file: &EdfFile, names: &EventNames, sfreq_hz: f64) -> Result<Self> {
@@ -189,7 +189,7 @@ impl OwnEeg {
         Self::new(&used_labels, &data, sfreq_hz, events)
     }
 
-    /// The recording's duration, in seconds.
+    /// The EEG's duration, in seconds.
     pub fn duration_secs(&self) -> f64 {
         self.raw.n_samples as f64 / self.sfreq_hz
     }
@@ -243,7 +243,7 @@ fn events_of(file: &EdfFile, names: &EventNames) -> Result<Vec<Assessment>> {
     Ok(events)
 }
 
-/// How much of a recording calibrates the decoder.
+/// How much of own EEG calibrates the decoder.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum CalibrationPart {
     /// This fraction of the events, the first ones, in (0, 1).
@@ -252,7 +252,7 @@ pub enum CalibrationPart {
     Events(usize),
 }
 
-/// One held-out epoch of a recording, preprocessed.
+/// One held-out epoch of own EEG, preprocessed.
 #[derive(Debug, Clone)]
 pub struct OwnEegEpoch {
     /// The event's index in [`OwnEeg::events`].
@@ -267,7 +267,7 @@ pub struct OwnEegEpoch {
     pub block: EegBlock,
 }
 
-/// A recording split for the discrete decoder.
+/// Own EEG split for the discrete decoder.
 #[derive(Debug, Clone)]
 pub struct OwnEegSplit {
     /// The calibration part's epochs, as a synthetic session gives them.
@@ -277,15 +277,15 @@ pub struct OwnEegSplit {
     /// The held-out epochs, by onset.
     pub held_out: Vec<OwnEegEpoch>,
     /// Events after the calibration's first whose epochs overlap the
-    /// calibration part or run past the recording's end: used by neither.
+    /// calibration part or run past the EEG's end: used by neither.
     pub dropped: usize,
 }
 
-/// Splits `recording` by time: the first events (`part`) calibrate, the
-/// later ones are held out. The preprocessing (`preprocessing`, at the
-/// recording's rate) is fitted on the calibration part, then run causally
-/// over the whole recording; every event's epoch becomes the paper's
-/// temporal features.
+/// Splits `recording` (own EEG) by time: the first events (`part`)
+/// calibrate, the later ones are held out. The preprocessing
+/// (`preprocessing`, at the EEG's rate) is fitted on the calibration part,
+/// then run causally over the whole of it; every event's epoch becomes the
+/// paper's temporal features.
 pub fn split_own_eeg(
     recording: &OwnEeg,
     part: CalibrationPart,

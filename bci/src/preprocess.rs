@@ -98,9 +98,9 @@ pub struct Preprocessor {
 
 impl Preprocessor {
     /// Fits the EOG regression on `eog_session` (raw samples of every
-    /// channel, ideally a recording with deliberate blinks and saccades) and
+    /// channel, ideally an EOG session with deliberate blinks and saccades) and
     /// returns a preprocessor producing the EEG channels `outputs`. A
-    /// montage without EOG channels (a recording that has none) gets no
+    /// montage without EOG channels (own EEG that has none) gets no
     /// EOG regression: CAR and the filters only.
     pub fn fit(
         montage: &Montage,
@@ -217,7 +217,7 @@ impl Preprocessor {
         &self.eog_weights
     }
 
-    /// Clears filter state (a new recording starts).
+    /// Clears filter state (a new signal starts).
     pub fn reset(&mut self) {
         self.filters.reset();
     }

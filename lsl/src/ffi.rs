@@ -2,7 +2,12 @@
 //! the functions the testbed calls, copied out of the library once, and the
 //! library kept loaded as long as one of them may be called.
 
-#![allow(unsafe_code)]
+#![allow(
+    unsafe_code,
+    reason = "the calls into liblsl: the one module of the workspace that allows unsafe code, \
+              each block with its SAFETY note"
+)]
+#![warn(clippy::undocumented_unsafe_blocks)]
 
 use std::ffi::{CStr, CString, c_char, c_double, c_void};
 use std::path::{Path, PathBuf};
@@ -16,7 +21,6 @@ use crate::LslError;
 pub(crate) type Handle = *mut c_void;
 
 /// The functions of liblsl the testbed calls.
-#[allow(missing_docs)]
 pub(crate) struct Api {
     pub library_version: unsafe extern "C" fn() -> i32,
     pub local_clock: unsafe extern "C" fn() -> c_double,

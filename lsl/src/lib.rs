@@ -8,6 +8,41 @@
 //! `liblsl.so`, or the one bundled in the `pylsl` wheel. The build needs
 //! neither cmake nor liblsl, and a program that never streams never loads
 //! it. All unsafe code (the calls) is in the private `ffi` module.
+//!
+//! A marker stream described, then published where liblsl is found (the
+//! description is plain data; nothing touches liblsl before
+//! [`Lsl::find`]):
+//!
+//! ```
+//! use errp_lsl::{Element, Format, Lsl, StreamSpec};
+//!
+//! let spec = StreamSpec {
+//!     name: "example-markers".into(),
+//!     kind: "Markers".into(),
+//!     channels: 1,
+//!     rate_hz: 0.0, // irregular
+//!     format: Format::String,
+//!     source_id: "example-markers-1".into(),
+//!     desc: vec![Element::node(
+//!         "example",
+//!         vec![Element::leaf("version", 1)],
+//!     )],
+//! };
+//! assert_eq!(spec.format.name(), "string");
+//! assert_eq!(spec.desc[0].children[0].value.as_deref(), Some("1"));
+//!
+//! // With ERRP_LIBLSL set (or pylsl installed), publish one marker.
+//! if std::env::var_os("ERRP_LIBLSL").is_some() {
+//!     let lsl = Lsl::find(None)?;
+//!     let outlet = lsl.outlet(&spec)?;
+//!     outlet.push_text("{\"event\":\"hello\"}", lsl.clock())?;
+//! }
+//! # Ok::<(), errp_lsl::LslError>(())
+//! ```
+
+#![warn(clippy::unwrap_used, clippy::print_stdout, clippy::iter_over_hash_type)]
+// No function over 100 lines of code (clippy.toml) outside the tests.
+#![cfg_attr(not(test), warn(clippy::too_many_lines))]
 
 use std::ffi::CString;
 use std::path::{Path, PathBuf};
@@ -471,18 +506,7 @@ impl Inlet {
             )));
         }
         let (stamp, ec) = self.raw.pull(buffer, timeout_secs);
-        match ec {
-            0 if stamp != 0.0 => Ok(Some(stamp)),
-            0 | LSL_TIMEOUT => Ok(None),
-            LSL_LOST => Err(LslError::Lost(format!(
-                "the stream {:?} was lost: its sender stopped",
-                self.name
-            ))),
-            ec => Err(LslError::Stream(format!(
-                "{}: liblsl error {ec} while reading",
-                self.name
-            ))),
-        }
+        pulled(&self.name, stamp, ec)
     }
 
     /// The offset (s) to add to the sender's timestamps for the local
@@ -509,5 +533,103 @@ impl Inlet {
     /// The stream's name.
     pub fn name(&self) -> &str {
         &self.name
+    }
+}
+
+/// What a pull of the stream `name` gave: a sample's timestamp (`stamp`,
+/// liblsl's error code `ec` 0), nothing yet (0 without a timestamp, or a
+/// timeout), a lost sender, or another error.
+fn pulled(name: &str, stamp: f64, ec: i32) -> Result<Option<f64>, LslError> {
+    match ec {
+        0 if stamp != 0.0 => Ok(Some(stamp)),
+        0 | LSL_TIMEOUT => Ok(None),
+        LSL_LOST => Err(LslError::Lost(format!(
+            "the stream {name:?} was lost: its sender stopped"
+        ))),
+        ec => Err(LslError::Stream(format!(
+            "{name}: liblsl error {ec} while reading"
+        ))),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const FORMATS: [Format; 7] = [
+        Format::Float32,
+        Format::Double64,
+        Format::String,
+        Format::Int32,
+        Format::Int16,
+        Format::Int8,
+        Format::Int64,
+    ];
+
+    #[test]
+    fn every_format_has_liblsls_code_and_name() {
+        for (k, f) in FORMATS.into_iter().enumerate() {
+            // lsl_channel_format_t: cft_float32 = 1 ... cft_int64 = 7.
+            assert_eq!(f.code(), k as i32 + 1);
+            assert_eq!(Format::from_code(f.code()), Some(f));
+        }
+        assert_eq!(Format::from_code(0), None, "cft_undefined");
+        assert_eq!(Format::from_code(8), None);
+        assert_eq!(Format::String.name(), "string");
+        assert_eq!(Format::Double64.name(), "double64");
+    }
+
+    #[test]
+    fn a_description_is_a_tree_of_leaves_and_nodes() {
+        let e = Element::node("errp", vec![Element::leaf("speed", 2.5)]);
+        assert_eq!(e.value, None);
+        assert_eq!(e.children[0].name, "speed");
+        assert_eq!(e.children[0].value.as_deref(), Some("2.5"));
+        assert!(e.children[0].children.is_empty());
+    }
+
+    #[test]
+    fn a_path_that_is_no_library_is_refused_naming_it() {
+        let dir = std::env::temp_dir().join(format!("errp-lsl-unit-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let missing = dir.join("missing.so");
+        let e = Lsl::open(&missing).unwrap_err().to_string();
+        assert!(
+            e.contains("missing.so") && e.ends_with("no such file"),
+            "{e}"
+        );
+        let e = Lsl::open(&dir).unwrap_err().to_string();
+        assert!(e.ends_with("not a regular file"), "{e}");
+        let text = dir.join("liblsl.so");
+        std::fs::write(&text, "not a library").unwrap();
+        let e = Lsl::open(&text).unwrap_err();
+        assert!(matches!(e, LslError::Load { .. }), "{e}");
+        assert!(matches!(
+            Lsl::find(Some(&missing)),
+            Err(LslError::Load { .. })
+        ));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_nul_in_a_name_is_refused_before_liblsl_sees_it() {
+        let e = ffi::c_string("a marker", "a\0b").unwrap_err();
+        assert!(matches!(e, LslError::Argument(_)));
+        assert_eq!(e.to_string(), "a marker holds a NUL character");
+        assert!(ffi::c_string("a marker", "ab").is_ok());
+    }
+
+    #[test]
+    fn a_pull_is_a_sample_nothing_yet_or_a_lost_sender() {
+        assert_eq!(pulled("d", 12.5, 0).unwrap(), Some(12.5));
+        assert_eq!(pulled("d", 0.0, 0).unwrap(), None);
+        assert_eq!(pulled("d", 0.0, LSL_TIMEOUT).unwrap(), None);
+        let e = pulled("d", 0.0, LSL_LOST).unwrap_err();
+        assert!(matches!(e, LslError::Lost(_)), "{e}");
+        assert_eq!(
+            e.to_string(),
+            "the stream \"d\" was lost: its sender stopped"
+        );
+        assert!(matches!(pulled("d", 0.0, -4), Err(LslError::Stream(_))));
     }
 }

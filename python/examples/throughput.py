@@ -4,7 +4,7 @@
 
 Grid: episodes per second of the fixed-goals scenario with the testbed's
 decoder and with a scikit-learn LDA (Platt-scaled) called from the loop,
-per epoch (streamed EEG: one Python call per action) and once over an
+per epoch (EEG per action: one Python call per action) and once over an
 epoch bank (the `batch_decoder`); a callable that returns a constant shows
 the cost of the binding itself. E-puck: the real-time factor (simulated
 seconds per second of wall time) of the Mexico-to-Pisa run with the
@@ -72,7 +72,7 @@ def main():
     print(f"Grid, fixed goals x {repeats} ({5 * repeats} episodes), one thread:")
     rows = [
         ("testbed LDA, epoch bank", dict(overrides={"repeats": repeats, "eeg": "bank"})),
-        ("testbed LDA, streamed EEG", dict(overrides={"repeats": repeats, "eeg": "stream"})),
+        ("testbed LDA, EEG per action", dict(overrides={"repeats": repeats, "eeg": "per_action"})),
         ("Python constant per epoch", dict(decoder=lambda x: 0.3,
                                            overrides={"repeats": repeats})),
         ("Python LDA per epoch, streamed", dict(decoder=f, overrides={"repeats": repeats})),

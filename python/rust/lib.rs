@@ -10,6 +10,7 @@
 //! by a decoder of the caller's own propagates unchanged.
 
 // No function over 100 lines of code (clippy.toml) outside the tests.
+#![forbid(unsafe_code)]
 #![cfg_attr(not(test), warn(clippy::too_many_lines))]
 
 mod convert;

@@ -1,7 +1,7 @@
-//! A person's recording given from Python (`GridTask(eeg=...)`): the
+//! A person's own EEG given from Python (`GridTask(eeg=...)`): the
 //! channels, data, rate and events the Python layer took from an MNE
 //! object, with its digest and the `[eeg]` options, as the scenario's
-//! recorded EEG.
+//! own EEG.
 
 use std::path::Path;
 
@@ -15,7 +15,7 @@ use pyo3::types::PyDict;
 
 use crate::convert::toml_value;
 
-/// The most samples a recording given from Python may hold (2^27, 1 GiB of
+/// The most samples own EEG given from Python may hold (2^27, 1 GiB of
 /// float64, as the largest EDF file read).
 const MAX_SAMPLES: usize = 1 << 27;
 
@@ -24,7 +24,7 @@ fn item<'py>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<Bound<'py, PyAny>> {
         .ok_or_else(|| PyValueError::new_err(format!("eeg: no {key:?}")))
 }
 
-/// The recording in `eeg` (keys `ch_names`, `data` `(n_channels,
+/// The own EEG in `eeg` (keys `ch_names`, `data` `(n_channels,
 /// n_samples)` in uV, `sfreq`, `onsets` s, `errors` (true for an error
 /// event), `name`, `bytes`, `sha256`, `options`), checked and matched to the
 /// montage, for the scenario of `task` at `who`.

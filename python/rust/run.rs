@@ -184,7 +184,7 @@ impl errp_sim::RunObserver for RunMeter<'_> {
 /// episodes as CSV text, one row per episode, and what was calibrated.
 #[pyfunction]
 #[pyo3(signature = (scenario=None, *, seed=None, runs=None, accuracy=None, overrides=None, save=None, progress=None))]
-#[allow(clippy::too_many_arguments)] // Python's keywords, one each
+#[allow(clippy::too_many_arguments, reason = "Python's keywords, one each")]
 pub(crate) fn run<'py>(
     py: Python<'py>,
     scenario: Option<PathBuf>,
@@ -287,7 +287,7 @@ pub(crate) fn grid_summary(
 }
 
 /// What the continuous decoder's calibration found, with its T_e and its
-/// operating point on the held-out recording.
+/// operating point on the held-out session.
 pub(crate) fn epuck_summary(
     s: &EpuckScenario,
     decoder: &ContinuousDecoder,
@@ -341,6 +341,24 @@ pub(crate) struct SweepKeywords {
     threads: Option<usize>,
 }
 
+/// The grid's EEG mode of a sweep, as `per_action=` (or its former name
+/// `stream=`) gives it, and the names that name the keyword given.
+fn eeg_mode(per_action: Option<bool>, stream: Option<bool>) -> (Option<&'static str>, Names) {
+    match (per_action, stream) {
+        (None, Some(s)) => (
+            Some(if s { "stream" } else { "bank" }),
+            Names {
+                sweep_eeg: "stream=",
+                ..Names::PYTHON
+            },
+        ),
+        (p, _) => (
+            p.map(|p| if p { "per_action" } else { "bank" }),
+            Names::PYTHON,
+        ),
+    }
+}
+
 /// The `task=` of a sweep: none (the scenario's), "grid" or "epuck".
 fn sweep_task(task: Option<&str>) -> PyResult<Option<TaskKind>> {
     task.map(|t| task_kind("task", t)).transpose()
@@ -353,7 +371,7 @@ fn sweep_spec(
     (text, path): (String, PathBuf),
     accuracy: Option<String>,
     params: Option<Vec<String>>,
-    per_action: Option<bool>,
+    eeg: Option<&str>,
     (episodes, seed): (usize, u64),
     names: &Names,
 ) -> PyResult<SweepSpec> {
@@ -380,7 +398,7 @@ fn sweep_spec(
              only a sweep over recordings (eeg.recording) has none",
         ));
     }
-    spec.set_levels(accuracy.as_deref(), per_action, names)
+    spec.set_levels(accuracy.as_deref(), eeg, names)
         .map_err(py_err)?;
     Ok(spec)
 }
@@ -427,24 +445,14 @@ pub(crate) fn sweep<'py>(
         Some(n) => n,
         None => rayon::current_num_threads(),
     };
-    // The EEG mode's keyword, or its former name (named as given).
-    let (per_action, names) = match (per_action, stream) {
-        (None, Some(_)) => (
-            stream,
-            Names {
-                sweep_eeg: "stream=",
-                ..Names::PYTHON
-            },
-        ),
-        _ => (per_action, Names::PYTHON),
-    };
+    let (eeg, names) = eeg_mode(per_action, stream);
     let (task, text, path) = sweep_scenario(scenario.as_deref(), want, names).map_err(py_err)?;
     let spec = sweep_spec(
         task,
         (text, path),
         accuracy,
         params,
-        per_action,
+        eeg,
         (episodes, seed),
         &names,
     )?;

@@ -25,7 +25,7 @@ pub(crate) const MAX_GENERATE_SAMPLES: usize = 3600 * errp_bci::SFREQ_HZ as usiz
 /// Simulates the discrete calibration session of `errp calibrate
 /// --accuracy ACCURACY --seed SEED`: the ErrP-to-noise ratio targeted so
 /// that the paper's decoder reaches `accuracy` by cross-validation, then 400
-/// actions (20 % erroneous) at that ratio. Returns the raw recording (all 40
+/// actions (20 % erroneous) at that ratio. Returns the raw EEG (all 40
 /// channels, uV), its events, the preprocessed epochs and the targeting.
 ///
 /// With `continuous`, the continuous decoder's calibration session instead

@@ -75,7 +75,7 @@ impl GridTask {
     /// epochs), a decoder of the caller's own replaces it in the loop.
     #[new]
     #[pyo3(signature = (scenario=None, *, decoder=None, batch_decoder=None, seed=None, accuracy=None, overrides=None, progress=None, eeg=None))]
-    #[allow(clippy::too_many_arguments)] // Python's keywords, one each
+    #[allow(clippy::too_many_arguments, reason = "Python's keywords, one each")]
     fn new(
         py: Python<'_>,
         scenario: Option<PathBuf>,
@@ -322,7 +322,7 @@ impl EpuckTask {
     /// decoder of the caller's own replaces it in the loop.
     #[new]
     #[pyo3(signature = (scenario=None, *, decoder=None, seed=None, accuracy=None, overrides=None, progress=None, eeg=None))]
-    #[allow(clippy::too_many_arguments)] // Python's keywords, one each
+    #[allow(clippy::too_many_arguments, reason = "Python's keywords, one each")]
     fn new(
         py: Python<'_>,
         scenario: Option<PathBuf>,
@@ -451,7 +451,7 @@ impl EpuckTask {
 
     /// What the calibration found (accuracy, ErrP-to-noise ratio,
     /// cross-validated accuracies, the detector's T_e and its operating
-    /// point on a held-out recording).
+    /// point on a held-out session).
     #[getter]
     fn calibration<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         summary_dict(py, &self.calibration)

@@ -33,6 +33,7 @@
 //! assert!((p[0] - 0.8).abs() < 1e-12 && (p[1] - 0.2).abs() < 1e-12);
 //! ```
 
+#![forbid(unsafe_code)]
 #![warn(clippy::unwrap_used, clippy::print_stdout, clippy::iter_over_hash_type)]
 // No function over 100 lines of code (clippy.toml) outside the tests.
 #![cfg_attr(not(test), warn(clippy::too_many_lines))]

@@ -56,7 +56,7 @@ fn episode_eeg_bank(bencher: Bencher) {
     episodes(bencher, &BANK);
 }
 
-/// The decoder calibrated on a recording (the first half of an exported
+/// The decoder calibrated on own EEG (the first half of an exported
 /// 400-action session at about 78 %), its held-out epochs drawn.
 static RECORDED: LazyLock<AssessmentDecoder> = LazyLock::new(|| {
     let dir = std::env::temp_dir().join(format!("errp-bench-recorded-{}", std::process::id()));
@@ -91,7 +91,7 @@ static RECORDED: LazyLock<AssessmentDecoder> = LazyLock::new(|| {
     decoder
 });
 
-/// One grid episode with the decoder calibrated on a recording, reading
+/// One grid episode with the decoder calibrated on own EEG, reading
 /// its held-out epochs (`[eeg] recording = ...`).
 #[divan::bench]
 fn episode_recorded(bencher: Bencher) {

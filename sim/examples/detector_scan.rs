@@ -1,4 +1,4 @@
-//! Scans the asynchronous detector's settings on a held-out recording: for
+//! Scans the asynchronous detector's settings on a held-out session: for
 //! T_e in 0.5..0.9 and 1..8 smoothed windows, the hit rate per ErrP, the
 //! false alarms per minute and the median latency, for a decoder calibrated
 //! at a given cross-validated accuracy.

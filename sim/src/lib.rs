@@ -50,6 +50,7 @@
 //! assert!(report.episodes.iter().filter(|e| e.reached()).count() >= 3);
 //! ```
 
+#![forbid(unsafe_code)]
 #![warn(clippy::unwrap_used, clippy::print_stdout, clippy::iter_over_hash_type)]
 // No function over 100 lines of code (clippy.toml) outside the tests.
 #![cfg_attr(not(test), warn(clippy::too_many_lines))]

@@ -1,9 +1,9 @@
-//! A person's own recording as a scenario's EEG: the `[eeg]` table that
+//! A person's own EEG as a scenario's EEG: the `[eeg]` table that
 //! names it, checked when the scenario loads, and the file's loading when
 //! the decoder is prepared (a regular file within [`MAX_OWN_EEG_BYTES`],
 //! hashed as it is read, checked as EDF or BDF and matched to the montage).
 //!
-//! Loading a scenario never opens the recording: a recording's stored
+//! Loading a scenario never opens the EEG file: a recording's stored
 //! scenario is read back (`errp inspect`, a sweep's finished scenario) far
 //! from the file it names.
 
@@ -21,7 +21,7 @@ use crate::rules::OwnEegFrom;
 use crate::scenario_file::field_error;
 use crate::task_kind::TaskKind;
 
-/// The largest recording file read (1 GiB).
+/// The largest own EEG file read (1 GiB).
 pub const MAX_OWN_EEG_BYTES: u64 = 1 << 30;
 
 /// The calibration part when a scenario sets none: the first half of the
@@ -30,7 +30,7 @@ pub const DEFAULT_CALIBRATION: f64 = 0.5;
 
 /// The false alarms a minute of the shipped e-puck user (accuracy 95 %,
 /// fitted to the paper's two runs by `errp fit epuck`) at the paper's
-/// T_e = 0.8 with the default detector, on its held-out recording:
+/// T_e = 0.8 with the default detector, on its held-out session:
 /// `docs/figures/epuck_mexico_default.txt` (a test reads it there). An
 /// e-puck hybrid's T_e is set to give this rate unless its `[eeg]` table
 /// says `false_alarms_per_min`.
@@ -69,7 +69,7 @@ pub(crate) struct OwnEegFields {
     false_alarms_per_min: Option<f64>,
 }
 
-/// The `[eeg]` table of an e-puck scenario: a table naming a recording
+/// The `[eeg]` table of an e-puck scenario: a table naming an EEG file
 /// (a grid's `eeg` may also be a mode).
 #[derive(Debug, Clone)]
 pub(crate) struct OwnEegTable(pub(crate) OwnEegFields);
@@ -94,7 +94,7 @@ impl<'de> Deserialize<'de> for OwnEegTable {
     }
 }
 
-/// A scenario's recorded EEG, checked (the file itself is read when the
+/// A scenario's own EEG, checked (the file itself is read when the
 /// decoder is prepared).
 #[derive(Debug, Clone, PartialEq)]
 pub struct OwnEegSpec {
@@ -102,7 +102,7 @@ pub struct OwnEegSpec {
     pub written: String,
     /// The path, relative ones resolved against the scenario's directory.
     pub file: PathBuf,
-    /// How much of the recording calibrates the decoder.
+    /// How much of the EEG calibrates the decoder.
     pub part: CalibrationPart,
     /// The annotations that mark each class.
     pub names: EventNames,
@@ -111,22 +111,22 @@ pub struct OwnEegSpec {
     /// The false alarms a minute the hybrid's T_e is set for (the e-puck;
     /// none: [`FITTED_FALSE_ALARMS_PER_MIN`]).
     pub false_alarms_per_min: Option<f64>,
-    /// The recording itself, when it was given in memory (Python's MNE
+    /// The EEG itself, when it was given in memory (Python's MNE
     /// objects) rather than as a file: used in place of reading `file`.
     pub supplied: Option<Arc<SuppliedOwnEeg>>,
 }
 
-/// A recording given in memory, with what identifies it.
+/// Own EEG given in memory, with what identifies it.
 #[derive(Debug)]
 pub struct SuppliedOwnEeg {
-    /// The recording, matched to the montage.
+    /// The EEG, matched to the montage.
     pub eeg: OwnEeg,
     /// Its name, size and SHA-256 (of the file it was read from, or of the
     /// data as given).
     pub digest: FileDigest,
 }
 
-/// Two recordings are the same if their digests are.
+/// Two own EEGs are the same if their digests are.
 impl PartialEq for SuppliedOwnEeg {
     fn eq(&self, other: &Self) -> bool {
         self.digest == other.digest
@@ -146,7 +146,7 @@ impl OwnEegSpec {
         }
     }
 
-    /// The recording `supplied` in memory, split and drawn as `options` (an
+    /// The own EEG `supplied` in memory, split and drawn as `options` (an
     /// `[eeg]` table's keys but `recording`) say; errors name the field
     /// (`eeg.calibration`) of `who`.
     pub fn supplied(
@@ -305,7 +305,7 @@ impl OwnEegFields {
     }
 }
 
-/// Reads the recording `eeg` names, at the decoder's `sfreq_hz`: opened as
+/// Reads the EEG file `eeg` names, at the decoder's `sfreq_hz`: opened as
 /// a regular file (never waiting on a FIFO or a device), at most
 /// [`MAX_OWN_EEG_BYTES`], read as EDF or BDF, every byte hashed, and
 /// matched to the montage. Errors name the file.

@@ -135,7 +135,7 @@ const NO_ACCURACY: &str = "nothing, with a recording (eeg.recording): the decode
 /// Rule: a person's own EEG is the user. A scenario on own EEG takes
 /// nothing that describes a simulated user or targets its decoder (an
 /// accuracy, a subject, a goal set, an online target, T_e), no EEG mode or
-/// bank (the EEG is the recording's held-out epochs), no oracle (it reads
+/// bank (the EEG is the file's held-out epochs), no oracle (it reads
 /// no EEG), no decoder of the caller's own, and cannot be streamed (`errp
 /// stream` streams the simulated user). `claims` are what the entry was
 /// also given, in the order it reports them; with own EEG, the first is

@@ -45,7 +45,7 @@ pub trait RunObserver: Sync {
     }
     /// A step of the search for the ErrP-to-noise ratio of the accuracy.
     fn targeting(&self, _step: &TargetingStep) {}
-    /// A step of the e-puck detector's calibration on a held-out recording.
+    /// A step of the e-puck detector's calibration on a held-out session.
     fn online_step(&self, _step: &OnlineStep) {}
     /// The decoder is ready; `summary` says what its calibration found.
     fn decoder_ready(&self, _summary: &str) {}
@@ -272,7 +272,7 @@ pub fn check_recordable_episodes(scenario: &GridScenario, names: &Names) -> Resu
 }
 
 /// What the grid decoder's calibration found, as `errp run` prints it:
-/// the synthetic session's (`calibration`) or the recording's (nothing for
+/// the synthetic session's (`calibration`) or the own EEG's (nothing for
 /// the oracle).
 pub fn grid_decoder_summary(
     decoder: &AssessmentDecoder,

@@ -133,7 +133,7 @@ impl ColumnKind {
 /// `sweep.json` lists it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DecoderInfo {
-    /// Requested accuracy (on a recording: the cross-validated one it
+    /// Requested accuracy (on own EEG: the cross-validated one it
     /// gives, which the control assumes).
     pub accuracy: f64,
     /// `lda` (grid EEG), `svm` (e-puck) or `oracle`.
@@ -148,13 +148,13 @@ pub struct DecoderInfo {
     pub cv_error: Option<f64>,
     /// Their mean: the accuracy reached.
     pub cv_mean: Option<f64>,
-    /// E-puck: the detector's hit rate per ErrP on the held-out recording.
+    /// E-puck: the detector's hit rate per ErrP on the held-out session.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub online_hit_rate: Option<f64>,
     /// E-puck: its false alarms per minute of error-free time there.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub online_false_alarms_per_min: Option<f64>,
-    /// A person's recording, when the decoder was calibrated on one: its
+    /// A person's own EEG, when the decoder was calibrated on it: its
     /// name, size and SHA-256 (a sweep resumed on another file is refused
     /// by it).
     #[serde(default, rename = "recording", skip_serializing_if = "Option::is_none")]

@@ -12,9 +12,10 @@ use errp_robot::GoalLayout;
 use errp_sim::epuck::{EpuckRunHeader, EpuckRunRow};
 use errp_sim::grid::{GridEpisodeHeader, GridEpisodeRow};
 use errp_sim::live::contract::{EEG_STREAM, MARKER_STREAM, STATE_STREAM};
-use errp_sim::live::epuck::EpuckLiveRun;
-use errp_sim::live::grid::GridLiveRun;
-use errp_sim::live::{LiveObserver, LiveOptions, LiveRequest, LiveRunStats, LiveSession, LslLink};
+use errp_sim::live::{
+    EpuckLiveRun, GridLiveRun, LiveObserver, LiveOptions, LiveRequest, LiveRunStats, LiveSession,
+    LslLink,
+};
 use errp_sim::pace::Speed;
 use errp_sim::{
     AnyScenario, Names, RunObserver, RunProvenance, ScenarioInput, ScenarioSeed, ScenarioSource,

@@ -9,7 +9,6 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use errp_sim::Names;
 use errp_sim::TaskKind;
-use errp_sim::grid::EegMode;
 use errp_sweep::{
     CheckedSweep, DecoderInfo, MAX_EPISODES, Shard, SweepObserver, SweepOptions, SweepOutcome,
     SweepReport, SweepSpec, TargetCache, aliases, merge_sweeps, parse_axis, prepare_sweep,
@@ -143,7 +142,10 @@ pub struct MergeArgs {
 
 /// Now, for the elapsed times the program prints. Only the command line
 /// reads the clock; nothing it computes depends on it.
-#[allow(clippy::disallowed_methods)]
+#[allow(
+    clippy::disallowed_methods,
+    reason = "the elapsed times printed; nothing computed reads the clock"
+)]
 pub(crate) fn wall_clock() -> Instant {
     Instant::now()
 }
@@ -290,8 +292,7 @@ fn sweep_spec(args: &SweepArgs, names: Names) -> Result<SweepSpec> {
         Some(a) => Some(a.as_str()),
         None => (!spec.on_own_eeg()).then_some(DEFAULT_ACCURACIES),
     };
-    let per_action = args.eeg.map(|e| e.mode() == EegMode::PerAction);
-    spec.set_levels(accuracy, per_action, &names)?;
+    spec.set_levels(accuracy, args.eeg.map(EegArg::word), &names)?;
     Ok(spec)
 }
 

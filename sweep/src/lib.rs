@@ -22,6 +22,7 @@
 //! assert!(parse_accuracies("0.4", &Names::CLI).is_err());
 //! ```
 
+#![forbid(unsafe_code)]
 #![warn(clippy::unwrap_used, clippy::print_stdout, clippy::iter_over_hash_type)]
 // No function over 100 lines of code (clippy.toml) outside the tests.
 #![cfg_attr(not(test), warn(clippy::too_many_lines))]

@@ -343,6 +343,7 @@ fn memory_is_refused_before_the_work_and_the_directories_made_go() {
 /// a scenario, a sweep's `episodes.csv`, `sweep.json` and lock. A FIFO in
 /// place of a cache entry is a miss.
 #[test]
+#[ignore = "slow (15 s): `cargo test --workspace -- --ignored` and CI run it"]
 fn special_files_are_refused_without_waiting() {
     let dir = scratch("fifos");
     mkfifo(&dir.join("fifo.toml"));
@@ -435,6 +436,7 @@ fn tampered_entries_are_misses(dir: &Path, prepare: &[&str]) {
 /// Reproduction 6, 7: A cache entry whose ratio was edited (x3, 0, 1e308) is found out
 /// by evaluating it again, for both tasks: a miss, with a warning.
 #[test]
+#[ignore = "slow (targets two accuracies, 40 s): `cargo test --workspace -- --ignored` and CI run it"]
 fn a_tampered_cache_entry_is_a_miss_with_a_warning_for_both_tasks() {
     let dir = scratch("tamper-grid");
     tampered_entries_are_misses(
@@ -470,6 +472,7 @@ fn a_tampered_cache_entry_is_a_miss_with_a_warning_for_both_tasks() {
 /// Reproduction 8, 17: A sweep is resumed only with the decoders its first rows were
 /// made with, and only by the version that wrote it; merge alike.
 #[test]
+#[ignore = "slow (targets an accuracy, 25 s): `cargo test --workspace -- --ignored` and CI run it"]
 fn resume_and_merge_refuse_other_decoders_and_other_versions() {
     let dir = scratch("resume-decoders");
     let args = [

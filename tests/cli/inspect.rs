@@ -31,6 +31,7 @@ fn stdout(o: &std::process::Output) -> String {
 }
 
 #[test]
+#[ignore = "slow (records 30 e-puck runs, 26 s): `cargo test --workspace -- --ignored` and CI run it"]
 fn epuck_runs_recomputed_from_the_recording_are_what_run_printed() {
     let dir = temp_dir("inspect-epuck");
     let rrd = dir.join("m.rrd");

@@ -31,6 +31,7 @@ fn number_after(text: &str, before: &str) -> f64 {
 }
 
 #[test]
+#[ignore = "slow (calibrates on an export, 27 s): `cargo test --workspace -- --ignored` and CI run it"]
 fn an_exported_session_runs_the_grid_at_the_accuracy_it_was_made_at() {
     let d = temp_dir("recorded-round-trip");
     let edf = d.join("s.edf");
@@ -185,6 +186,7 @@ fn relabelled(bytes: &[u8], from: &str, to: &str) -> Vec<u8> {
 }
 
 #[test]
+#[ignore = "slow (18 s): `cargo test --workspace -- --ignored` and CI run it"]
 fn a_recording_that_cannot_calibrate_is_refused_naming_what_is_missing() {
     let d = temp_dir("recorded-refused");
     let edf = d.join("s.edf");

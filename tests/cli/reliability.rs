@@ -94,6 +94,7 @@ fn assert_same_as_alone(scenario: &str, dir: &Path, out: &Path, episodes: &str) 
 }
 
 #[test]
+#[ignore = "slow (16 s): `cargo test --workspace -- --ignored` and CI run it"]
 fn a_second_sweep_on_one_directory_is_refused_and_the_first_finishes_intact() {
     let (dir, scenario) = oracle_dir("two-sweeps");
     let s = scenario.to_str().unwrap();
@@ -118,6 +119,7 @@ fn a_second_sweep_on_one_directory_is_refused_and_the_first_finishes_intact() {
 }
 
 #[test]
+#[ignore = "slow (12 s): `cargo test --workspace -- --ignored` and CI run it"]
 fn sigterm_stops_a_sweep_between_episodes_and_the_same_command_resumes() {
     let (dir, scenario) = oracle_dir("sweep-sigterm");
     let s = scenario.to_str().unwrap();

@@ -33,6 +33,7 @@
 //! // A changed copy is checked again.
 //! assert!(rate.with(|r| r.0 = -1.0).is_err());
 //! ```
+#![forbid(unsafe_code)]
 #![cfg_attr(not(test), warn(clippy::too_many_lines))]
 
 use std::fmt;

@@ -37,7 +37,7 @@ pub struct ContinuousCalibrationParams {
     /// is locked to the press, which follows the assessment only up to the
     /// spread of the reaction time.
     pub trigger_jitter_ms: f64,
-    /// Length of the EOG recording the EOG regression is fitted on (s).
+    /// Length of the EOG session the EOG regression is fitted on (s).
     pub eog_session_secs: f64,
     /// Cross-validation folds.
     pub folds: usize,
@@ -102,11 +102,11 @@ impl Protocol for ContinuousCalibrationParams {
     }
 }
 
-/// A simulated user and recording for the continuous decoder: the EEG
+/// A simulated user and its session for the continuous decoder: the EEG
 /// model, the button-locked protocol, the preprocessing and the montage.
 pub type ContinuousSetup = Setup<ContinuousCalibrationParams>;
 
-/// The same recording as a [`CalibrationSetup`] for
+/// The same setup as a [`CalibrationSetup`] for
 /// [`simulate_session_with`], which reads only the EOG session length of
 /// its protocol. The continuous protocol's checks include the discrete one's
 /// (at least 10 examples per class, so 20 actions; error rate 0.5; the same
@@ -158,7 +158,7 @@ pub fn continuous_schedule(
     (assessments, windows)
 }
 
-/// Simulates a continuous calibration session: EOG recording, preprocessor
+/// Simulates a continuous calibration session: EOG session, preprocessor
 /// fit, the schedule of [`continuous_schedule`] streamed through the
 /// generator and the preprocessor, and the 512 features of
 /// [`ContinuousFeatures::paper`] of every example window.

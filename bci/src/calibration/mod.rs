@@ -29,7 +29,7 @@ pub struct CalibrationParams {
     pub interval_min_secs: f64,
     /// Longest inter-action interval (s).
     pub interval_max_secs: f64,
-    /// Length of the EOG recording (deliberate blinks and saccades) that the
+    /// Length of the EOG session (deliberate blinks and saccades) that the
     /// EOG regression is fitted on, before the session (s).
     pub eog_session_secs: f64,
     /// Cross-validation folds.
@@ -213,7 +213,7 @@ impl Default for TargetingParams {
     }
 }
 
-/// Everything that defines a simulated user and recording: the EEG model,
+/// Everything that defines a simulated user and its session: the EEG model,
 /// the calibration protocol `P`, the preprocessing and the montage.
 ///
 /// The sessions take it checked, as a `Valid<Setup<P>>`; the EEG model in
@@ -303,7 +303,7 @@ impl<P: Protocol> Setup<P> {
 /// The setup of the discrete calibration session (sec. 2.2).
 pub type CalibrationSetup = Setup<CalibrationParams>;
 
-/// Checks the length of a protocol's EOG recording (for the regression
+/// Checks the length of a protocol's EOG session (for the regression
 /// weights): at least 15 s.
 pub(crate) fn check_eog_session(secs: f64) -> Result<()> {
     check(

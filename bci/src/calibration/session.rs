@@ -27,7 +27,7 @@ pub struct CalibrationSession {
     pub labels: Vec<bool>,
     /// The assessments, on the session clock.
     pub assessments: Vec<Assessment>,
-    /// The preprocessor fitted on the EOG recording.
+    /// The preprocessor fitted on the EOG session.
     pub preprocessor: Preprocessor,
     /// Grand averages over every EEG channel, when asked for.
     pub grand_average: Option<GrandAverage>,
@@ -47,13 +47,13 @@ pub struct SessionOptions<'a> {
     /// Called with each raw block (all channels) and the assessments whose
     /// onsets fall in it, e.g. to export the raw EEG.
     pub raw_sink: Option<RawSink<'a>>,
-    /// A person's recording in place of the synthetic user's EEG: its
+    /// A person's own EEG in place of the synthetic user's EEG: its
     /// background looped, the subject's response at the errors, the
     /// preprocessing fitted on its calibration part (no EOG session).
     pub hybrid: Option<&'a HybridSource>,
 }
 
-/// The EOG recording that precedes a session: the same user and montage,
+/// The EOG session that precedes a calibration: the same user and montage,
 /// asked to blink and look around (2 blinks and 1 saccade per second on
 /// average), no actions.
 pub fn eog_session(
@@ -92,7 +92,7 @@ pub fn schedule(calib: &CalibrationParams, seed: u64) -> Vec<Assessment> {
         .collect()
 }
 
-/// Simulates a calibration session: EOG recording, preprocessor fit, then
+/// Simulates a calibration session: EOG session, preprocessor fit, then
 /// `n_actions` assessed actions streamed through the generator and the
 /// preprocessor in 1 s blocks, and the paper's temporal features.
 pub fn simulate_session(
@@ -190,7 +190,7 @@ fn grand_average(
 }
 
 /// Simulates a session with a given schedule and feature extractor: EOG
-/// recording, preprocessor fit, then `assessments` (sorted by onset) streamed
+/// session, preprocessor fit, then `assessments` (sorted by onset) streamed
 /// through the generator and the preprocessor in 1 s blocks, and one feature
 /// vector per assessment from the window that starts at the matching entry of
 /// `window_onsets_secs` (rounded to samples), labelled by the assessment.

@@ -237,7 +237,7 @@ pub fn target_accuracy_on<C: Classifier>(
 /// the ERPs at ratio 1. The preprocessing and the features are linear in the
 /// signal and the generator's parts add up exactly, so the session's
 /// features at r are `noise + r * erp` (to rounding), and the preprocessor
-/// (fitted on an EOG recording without ERPs) does not depend on r.
+/// (fitted on an EOG session without ERPs) does not depend on r.
 #[derive(Debug, Clone)]
 pub struct SessionParts {
     noise: CalibrationSession,
@@ -288,7 +288,7 @@ impl SessionParts {
         })
     }
 
-    /// The preprocessor fitted on the session's EOG recording (the same at
+    /// The preprocessor fitted on the calibration's EOG session (the same at
     /// every ratio).
     pub fn preprocessor(&self) -> &crate::Preprocessor {
         &self.noise.preprocessor

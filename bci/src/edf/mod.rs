@@ -1,6 +1,6 @@
 //! EDF+ export of raw EEG with event annotations ([`EdfWriter`]), and the
 //! reading of EDF, EDF+, BDF and BDF+ files ([`EdfFile`]) for a person's own
-//! recordings.
+//! EEG.
 
 mod read;
 mod write;

@@ -8,8 +8,8 @@
 //! reader trusts nothing it reads: every field is parsed and checked, sizes
 //! are bounded ([`MAX_EDF_SIGNALS`], [`MAX_EDF_SAMPLES`]) before anything
 //! is allocated, and a file that ends inside a record is refused.
-//! Discontinuous files (EDF+D, BDF+D) are refused: a recording in the loop
-//! is one continuous session.
+//! Discontinuous files (EDF+D, BDF+D) are refused: own EEG in the loop
+//! is one unbroken session.
 
 use std::io::Read;
 
@@ -388,7 +388,7 @@ impl EdfFile {
         Ok(())
     }
 
-    /// The ordinary signal labelled `label`, matched as a recording's
+    /// The ordinary signal labelled `label`, matched as own EEG's
     /// channels are ([`OwnEeg`](crate::OwnEeg)): as written, else
     /// ignoring case and an `EEG ` or `EOG ` prefix.
     pub fn signal(&self, label: &str) -> Option<&EdfSignal> {
@@ -396,7 +396,7 @@ impl EdfFile {
         find(&labels, label).map(|i| &self.signals[i])
     }
 
-    /// The recording's duration, in seconds.
+    /// The file's duration, in seconds.
     pub fn duration_secs(&self) -> f64 {
         self.records as f64 * self.record_secs
     }

@@ -1,8 +1,8 @@
-//! A hybrid EEG stream on a person's recording: the recording's own
-//! continuous EEG as the background (read in order, looped), and the
-//! subject's error-minus-correct response, taken from the recording, added
-//! at each scheduled erroneous assessment with the synthetic generator's
-//! single-trial latency jitter and amplitude variability.
+//! A hybrid EEG feed on a person's own EEG: the file's EEG as the
+//! background (read in order, looped), and the subject's error-minus-correct
+//! response, taken from the same file, added at each scheduled erroneous
+//! assessment with the synthetic generator's single-trial latency jitter and
+//! amplitude variability.
 
 use std::sync::Arc;
 
@@ -22,21 +22,21 @@ pub const TEMPLATE_SECS: f64 = 1.0;
 /// Seconds before each event averaged as its baseline.
 pub const BASELINE_SECS: f64 = 0.2;
 
-/// The subject's error-minus-correct response on every channel of a
-/// recording, `(n_channels, TEMPLATE_SECS)` in uV from the event: the
+/// The subject's error-minus-correct response on every channel of own
+/// EEG, `(n_channels, TEMPLATE_SECS)` in uV from the event: the
 /// average of the error epochs minus that of the correct epochs, each
 /// epoch less its baseline.
 #[derive(Debug, Clone)]
 pub struct ErrpTemplate {
-    /// The response, one row per channel of the recording's montage.
+    /// The response, one row per channel of the own EEG's montage.
     pub response: EegBlock,
     /// Error and correct epochs averaged.
     pub counts: (usize, usize),
 }
 
 impl ErrpTemplate {
-    /// The template of `events` (a recording's calibration part) in `raw`
-    /// at `fs` Hz; an event whose epoch or baseline leaves the recording is
+    /// The template of `events` (own EEG's calibration part) in `raw`
+    /// at `fs` Hz; an event whose epoch or baseline leaves the EEG is
     /// skipped. Refused without an epoch of each class.
     pub fn from_raw(raw: &EegBlock, fs: f64, events: &[Assessment]) -> Result<Self> {
         let span = (TEMPLATE_SECS * fs).round() as usize;
@@ -89,7 +89,7 @@ struct Active {
     gain: f64,
 }
 
-/// The hybrid stream: the recording's background looped, the subject's
+/// The hybrid feed: the own EEG's background looped, the subject's
 /// response added at each erroneous assessment.
 #[derive(Debug, Clone)]
 pub struct HybridEeg {
@@ -105,7 +105,7 @@ pub struct HybridEeg {
 }
 
 impl HybridEeg {
-    /// A stream over `background` (the recording's raw channels, in the
+    /// A feed over `background` (the own EEG's raw channels, in the
     /// montage's order) starting at sample `start` of it, with `template`
     /// added at errors; `params` gives the rate and the single-trial
     /// variability; every draw from `seed`.
@@ -133,7 +133,7 @@ impl HybridEeg {
         })
     }
 
-    /// The stream's parameters (its rate).
+    /// The feed's parameters (its rate).
     pub fn params(&self) -> &GeneratorParams {
         &self.params
     }
@@ -212,35 +212,35 @@ impl HybridEeg {
     }
 }
 
-/// What a hybrid session or stream is made of: a person's recording (its
+/// What a hybrid session or feed is made of: a person's own EEG (its
 /// channels and raw EEG, split where its calibration part ends) and the
 /// subject's response from that part. The calibration session loops over
-/// the calibration part and the online streams over the rest, so no
+/// the calibration part and the online feeds over the rest, so no
 /// background the decoder was trained on is ever decoded online.
 #[derive(Debug, Clone)]
 pub struct HybridSource {
-    /// The recording's channels.
+    /// The own EEG's channels.
     pub montage: Montage,
     /// The calibration part's raw EEG, less the subject's response at its
     /// errors: the calibration session's background (and the preprocessing
     /// is fitted on it).
     pub calibration: Arc<EegBlock>,
-    /// The rest of the recording, likewise cleaned: the online background.
+    /// The rest of the own EEG, likewise cleaned: the online background.
     pub held_out: Arc<EegBlock>,
     /// The subject's error-minus-correct response.
     pub template: Arc<ErrpTemplate>,
 }
 
-/// The shortest part of a recording a hybrid loops over, s: an online
+/// The shortest part of own EEG a hybrid loops over, s: an online
 /// window (800 ms) many times over.
 pub const MIN_HYBRID_PART_SECS: f64 = 30.0;
 
 impl HybridSource {
-    /// The hybrid of a recording (`raw` on `montage`, at `fs` Hz, its
+    /// The hybrid of own EEG (`raw` on `montage`, at `fs` Hz, its
     /// `events`), the subject's response taken from the first `calibration`
     /// events, whose end (1 s after the last of them) splits the
-    /// background. The background is the recording less that response at
-    /// each of its own error events, so that the stream's errors are the
+    /// background. The background is the own EEG less that response at
+    /// each of its own error events, so that the feed's errors are the
     /// scheduled ones only. Refused when either part is shorter than
     /// [`MIN_HYBRID_PART_SECS`].
     pub fn from_own_eeg(
@@ -285,13 +285,13 @@ impl HybridSource {
         })
     }
 
-    /// A calibration stream: over the calibration part, from a point drawn
+    /// A calibration feed: over the calibration part, from a point drawn
     /// from `seed`, with the single-trial variability of `params`.
     pub fn calibration_feed(&self, params: &GeneratorParams, seed: u64) -> Result<HybridEeg> {
         self.feed_over(&self.calibration, params, seed)
     }
 
-    /// An online stream: over the held-out part, likewise.
+    /// An online feed: over the held-out part, likewise.
     pub fn online_feed(&self, params: &GeneratorParams, seed: u64) -> Result<HybridEeg> {
         self.feed_over(&self.held_out, params, seed)
     }
@@ -362,13 +362,13 @@ mod tests {
     }
 }
 
-/// A stream of EEG the online decoder reads: the synthetic user's, or a
-/// hybrid on a person's recording.
+/// The EEG the online decoder reads: the synthetic user's, or a hybrid on
+/// a person's own EEG.
 #[derive(Debug, Clone)]
 pub enum EegFeed {
     /// The synthetic generator.
     Synthetic(Box<crate::generator::EegGenerator>),
-    /// A recording's background with the subject's response.
+    /// Own EEG's background with the subject's response.
     Hybrid(Box<HybridEeg>),
 }
 

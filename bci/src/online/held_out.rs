@@ -1,4 +1,4 @@
-//! The held-out continuous recording, the decoder's response span on it, and
+//! The held-out session, the decoder's response span on it, and
 //! the detector's operating point scored per event.
 
 use rand::Rng;
@@ -17,13 +17,13 @@ use crate::preprocess::Preprocessor;
 use crate::rng::labelled;
 use crate::svm::SvmModel;
 
-/// The held-out continuous recording on which a calibrated decoder's online
-/// operating point is measured: the user watches correct continuous motion
-/// and now and then an error, EEG streams, the decoder slides.
+/// The held-out session on which a calibrated decoder's online operating
+/// point is measured: the user watches correct motion and now and then an
+/// error, the EEG is fed in, the decoder slides.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct HeldOutParams {
-    /// Length of the recording (s): 60 to 3600.
+    /// Length of the session (s): 60 to 3600.
     pub duration_secs: f64,
     /// Shortest gap between two ErrPs (s); longer than the response span, so
     /// each ErrP is scored on its own.
@@ -77,7 +77,7 @@ impl HeldOutParams {
     }
 }
 
-/// The decoder's output over a held-out continuous recording.
+/// The decoder's output over a held-out session.
 #[derive(Debug, Clone, PartialEq)]
 pub struct HeldOutSession {
     /// p(error) of the window ending at `(k + 1) * WINDOW_STEP_SECS`.
@@ -92,13 +92,13 @@ impl HeldOutSession {
         (k + 1) as f64 * WINDOW_STEP_SECS
     }
 
-    /// Length of the recording (s).
+    /// Length of the session (s).
     pub fn duration_secs(&self) -> f64 {
         Self::window_end_secs(self.p_error.len()) - WINDOW_STEP_SECS
     }
 }
 
-/// Streams a held-out recording of `params.duration_secs` through
+/// Feeds a held-out session of `params.duration_secs` through
 /// `preprocessor` and `model`: ErrPs U[error_gap_min, error_gap_max] s
 /// apart (from 2 s on), and the correct-assessment potential half-way
 /// between two of them (the user sees the motion corrected). All draws come
@@ -114,7 +114,7 @@ pub fn simulate_held_out(
     simulate_held_out_from(generator, None, montage, preprocessor, model, params, seed)
 }
 
-/// [`simulate_held_out`] on a person's recording (`hybrid`: its background,
+/// [`simulate_held_out`] on a person's own EEG (`hybrid`: its background,
 /// the subject's response), or on the synthetic user without it.
 pub fn simulate_held_out_from(
     generator: &Valid<GeneratorParams>,
@@ -213,7 +213,7 @@ pub fn binomial_upper_tail(k: usize, n: usize, p: f64) -> f64 {
     (1.0 - below).max(0.0)
 }
 
-/// The windows of `recording` at which `detector` fires.
+/// The windows of `recording` (a held-out session) at which `detector` fires.
 pub fn firings(recording: &HeldOutSession, mut detector: Detector) -> Vec<bool> {
     recording
         .p_error

@@ -1,8 +1,8 @@
 //! Online, asynchronous ErrP detection (sec. 2.2.2 of the paper, and how
 //! asynchronous-ErrP studies score it): the 800 ms window sliding every
-//! 62.5 ms over streamed EEG, the detector that turns its p(error) stream
+//! 62.5 ms over an EEG feed, the detector that turns its p(error) series
 //! into error events, and the detector's operating point measured on a
-//! held-out continuous recording.
+//! held-out session.
 //!
 //! Without a cue, a decoder that looks every 62.5 ms has about 16 chances a
 //! second to fire on background EEG, and one ErrP is visible in several
@@ -32,11 +32,11 @@ pub use targeting::*;
 
 /// The decoder's window step: 62.5 ms (sec. 2.2.2).
 pub const WINDOW_STEP_SECS: f64 = 0.0625;
-/// Seconds of EEG streamed before a recording so the causal filters settle;
-/// recording time 0 is generator time `WARM_UP_SECS`.
+/// Seconds of EEG fed before the window's time 0 so the causal filters
+/// settle; the window's time 0 is generator time `WARM_UP_SECS`.
 pub const WARM_UP_SECS: f64 = 2.0;
 
-/// Streamed EEG and the 800 ms window sliding over its preprocessed
+/// An EEG feed and the 800 ms window sliding over its preprocessed
 /// channels, one hop of 62.5 ms at a time.
 #[derive(Debug)]
 pub struct SlidingWindow {
@@ -53,9 +53,9 @@ pub struct SlidingWindow {
 }
 
 impl SlidingWindow {
-    /// Starts a stream from `generator` (fresh, at its time 0) through a
+    /// Starts feeding `generator` (fresh, at its time 0) through a
     /// reset copy of `preprocessor`, and lets the filters settle for
-    /// [`WARM_UP_SECS`]: recording time 0 is generator time `WARM_UP_SECS`.
+    /// [`WARM_UP_SECS`]: the window's time 0 is generator time `WARM_UP_SECS`.
     pub fn start(
         generator: impl Into<EegFeed>,
         preprocessor: &Preprocessor,
@@ -98,7 +98,7 @@ impl SlidingWindow {
         })
     }
 
-    /// Schedules the potential of an assessment at recording time
+    /// Schedules the potential of an assessment at the window's time
     /// `onset_secs` (its time zero).
     pub fn schedule(&mut self, onset_secs: f64, kind: AssessmentKind) {
         self.generator.schedule(Assessment {
@@ -107,7 +107,7 @@ impl SlidingWindow {
         });
     }
 
-    /// Streams one more hop through the preprocessing, slides the window,
+    /// Feeds one more hop through the preprocessing, slides the window,
     /// and returns the new preprocessed samples `(n_channels, hop)`.
     pub fn advance(&mut self) -> EegBlock {
         self.generator.generate_into(&mut self.raw);
@@ -122,7 +122,7 @@ impl SlidingWindow {
         fresh
     }
 
-    /// The raw samples of the warm-up ([`WARM_UP_SECS`] before recording
+    /// The raw samples of the warm-up ([`WARM_UP_SECS`] before the window's
     /// time 0), all channels.
     pub fn warm_up_raw(&self) -> &EegBlock {
         &self.warm_up

@@ -11,7 +11,7 @@ use crate::calibration::TargetingParams;
 use crate::error::{BciError, Result, check};
 
 /// An online operating point to calibrate for, instead of a cross-validated
-/// accuracy: the detector's hit rate per ErrP on the held-out recording, and
+/// accuracy: the detector's hit rate per ErrP on the held-out session, and
 /// optionally its false alarms per minute (then T_e is calibrated too, as a
 /// personal decision threshold).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -116,9 +116,9 @@ pub fn threshold_for_false_alarms(
 }
 
 /// Searches the ErrP-to-noise ratio (and T_e, if false alarms are targeted)
-/// at which the detector's operating point on the held-out recording meets
+/// at which the detector's operating point on the held-out session meets
 /// `target`. `evaluate(ratio)` calibrates the decoder at that ratio and
-/// returns its held-out recording; the hit rate rises with the ratio, so the
+/// returns its held-out session; the hit rate rises with the ratio, so the
 /// search brackets it by doubling from 0.25 (up to `search.max_ratio`) and
 /// then bisects until the hit rate is within `search.tolerance` (of a hit
 /// rate) or `search.max_evaluations` are spent. Returns the closest

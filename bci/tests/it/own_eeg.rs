@@ -1,6 +1,6 @@
-//! A recorded session in place of the synthetic one: an EDF+ export read
+//! Own EEG in place of the synthetic session: an EDF+ export read
 //! back gives the decoder the accuracy the synthetic session gave, no
-//! held-out epoch overlaps the calibration part, and what a recording lacks
+//! held-out epoch overlaps the calibration part, and what own EEG lacks
 //! is named.
 
 use std::io::Cursor;

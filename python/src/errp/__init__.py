@@ -751,8 +751,8 @@ class GridTask(_Task):
     same user at the same seed is behind all three, so their results
     compare at the same accuracy.
 
-    With ``eeg``, a person's own recording replaces the synthetic user's
-    EEG: the testbed's decoder is calibrated on the recording's first part
+    With ``eeg``, a person's own EEG replaces the synthetic user's
+    EEG: the testbed's decoder is calibrated on the file's first part
     (the same preprocessing, features, LDA, cross-validation and Platt
     scaling as on a synthetic session) and each action decodes an epoch of
     its class drawn from the part after it, never from the part it was

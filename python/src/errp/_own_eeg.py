@@ -1,4 +1,4 @@
-"""A person's recording as the grid's EEG (``GridTask(eeg=...)``): an MNE
+"""A person's own EEG as the grid's EEG (``GridTask(eeg=...)``): an MNE
 object, or a file MNE reads, turned into the channels, data, rate and events
 the testbed's decoder takes, with what identifies it."""
 

@@ -66,7 +66,7 @@ pub fn calibrate_continuous_at(
 }
 
 /// What the calibrated decoder does online, measured at calibration time on
-/// a held-out continuous recording (same user, fresh EEG): the span over
+/// a held-out session (same user, fresh EEG): the span over
 /// which its windows respond to an ErrP, and the operating point of the
 /// scenario's detector beside the paper's literal per-window reading.
 #[derive(Debug, Clone, PartialEq)]
@@ -87,7 +87,7 @@ pub struct OnlineReport {
 
 impl OnlineReport {
     /// Scores `detector` at `t_e`, and the literal reading, on a held-out
-    /// `recording` of the calibrated pipeline.
+    /// session `recording` of the calibrated pipeline.
     pub fn from_held_out(
         recording: &HeldOutSession,
         detector: Valid<DetectorParams>,
@@ -152,9 +152,9 @@ impl std::fmt::Display for OnlineReport {
 
 /// Calibrates the continuous decoder for an online operating point: the
 /// ErrP-to-noise ratio (and T_e, if false alarms are targeted) at which
-/// `detector`, run over the held-out recording of
+/// `detector`, run over the held-out session of
 /// [`ContinuousDecoder::record_held_out`], meets `target`. Every evaluation
-/// is a full calibration at the ratio tried and its held-out recording; the
+/// is a full calibration at the ratio tried and its held-out session; the
 /// one the search picks becomes the decoder (measured online at the T_e
 /// found) and the report, so nothing is calibrated or recorded twice.
 pub fn run_online_calibration(
@@ -216,18 +216,18 @@ const UNMEASURED_SPAN: ResponseSpan = ResponseSpan {
     to_secs: 1.1,
 };
 
-/// The seed of the held-out recording of a calibration seeded `seed`.
+/// The seed of the held-out session of a calibration seeded `seed`.
 fn held_out_seed(seed: u64) -> u64 {
     derive_seed(seed, "online/held-out", 0)
 }
 
 /// The calibrated online pipeline: the user's EEG model, the preprocessing
-/// fitted on the calibration's EOG recording, the trained SVM, and what it
+/// fitted on the calibration's EOG session, the trained SVM, and what it
 /// does online.
 #[derive(Debug, Clone)]
 pub struct ContinuousDecoder {
     /// The synthetic user's EEG model (at the calibrated ErrP-to-noise
-    /// ratio) as calibrated: the held-out recording's.
+    /// ratio) as calibrated: the held-out session's.
     pub generator: Valid<GeneratorParams>,
     /// The same user in the closed loop ([`Realism::closed_loop`]; the same
     /// model for an ideal user): what the episodes stream.
@@ -242,11 +242,11 @@ pub struct ContinuousDecoder {
     pub model: SvmModel,
     /// Temporal + theta PSD features of one window.
     pub features: ContinuousFeatures,
-    /// The operating point on a held-out recording (set by
+    /// The operating point on a held-out session (set by
     /// [`measure_online`](Self::measure_online)).
     pub online: Option<OnlineReport>,
-    /// A person's recording in place of the synthetic user's EEG: the
-    /// held-out recording and the episodes stream its background with the
+    /// A person's own EEG in place of the synthetic user's EEG: the
+    /// held-out session and the episodes feed on its background with the
     /// subject's response (a hybrid).
     pub hybrid: Option<Arc<HybridSource>>,
     /// What the hybrid was made of, and the accuracy the shared control
@@ -282,7 +282,7 @@ impl ContinuousDecoder {
         Ok(self)
     }
 
-    /// The held-out continuous recording of this pipeline for a calibration
+    /// The held-out session of this pipeline for a calibration
     /// seeded `seed`: [`HeldOutParams::default`] of fresh EEG.
     pub fn record_held_out(&self, seed: u64) -> Result<HeldOutSession> {
         Ok(simulate_held_out_from(
@@ -297,7 +297,7 @@ impl ContinuousDecoder {
     }
 
     /// Measures the operating point of `detector` at threshold `t_e` on the
-    /// held-out recording for `seed` and keeps it.
+    /// held-out session for `seed` and keeps it.
     pub fn measure_online(
         &mut self,
         detector: Valid<DetectorParams>,

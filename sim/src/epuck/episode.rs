@@ -250,8 +250,8 @@ fn run_episode(
 /// The shared control of an episode of `scenario` with `decoder`. Left
 /// open by the scenario: the stop on a goal, long enough for the user's
 /// verdict on the arrival to reach the detector, and the veto window, the
-/// end of the detector's response span. On a recording, the control assumes
-/// the recording's cross-validated accuracy.
+/// end of the detector's response span. On own EEG, the control assumes
+/// the cross-validated accuracy it gives.
 pub fn shared_control(
     scenario: &EpuckScenario,
     decoder: &ContinuousDecoder,

@@ -1,5 +1,5 @@
-//! The e-puck on a person's recording, as a labelled hybrid: the
-//! recording's own continuous EEG as the background (its calibration part
+//! The e-puck on a person's own EEG, as a labelled hybrid: the file's
+//! EEG as the background (its calibration part
 //! for the calibration, the rest online), and the subject's
 //! error-minus-correct response, from the calibration part, added at the
 //! simulated user's assessments with the generator's single-trial
@@ -9,7 +9,7 @@
 //! button-locked protocol, preprocessing, features, SVM and Platt), with no
 //! targeting: the subject's response has the amplitude it has. T_e cannot
 //! be the paper's 0.8 as it stands, since one person's Platt probability is
-//! not another's: it is set on the hybrid's held-out recording to give the
+//! not another's: it is set on the hybrid's held-out session to give the
 //! false alarms a minute that the paper-fitted user makes at 0.8
 //! ([`FITTED_FALSE_ALARMS_PER_MIN`]), the paper's "a high value, to
 //! minimise false positives" kept as a rate.
@@ -27,7 +27,7 @@ use crate::epuck::scenario::EpuckScenario;
 use crate::error::{Result, SimError};
 use crate::own_eeg::{FITTED_FALSE_ALARMS_PER_MIN, OwnEegSpec, load_own_eeg};
 
-/// Calibrates the continuous decoder of `scenario` on the recording `eeg`
+/// Calibrates the continuous decoder of `scenario` on the own EEG `eeg`
 /// (a hybrid), sets T_e for the false-alarm rate, and measures the
 /// detector there. Errors name the file.
 pub fn prepare_hybrid(
@@ -111,7 +111,7 @@ pub fn calibrate_on_own_eeg(
 }
 
 /// What the continuous decoder's calibration found, as `errp run` prints
-/// it, with its operating point on the held-out recording.
+/// it, with its operating point on the held-out session.
 pub fn epuck_decoder_summary(decoder: &ContinuousDecoder, report: &ContinuousReport) -> String {
     let acc = report.calibrated.accuracy;
     let mut text = decoder

@@ -7,7 +7,7 @@ use crate::own_eeg::{FITTED_FALSE_ALARMS_PER_MIN, FileDigest};
 /// provenance say it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct HybridReport {
-    /// The recording's name, size and SHA-256.
+    /// The own EEG file's name, size and SHA-256.
     pub file: FileDigest,
     /// Events of the calibration part (the subject's response).
     pub calibration_events: usize,

@@ -64,10 +64,10 @@ pub(crate) fn continuous_request(scenario: &EpuckScenario) -> Result<ContinuousR
 /// Builds the scenario's continuous decoder, the one path of every e-puck
 /// command. With an accuracy target: the ratio from `cache` (or searched;
 /// `progress` sees the search), the calibration session at it, then the
-/// operating point measured on a held-out recording. With an online target
+/// operating point measured on a held-out session. With an online target
 /// (`[user] hit_rate`), the search that `online_progress` sees, which
 /// measures the operating point at every step and is not cached. With a
-/// person's recording, the hybrid ([`crate::epuck::prepare_hybrid`]).
+/// person's own EEG, the hybrid ([`crate::epuck::prepare_hybrid`]).
 pub fn prepare_epuck_decoder(
     scenario: &EpuckScenario,
     cache: &dyn TargetingCache,
@@ -131,7 +131,7 @@ pub fn prepare_epuck_decoder(
 }
 
 /// The online decoder of a finished calibration, with the operating point
-/// of the scenario's detector measured on a held-out recording (seeded by
+/// of the scenario's detector measured on a held-out session (seeded by
 /// the scenario's seed): the last step of every path that prepares an
 /// e-puck decoder.
 pub fn finish_continuous_decoder(

@@ -29,10 +29,10 @@ pub(crate) struct EpuckFile {
     pub(crate) runs: Option<f64>,
     #[serde(default = "default_max_secs")]
     pub(crate) max_secs: f64,
-    /// Required but with a recording (`[eeg]`), whose user is the person.
+    /// Required but with own EEG (`[eeg]`), whose user is the person.
     #[serde(default)]
     pub(crate) user: UserFile,
-    /// A person's recording in place of the synthetic user's EEG.
+    /// A person's own EEG in place of the synthetic user's EEG.
     #[serde(default)]
     pub(crate) eeg: Option<crate::own_eeg::OwnEegTable>,
     /// Straight into the robot's type: its field names are the file's.

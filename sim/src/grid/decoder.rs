@@ -35,8 +35,8 @@ pub enum AssessmentDecoder {
     /// action, but no EEG is synthesised during the episode. For Monte Carlo
     /// speed; epochs are reused across episodes.
     EegBank(Box<EpochBank>),
-    /// A decoder calibrated on a person's recording, decoding held-out
-    /// epochs of the same recording (`[eeg] recording = ...`).
+    /// A decoder calibrated on a person's own EEG, decoding held-out
+    /// epochs of the same file (`[eeg] recording = ...`).
     OwnEeg(Box<OwnEegBank>),
 }
 
@@ -317,7 +317,7 @@ pub struct EegDecoder {
     pub generator: Valid<GeneratorParams>,
     /// The montage.
     pub montage: Montage,
-    /// Preprocessing fitted on the calibration session's EOG recording.
+    /// Preprocessing fitted on the EOG session before the calibration.
     pub preprocessor: Preprocessor,
     /// The decoder trained on the calibration session.
     pub model: LdaModel,

@@ -1,5 +1,5 @@
-//! The grid on a person's own recording: the decoder is calibrated on the
-//! recording's first part exactly as on a synthetic session (the same
+//! The grid on a person's own EEG: the decoder is calibrated on the
+//! file's first part exactly as on a synthetic session (the same
 //! preprocessing fitted on it, features, LDA, cross-validation and Platt
 //! scaling), and each online action decodes an epoch of its class drawn
 //! from the part after it, never from the part it was trained on.
@@ -20,7 +20,7 @@ use crate::grid::params::GridTaskParams;
 use crate::grid::scenario::GridScenario;
 use crate::own_eeg::{BankDraw, FileDigest, OwnEegSpec, load_own_eeg};
 
-/// What the recording gave: the file, its split and the decoder's
+/// What the own EEG gave: the file, its split and the decoder's
 /// accuracy, cross-validated on the calibration part and measured on the
 /// held-out part.
 #[derive(Debug, Clone, PartialEq)]
@@ -39,11 +39,11 @@ pub struct OwnEegReport {
     /// epoch: the accuracy the closed loop draws from.
     pub held_out: Accuracy,
     /// Events after the calibration part used by neither part (their
-    /// epochs overlap it or run past the recording's end).
+    /// epochs overlap it or run past the EEG's end).
     pub dropped: usize,
     /// How held-out epochs are drawn.
     pub draw: BankDraw,
-    /// The recording's length, s.
+    /// The EEG's length, s.
     pub duration_secs: f64,
     /// Its EOG channels: the six the regression reads, or none (no EOG
     /// regression).
@@ -105,7 +105,7 @@ impl std::fmt::Display for OwnEegReport {
     }
 }
 
-/// One held-out epoch: its event in the recording, the decoder's features
+/// One held-out epoch: its event in the own EEG, the decoder's features
 /// and its preprocessed FCz.
 #[derive(Debug, Clone)]
 pub(crate) struct HeldOutEpoch {
@@ -114,11 +114,11 @@ pub(crate) struct HeldOutEpoch {
     pub(crate) fcz: Vec<f64>,
 }
 
-/// The decoder calibrated on a recording and the held-out epochs it
+/// The decoder calibrated on own EEG and the held-out epochs it
 /// decodes online, one pool per class.
 #[derive(Debug, Clone)]
 pub struct OwnEegBank {
-    /// The recording's channels.
+    /// The own EEG's channels.
     pub montage: Montage,
     /// The decoder trained on the calibration part.
     pub model: LdaModel,
@@ -127,7 +127,7 @@ pub struct OwnEegBank {
     /// The accuracy the shared control assumes: the cross-validated one,
     /// above 0.5 (checked).
     pub assumed_accuracy: f64,
-    /// What the recording gave.
+    /// What the own EEG gave.
     pub report: OwnEegReport,
     pub(crate) error: Vec<HeldOutEpoch>,
     pub(crate) correct: Vec<HeldOutEpoch>,
@@ -135,7 +135,7 @@ pub struct OwnEegBank {
 
 impl OwnEegBank {
     /// Every epoch the closed loop may draw: its event's index in the
-    /// recording (none in the calibration part), its class (true for
+    /// own EEG (none in the calibration part), its class (true for
     /// error) and its preprocessed FCz, as a step records it.
     pub fn epochs(&self) -> impl Iterator<Item = (usize, bool, &[f64])> {
         let error = self.error.iter().map(|e| (e.event, true, e.fcz.as_slice()));
@@ -195,7 +195,7 @@ impl OwnEegDraw {
     }
 }
 
-/// Reads the recording of `scenario`, calibrates the decoder on its first
+/// Reads the own EEG of `scenario`, calibrates the decoder on its first
 /// part as a synthetic session is calibrated (`setup`'s preprocessing and
 /// folds, an LDA, Platt scaling) and keeps the held-out epochs. Errors
 /// name the file.
@@ -286,7 +286,7 @@ pub const CV_REPEATS: u64 = 10;
 
 /// The cross-validated accuracy averaged over [`CV_REPEATS`] draws of the
 /// folds (`first` is the draw of `seed` itself, the one the decoder's Platt
-/// scaling comes from): a recording's calibration part is short (200
+/// scaling comes from): own EEG's calibration part is short (200
 /// events, 30 to 40 errors, in a 400-action session), and one draw's
 /// accuracy moves by about 2 points with the folds alone.
 fn repeated_cv(
@@ -328,7 +328,7 @@ fn fcz_row(recording: &OwnEeg, preprocessor: &errp_bci::Preprocessor) -> Result<
 }
 
 /// `params` as the shared control uses them with `bank`: the accuracy it
-/// assumes is the recording's.
+/// assumes is the own EEG's.
 pub(crate) fn own_eeg_control(
     params: &GridTaskParams,
     bank: &OwnEegBank,

@@ -28,10 +28,10 @@ use crate::task_kind::TaskKind;
 pub struct GridRunReport {
     /// The scenario as run.
     pub scenario: GridScenario,
-    /// The calibration behind the EEG decoder (none for the oracle and a
-    /// recording).
+    /// The calibration behind the EEG decoder (none for the oracle and
+    /// own EEG).
     pub calibration: Option<CalibrationReport>,
-    /// What a person's recording gave (`[eeg] recording = ...`).
+    /// What a person's own EEG gave (`[eeg] recording = ...`).
     pub own_eeg: Option<OwnEegReport>,
     /// One result per episode, in scenario order.
     pub episodes: Vec<GridEpisodeResult>,
@@ -118,9 +118,9 @@ impl PreparedGrid {
 }
 
 /// The accuracy the decoder of `s` is known by: the one asked for, or
-/// (its EEG a recording) the one cross-validated on the recording's
-/// calibration part, which the control assumes. Not a number for a
-/// recording's scenario without its `own_eeg` report.
+/// (on own EEG) the one cross-validated on its calibration part, which the
+/// control assumes. Not a number for an own-EEG scenario without its
+/// `own_eeg` report.
 pub fn decoder_accuracy(s: &GridScenario, own_eeg: Option<&OwnEegReport>) -> f64 {
     match (s.accuracy.requested(), own_eeg) {
         (Some(a), _) => a.get(),
@@ -416,7 +416,7 @@ fn targeted(scenario: &GridScenario) -> Result<MeanAccuracy> {
     }
 }
 
-/// The accuracy `scenario` asks for (none when its EEG is a recording).
+/// The accuracy `scenario` asks for (none when its EEG is own EEG).
 fn requested(scenario: &GridScenario) -> Result<RequestedAccuracy> {
     scenario.accuracy.requested().ok_or_else(|| {
         SimError::Scenario(format!(

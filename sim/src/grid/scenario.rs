@@ -100,7 +100,7 @@ fn default_p_error() -> PErrorChoice {
     PErrorChoice::Platt
 }
 
-/// A scenario's `eeg`: a mode (`eeg = "bank"`) or a recording (an `[eeg]`
+/// A scenario's `eeg`: a mode (`eeg = "bank"`) or own EEG (an `[eeg]`
 /// table with `recording = "s01.edf"`).
 #[derive(Debug)]
 enum EegFile {
@@ -195,7 +195,7 @@ pub enum GridAccuracy {
     /// Asked for: the synthetic user's EEG is targeted at it (or the
     /// oracle has it).
     Requested(RequestedAccuracy),
-    /// Whatever a person's recording gives: the decoder is calibrated on
+    /// Whatever a person's own EEG gives: the decoder is calibrated on
     /// its first part and decodes epochs of the rest.
     OwnEeg(Box<OwnEegSpec>),
 }
@@ -209,7 +209,7 @@ impl GridAccuracy {
         }
     }
 
-    /// The recording, if the EEG is one.
+    /// The own EEG, if the EEG is a person's.
     pub fn own_eeg(&self) -> Option<&OwnEegSpec> {
         match self {
             Self::Requested(_) => None,
@@ -241,7 +241,7 @@ pub struct GridScenario {
     /// Epochs per class in the bank (bank mode).
     pub bank_per_class: usize,
     /// The decoder's mean accuracy: targeted in (0.5, 1), perfect (the
-    /// oracle only), or what a person's recording gives.
+    /// oracle only), or what a person's own EEG gives.
     pub accuracy: GridAccuracy,
     /// Who the accuracy comes from ("accuracy 0.7438", "subject S2, fixed goals").
     pub user: String,
@@ -359,7 +359,7 @@ impl GridScenario {
 
 /// The control a scenario runs, as the loader and the builder both derive
 /// it: the device assumes the accuracy asked of its decoder (an own EEG's
-/// cross-validated accuracy is set when the recording is read); checked
+/// cross-validated accuracy is set when the file is read); checked
 /// once, the controllers take it checked.
 pub(crate) fn assumed_control(
     control: GridControlParams,
@@ -419,8 +419,8 @@ fn user_accuracy(file: &ScenarioFile, path: &Path) -> Result<(RequestedAccuracy,
 
 /// What a scenario on own EEG is also given, as its file writes it, in
 /// the order [`rules::own_eeg_is_the_user`] reports them: a user (the
-/// recording is the user), the oracle (it has no EEG), a bank's size (the
-/// bank is the recording's held-out epochs). A `[realism]` table (a
+/// own EEG is the user), the oracle (it has no EEG), a bank's size (the
+/// bank is the own EEG's held-out epochs). A `[realism]` table (a
 /// simulated user's) is not used: [`GridScenario::on_own_eeg`].
 fn refuse_with_own_eeg(file: &ScenarioFile, own: &OwnEegSpec, path: &Path) -> Result<()> {
     let at = Origin::Scenario(path);
@@ -452,9 +452,9 @@ fn refuse_with_own_eeg(file: &ScenarioFile, own: &OwnEegSpec, path: &Path) -> Re
 }
 
 impl GridScenario {
-    /// This scenario on a person's recording `eeg` (given in memory, from
-    /// Python): its decoder calibrated on the recording's first part, its
-    /// user the recording (a simulated user's `[realism]` is not used, and
+    /// This scenario on a person's own EEG `eeg` (given in memory, from
+    /// Python): its decoder calibrated on the EEG's first part, its
+    /// user the person (a simulated user's `[realism]` is not used, and
     /// its user says so). Refused for the oracle, which reads no EEG.
     pub fn on_own_eeg(mut self, eeg: OwnEegSpec) -> Result<Self> {
         if self.decoder == DecoderChoice::Oracle {

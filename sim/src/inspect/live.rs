@@ -1,5 +1,5 @@
 //! A live session's recording (`errp stream --save`) read back: each run's
-//! decisions as received ([`LiveSession`]), and the runs replayed offline
+//! decisions as received ([`LiveDecisionLog`]), and the runs replayed offline
 //! with the decisions they applied ([`Recording::replay_live`]).
 
 use std::collections::BTreeMap;
@@ -16,7 +16,7 @@ use crate::task_kind::TaskKind;
 
 /// The decisions of a live session, per run.
 #[derive(Debug, Clone, PartialEq)]
-pub struct LiveSession {
+pub struct LiveDecisionLog {
     /// Simulated seconds per second of the link's clock.
     pub speed: Speed,
     /// The decoder's stream, as found (`name=...`).
@@ -32,12 +32,12 @@ pub struct LiveSession {
 /// The session in `tables` of `runs` runs of `task`, live at `speed` from
 /// `decoder` (the grid's decisions apply to actions, the e-puck's to
 /// windows).
-pub(super) fn live_session(
+pub(super) fn decision_log(
     tables: &BTreeMap<String, Table>,
     runs: usize,
     (speed, decoder): (Speed, &str),
     task: TaskKind,
-) -> Result<LiveSession, String> {
+) -> Result<LiveDecisionLog, String> {
     let d = LiveDecisionsView::of_or_empty(tables)?;
     check_run_order(LiveDecisions::ENTITY, d.run)?;
     // What each run's decisions apply to: its actions or its windows.
@@ -45,7 +45,7 @@ pub(super) fn live_session(
         TaskKind::Grid => (ActionsView::of_or_empty(tables)?.run, "action"),
         TaskKind::Epuck => (WindowsView::of(tables)?.run, "window"),
     };
-    let mut session = LiveSession {
+    let mut session = LiveDecisionLog {
         speed,
         decoder: decoder.to_string(),
         runs: Vec::with_capacity(runs),

@@ -22,7 +22,7 @@ mod rows;
 mod tables;
 
 pub use crate::record::data::Table;
-pub use live::{LiveReplay, LiveSession};
+pub use live::{LiveDecisionLog, LiveReplay};
 pub use read::MAX_RECORDING_BYTES;
 pub use report::{Comparison, RecordingHeadline, RecordingReport};
 pub use tables::{CsvTable, PARQUET_TABLE_KEY, csv_tables, phase_secs};
@@ -92,7 +92,7 @@ pub struct Recording {
     /// Every run, recomputed from the tables.
     pub runs: Runs,
     /// A live session's decisions (`errp stream --save`).
-    pub live: Option<LiveSession>,
+    pub live: Option<LiveDecisionLog>,
 }
 
 impl Recording {
@@ -140,7 +140,7 @@ impl Recording {
         let live = provenance
             .live
             .as_ref()
-            .map(|l| live::live_session(&tables, n, (l.speed, &l.decoder), runs.kind()))
+            .map(|l| live::decision_log(&tables, n, (l.speed, &l.decoder), runs.kind()))
             .transpose()
             .map_err(&bad)?;
         Ok(Self {

@@ -21,22 +21,11 @@ use crate::epuck::{
 };
 use crate::error::{Result, SimError};
 use crate::live::contract::{Marker, State};
-use crate::live::session::{Sink, check_rate};
+use crate::live::sink::{Sink, check_rate};
 use crate::live::streamer::{
     CalibrationMark, begin_control, end_session, stream_calibration, wait_for_decoder,
 };
-use crate::live::{LiveLink, LiveObserver, LiveOptions, LiveRunStats, Streamer, WindowTracker};
-
-/// One run of a live e-puck session.
-#[derive(Debug, Clone, PartialEq)]
-pub struct EpuckLiveRun {
-    /// The run, as the task scores it.
-    pub result: EpuckEpisodeResult,
-    /// The decoder's timing (missed: windows without a decision).
-    pub stats: LiveRunStats,
-    /// The p(error)s applied at each of the device's windows.
-    pub decisions: Vec<Vec<f64>>,
-}
+use crate::live::{EpuckLiveRun, LiveLink, LiveObserver, LiveOptions, Streamer, WindowTracker};
 
 /// Prepares the decoder of `scenario` (the simulated user's EEG model at
 /// the scenario's accuracy), each step of its calibration shown to

@@ -21,22 +21,11 @@ use crate::grid::{
     grid_episode_seed, prepare_decoder, run_grid_episode_with,
 };
 use crate::live::contract::{CellXy, Marker, State};
-use crate::live::session::{Sink, check_rate};
+use crate::live::sink::{Sink, check_rate};
 use crate::live::streamer::{
     CalibrationMark, begin_control, end_session, stream_calibration, wait_for_decoder,
 };
-use crate::live::{DecisionTracker, LiveLink, LiveOptions, LiveRunStats, Streamer};
-
-/// One run of a live grid session.
-#[derive(Debug, Clone, PartialEq)]
-pub struct GridLiveRun {
-    /// The episode, as the task scores it.
-    pub result: GridEpisodeResult,
-    /// The decoder's timing.
-    pub stats: LiveRunStats,
-    /// Each action's decision as applied: p(error), or none (missed).
-    pub decisions: Vec<Option<f64>>,
-}
+use crate::live::{DecisionTracker, GridLiveRun, LiveLink, LiveOptions, Streamer};
 
 fn cell(c: Cell) -> CellXy {
     [c.x, c.y]

@@ -17,8 +17,6 @@
 use errp_bci::EegBlock;
 
 use crate::error::{Result, SimError};
-use crate::live::epuck::EpuckLiveRun;
-use crate::live::grid::GridLiveRun;
 use crate::names::Names;
 use crate::pace::{self, Speed};
 use crate::runner::RunObserver;
@@ -28,15 +26,18 @@ mod decisions;
 pub mod epuck;
 pub mod grid;
 mod lsl;
+mod runs;
 #[cfg(feature = "rerun")]
 pub mod save;
 mod session;
+mod sink;
 mod streamer;
 
 pub use decisions::{
     DecisionTracker, Decisions, Fate, LiveRunStats, LoggedDecision, Received, WindowTracker,
 };
 pub use lsl::LslLink;
+pub use runs::{EpuckLiveRun, GridLiveRun};
 pub use session::{LiveOutcome, LiveRequest, LiveSession};
 pub use streamer::Streamer;
 
@@ -160,6 +161,7 @@ pub trait LiveObserver: RunObserver {
 }
 
 impl LiveObserver for () {}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -9,11 +9,12 @@ use std::path::{Path, PathBuf};
 
 use errp_bci::SFREQ_HZ;
 
-use crate::error::{Result, SimError};
+use crate::error::Result;
 use crate::input::LoadedScenario;
 use crate::live::contract::EegHeader;
 use crate::live::epuck::run_epuck_live;
 use crate::live::grid::run_grid_live;
+use crate::live::sink::{Sink, recording};
 use crate::live::{LiveLink, LiveObserver, LiveOptions, LiveRunStats};
 use crate::names::Names;
 use crate::rules::{self, Claim, Origin};
@@ -90,7 +91,10 @@ impl LiveSession {
         };
         let recording = request
             .save
-            .map(|path| recording::open(path, &scenario, &text, &request))
+            .map(|path| {
+                let live = (request.options.speed, request.decoder);
+                recording::open(path, (&scenario, &text), request.provenance, live)
+            })
             .transpose()?;
         let decoder = request
             .decoder
@@ -134,10 +138,7 @@ impl LiveSession {
         observer: &mut dyn LiveObserver,
     ) -> Result<LiveOutcome> {
         let task = self.task();
-        let mut sink = Sink {
-            observer,
-            recording: self.recording.as_mut(),
-        };
+        let mut sink = Sink::new(observer, self.recording.as_mut());
         let (reached, stats): (Vec<bool>, Vec<LiveRunStats>) = match &self.scenario {
             AnyScenario::Grid(s) => {
                 run_grid_live(s, link, self.options, self.runs, &self.decoder, &mut sink)?
@@ -160,177 +161,4 @@ impl LiveSession {
             recording,
         })
     }
-}
-
-/// Where a live loop's runs go: the front end's observer and the
-/// recording.
-pub(crate) struct Sink<'a> {
-    observer: &'a mut dyn LiveObserver,
-    recording: Option<&'a mut recording::File>,
-}
-
-impl Sink<'_> {
-    /// A line about the session.
-    pub(crate) fn note(&mut self, text: &str) {
-        self.observer.note(text);
-    }
-
-    /// The front end's observer (for what a run shows offline too: the
-    /// calibration's steps).
-    pub(crate) fn observer(&self) -> &dyn LiveObserver {
-        &*self.observer
-    }
-
-    /// Grid run `k` ended.
-    pub(crate) fn grid_run(
-        &mut self,
-        k: usize,
-        run: &crate::live::grid::GridLiveRun,
-    ) -> Result<()> {
-        self.observer.grid_run(k, run);
-        match &mut self.recording {
-            Some(r) => recording::grid_run(r, k, run),
-            None => Ok(()),
-        }
-    }
-
-    /// E-puck run `k` ended.
-    pub(crate) fn epuck_run(
-        &mut self,
-        k: usize,
-        run: &crate::live::epuck::EpuckLiveRun,
-    ) -> Result<()> {
-        self.observer.epuck_run(k, run);
-        match &mut self.recording {
-            Some(r) => recording::epuck_run(r, k, run),
-            None => Ok(()),
-        }
-    }
-
-    /// What watches e-puck run `k` (seed `seed`) step by step: the
-    /// recording, if any.
-    pub(crate) fn watch(
-        &mut self,
-        k: usize,
-        seed: u64,
-    ) -> Option<&mut dyn crate::epuck::EpuckObserver> {
-        recording::watch(self.recording.as_deref_mut()?, k, seed)
-    }
-}
-
-/// The session's recording: each run through the task's own recorder,
-/// and the decisions as received ([`crate::live::save`]).
-#[cfg(feature = "rerun")]
-mod recording {
-    use std::path::{Path, PathBuf};
-
-    use super::LiveRequest;
-    use crate::epuck::EpuckObserver;
-    use crate::error::Result;
-    use crate::live::epuck::EpuckLiveRun;
-    use crate::live::grid::GridLiveRun;
-    use crate::live::save::LiveRecording;
-    use crate::record::data::{LiveProvenance, Provenance};
-    use crate::scenario::AnyScenario;
-
-    pub(crate) type File = LiveRecording;
-
-    /// The recording of `scenario` (run as `text`) at `path`, made now.
-    pub(super) fn open(
-        path: &Path,
-        scenario: &AnyScenario,
-        text: &str,
-        request: &LiveRequest<'_>,
-    ) -> Result<File> {
-        let (name, seed) = match scenario {
-            AnyScenario::Grid(s) => (&s.name, s.seed),
-            AnyScenario::Epuck(s) => (&s.name, s.seed),
-        };
-        let mut p = Provenance::new(scenario.kind(), name, text.to_string(), seed);
-        p.command.clone_from(&request.provenance.command);
-        if let Some(commit) = &request.provenance.commit {
-            p.commit.clone_from(commit);
-        }
-        let live = LiveProvenance {
-            speed: request.options.speed,
-            decoder: request.decoder.to_string(),
-        };
-        p.decoder_summary = format!(
-            "decoder: outside the process, over Lab Streaming Layer ({}), live at speed {}\n",
-            live.decoder, live.speed
-        );
-        match scenario {
-            AnyScenario::Grid(s) => LiveRecording::grid(path, s, p, live),
-            AnyScenario::Epuck(s) => LiveRecording::epuck(path, s, p, live),
-        }
-    }
-
-    pub(super) fn grid_run(file: &mut File, k: usize, run: &GridLiveRun) -> Result<()> {
-        file.grid_run(k, run)
-    }
-
-    pub(super) fn epuck_run(file: &mut File, k: usize, run: &EpuckLiveRun) -> Result<()> {
-        file.epuck_run(k, run)
-    }
-
-    pub(super) fn watch(file: &mut File, k: usize, seed: u64) -> Option<&mut dyn EpuckObserver> {
-        file.epuck_watch(k, seed)
-    }
-
-    pub(super) fn finish(file: File) -> Result<PathBuf> {
-        file.finish()
-    }
-}
-
-/// Without the `rerun` feature nothing records: asking to is an error.
-#[cfg(not(feature = "rerun"))]
-mod recording {
-    use std::path::{Path, PathBuf};
-
-    use super::LiveRequest;
-    use crate::epuck::EpuckObserver;
-    use crate::error::{Result, SimError};
-    use crate::live::epuck::EpuckLiveRun;
-    use crate::live::grid::GridLiveRun;
-    use crate::scenario::AnyScenario;
-
-    /// No file is ever open.
-    pub(crate) enum File {}
-
-    pub(super) fn open(
-        path: &Path,
-        _scenario: &AnyScenario,
-        _text: &str,
-        _request: &LiveRequest<'_>,
-    ) -> Result<File> {
-        Err(SimError::NoRecorder {
-            path: path.to_path_buf(),
-        })
-    }
-
-    pub(super) fn grid_run(file: &mut File, _k: usize, _run: &GridLiveRun) -> Result<()> {
-        match *file {}
-    }
-
-    pub(super) fn epuck_run(file: &mut File, _k: usize, _run: &EpuckLiveRun) -> Result<()> {
-        match *file {}
-    }
-
-    pub(super) fn watch(file: &mut File, _k: usize, _seed: u64) -> Option<&mut dyn EpuckObserver> {
-        match *file {}
-    }
-
-    pub(super) fn finish(file: File) -> Result<PathBuf> {
-        match file {}
-    }
-}
-
-/// The error of a generator whose rate is not the contract's.
-pub(crate) fn check_rate(fs_hz: f64) -> Result<()> {
-    if fs_hz != SFREQ_HZ {
-        return Err(SimError::Live(format!(
-            "the EEG is sampled at {fs_hz} Hz, not the {SFREQ_HZ} Hz the stream announces"
-        )));
-    }
-    Ok(())
 }

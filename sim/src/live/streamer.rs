@@ -8,7 +8,7 @@ use errp_bci::{Assessment, AssessmentKind, EegBlock, EegGenerator};
 
 use crate::error::{Result, SimError};
 use crate::live::contract::{Label, Marker, State, encode};
-use crate::live::session::Sink;
+use crate::live::sink::Sink;
 use crate::live::{Decisions, HOP_SAMPLES, LiveLink, LiveOptions};
 use crate::pace::{Pace, Speed};
 

@@ -1,5 +1,5 @@
 //! `errp realism`: the simulated user's statistics beside published
-//! recordings of people. Each row measures one statistic on the user of a
+//! EEG of people. Each row measures one statistic on the user of a
 //! scenario (its `[realism]` table) and sets it beside the published range,
 //! with the source and whether the simulated user falls inside it.
 
@@ -199,7 +199,7 @@ fn grid_values(s: &GridScenario) -> Result<Vec<(&'static str, f64)>> {
     ])
 }
 
-/// The e-puck detector's per-trial rates on the held-out recording: a hit
+/// The e-puck detector's per-trial rates on the held-out session: a hit
 /// per ErrP, and the chance that the span of a trial's response holds no
 /// false alarm.
 fn epuck_values(s: &EpuckScenario) -> Result<Vec<(&'static str, f64)>> {

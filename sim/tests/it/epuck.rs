@@ -127,6 +127,7 @@ fn walls_never_let_the_robot_out_even_driven_blindly() {
 }
 
 #[test]
+#[ignore = "slow (every shipped e-puck scenario, 13 s): `cargo test --workspace -- --ignored` and CI run it"]
 fn every_epuck_scenario_loads_and_runs_inside_the_arena() {
     let dir = format!("{}/../scenarios", env!("CARGO_MANIFEST_DIR"));
     let mut n = 0;
@@ -248,7 +249,7 @@ fn the_default_detector_reproduces_section_5_3_where_the_literal_reading_fails()
 }
 
 /// The span over which detections are attributed to an ErrP is where the
-/// decoder responds: measured on the held-out recording, it holds the
+/// decoder responds: measured on the held-out session, it holds the
 /// training alignment (window end 0.8 s after time zero) and reaches past it,
 /// and a strong single ErrP at a known time peaks inside it.
 #[test]
@@ -317,7 +318,7 @@ fn detections_are_scored_over_the_span_where_the_decoder_responds() {
 }
 
 /// A scenario can ask for an online operating point instead of an
-/// accuracy: the ratio and T_e are calibrated until the held-out recording
+/// accuracy: the ratio and T_e are calibrated until the held-out session
 /// shows it.
 #[test]
 fn an_online_operating_point_is_calibrated_for() {

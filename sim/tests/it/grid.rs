@@ -80,6 +80,7 @@ fn online_accuracy_matches_the_calibrated_accuracy() {
 }
 
 #[test]
+#[ignore = "slow (8 s): `cargo test --workspace -- --ignored` and CI run it"]
 fn banked_epochs_give_the_streamed_accuracy_and_reach_the_goals() {
     let eeg = streamed(0.90, 7);
     let bank = errp_sim::grid::EpochBank::build(eeg, &GridTaskParams::default(), 400, 7).unwrap();
@@ -242,6 +243,7 @@ fn the_oracle_carries_what_a_binary_symmetric_channel_does() {
 /// clearly more than a binary symmetric channel at its accuracy, and less
 /// than an erasure channel, the most a decoder at that accuracy can carry.
 #[test]
+#[ignore = "slow (8 s): `cargo test --workspace -- --ignored` and CI run it"]
 fn the_eeg_decoder_carries_more_than_its_class_alone() {
     let params = GridTaskParams::default();
     let d = eeg_decoder(0.7438, 1);

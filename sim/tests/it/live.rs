@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 
 use errp_bci::EegBlock;
 use errp_sim::grid::GridScenario;
-use errp_sim::live::epuck::EpuckLiveRun;
-use errp_sim::live::grid::{GridLiveRun, replay_grid};
+use errp_sim::live::grid::replay_grid;
+use errp_sim::live::{EpuckLiveRun, GridLiveRun};
 use errp_sim::live::{
     Fate, LiveLink, LiveObserver, LiveOptions, LiveOutcome, LiveRequest, LiveSession, Received,
 };
@@ -402,8 +402,7 @@ fn scratch(name: &str) -> PathBuf {
 mod saved {
     use errp_sim::epuck::EpuckScenario;
     use errp_sim::inspect::Recording;
-    use errp_sim::live::epuck::EpuckLiveRun;
-    use errp_sim::live::grid::GridLiveRun;
+    use errp_sim::live::{EpuckLiveRun, GridLiveRun};
     use errp_sim::live::{LiveOutcome, LiveRunStats};
 
     /// The session's recording, read back (and its directory removed).

@@ -12,4 +12,5 @@ mod own_eeg;
 mod realism;
 #[cfg(feature = "rerun")]
 mod recordings;
+mod rules;
 mod scenario_fuzz;

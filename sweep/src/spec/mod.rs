@@ -268,21 +268,22 @@ impl SweepSpec {
     }
 
     /// Sets what the caller gave for every level: the accuracy levels
-    /// (`accuracy`, none on own EEG) and the grid's EEG mode (`per_action`;
-    /// otherwise the bank, but on own EEG, whose EEG is the recording's).
-    /// What own EEG cannot take is refused when the levels are checked, by
-    /// the rule ([`rules::own_eeg_is_the_user`]), naming `names`' inputs.
+    /// (`accuracy`, none on own EEG) and the grid's EEG mode (`eeg`, as
+    /// given: `per_action`, `bank`; otherwise the bank, but on own EEG,
+    /// whose EEG is the recording's). What own EEG cannot take is refused
+    /// when the levels are checked, by the rule
+    /// ([`rules::own_eeg_is_the_user`]), naming `names`' inputs.
     pub fn set_levels(
         &mut self,
         accuracy: Option<&str>,
-        per_action: Option<bool>,
+        eeg: Option<&str>,
         names: &Names,
     ) -> Result<()> {
         if let Some(a) = accuracy {
             self.accuracies = parse_accuracies(a, names)?;
         }
-        if !self.on_own_eeg() || per_action.is_some() {
-            self.fixed = sweep_fixed(self.task, &self.scenario_path, per_action, names)?;
+        if !self.on_own_eeg() || eeg.is_some() {
+            self.fixed = sweep_fixed(self.task, &self.scenario_path, eeg, names)?;
         }
         Ok(())
     }

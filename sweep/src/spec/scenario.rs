@@ -49,27 +49,23 @@ pub fn sweep_scenario(
 }
 
 /// The scenario keys a sweep of `task` (the scenario at `path`) sets
-/// whatever its levels: the grid reads its epochs from a bank unless it is
-/// asked to synthesise each action's EEG (`per_action`: `Some(true)`;
-/// `Some(false)` or none uses the bank); the e-puck takes no EEG mode
+/// whatever its levels: the grid reads its EEG as `eeg` says (a mode as
+/// the caller gave it, `per_action` or `bank`, checked with the levels),
+/// from a bank by default; the e-puck takes no EEG mode
 /// ([`rules::task_takes`]).
 pub fn sweep_fixed(
     task: TaskKind,
     path: &Path,
-    per_action: Option<bool>,
+    eeg: Option<&str>,
     names: &Names,
 ) -> Result<Vec<(String, Value)>> {
-    if per_action.is_some() {
+    if eeg.is_some() {
         rules::task_takes(task, path, &[(TaskValue::EegMode, Origin::Sweep(names))])?;
     }
     Ok(match task {
         TaskKind::Grid => {
-            let mode = if per_action == Some(true) {
-                EegMode::PerAction
-            } else {
-                EegMode::Bank
-            };
-            vec![("eeg".to_string(), Value::String(mode.key().into()))]
+            let mode = eeg.unwrap_or(EegMode::Bank.key());
+            vec![("eeg".to_string(), Value::String(mode.into()))]
         }
         TaskKind::Epuck => Vec::new(),
     })

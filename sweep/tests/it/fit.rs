@@ -113,6 +113,7 @@ fn shipped_scenarios_have_distinct_seeds() {
 }
 
 #[test]
+#[ignore = "slow (an e-puck fit, 38 s): `cargo test --workspace -- --ignored` and CI run it"]
 fn a_small_fit_writes_its_files_resumes_to_the_same_bytes_and_guards_its_directory() {
     let out = temp_dir("fit");
     let spec = EpuckFitSpec {
@@ -210,7 +211,7 @@ fn median_time_to_goal(rows: &[(bool, f64)]) -> f64 {
 }
 
 #[test]
-#[ignore = "slow (2500 e-puck runs, about 3 minutes): .ci/run runs it"]
+#[ignore = "slow (2500 e-puck runs, 67 s): `cargo test --workspace -- --ignored` and CI run it"]
 fn the_median_time_to_pisa_does_not_rise_with_accuracy() {
     use errp_sim::TaskKind;
     use errp_sweep::{Shard, SweepOptions, SweepSpec, run_sweep, sweep_fixed};
@@ -548,6 +549,7 @@ fn a_small_grid_fit_writes_its_files_and_refuses_bad_settings() {
 /// length, shorter pairs taking fewer actions at every goal reward, and the
 /// chosen length's example set of that length, with run 3 central.
 #[test]
+#[ignore = "slow (a grid fit over two pair lengths, 108 s): `cargo test --workspace -- --ignored` and CI run it"]
 fn a_grid_fit_over_pair_lengths_profiles_each_length() {
     let out = temp_dir("fit-grid-pairs");
     let spec = GridFitSpec {
@@ -582,6 +584,7 @@ fn a_grid_fit_over_pair_lengths_profiles_each_length() {
 /// the SD would give the same runs bit for bit), and the result at the
 /// chosen SD.
 #[test]
+#[ignore = "slow (two grid fits, 108 s): `cargo test --workspace -- --ignored` and CI run it"]
 fn a_grid_fit_over_trial_latency_sds_runs_each_users() {
     let out = temp_dir("fit-grid-trial");
     let spec = GridFitSpec {

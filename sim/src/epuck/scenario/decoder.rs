@@ -27,14 +27,15 @@ pub(super) fn table_error(path: &Path, table: &str, e: errp_bci::BciError) -> Si
     }
 }
 
-/// The accuracy an e-puck scenario on a recording holds until its decoder
-/// is calibrated (nothing reads it: the control assumes the recording's).
+/// The accuracy an e-puck scenario on own EEG holds until its decoder
+/// is calibrated (nothing reads it: the control assumes the one the EEG
+/// gives).
 pub(super) const OWN_EEG_PLACEHOLDER_ACCURACY: f64 = 0.75;
 
 /// What a scenario on own EEG is also given, as its file writes it, in
 /// the order [`rules::own_eeg_is_the_user`] reports them: a decoder target
-/// (the recording has the accuracy it gives) and T_e (set for a
-/// false-alarm rate on the recording).
+/// (own EEG has the accuracy it gives) and T_e (set for a
+/// false-alarm rate on the own EEG).
 pub(super) fn refuse_with_own_eeg(
     u: &UserFile,
     t_e_given: bool,

@@ -73,9 +73,9 @@ pub struct EpuckScenario {
     /// Robot, control, user, tracker, avoidance, time-out.
     pub params: EpuckTaskParams,
     /// How far the simulated user is from the ideal one (`[realism]`; the
-    /// ideal one with a recording).
+    /// ideal one with own EEG).
     pub realism: Realism,
-    /// A person's recording in place of the synthetic user's EEG (`[eeg]`):
+    /// A person's own EEG in place of the synthetic user's EEG (`[eeg]`):
     /// the decoder is calibrated and run on a hybrid of it.
     pub own_eeg: Option<Box<OwnEegSpec>>,
 }
@@ -106,9 +106,9 @@ impl EpuckScenario {
         }
     }
 
-    /// This scenario on a person's recording `eeg` (given in memory, from
+    /// This scenario on a person's own EEG `eeg` (given in memory, from
     /// Python): its runs on a hybrid of it, its decoder calibrated on the
-    /// recording's first part with no accuracy targeted and T_e set for a
+    /// EEG's first part with no accuracy targeted and T_e set for a
     /// false-alarm rate (a simulated user's `[realism]` and decoder target
     /// are not used).
     pub fn on_own_eeg(mut self, eeg: OwnEegSpec) -> Self {

@@ -39,7 +39,7 @@ fn check_out(out: &Path) -> Result<()> {
 }
 
 /// Calibrates every subject's decoders, runs every grid point and writes
-/// [`GRID_FIT_FILES`] into `out`. The observer sees each decoder as it is
+/// [`FIT_FILES`](crate::fit::FIT_FILES) into `out`. The observer sees each decoder as it is
 /// ready, then the episodes.
 pub fn run_grid_fit(
     spec: &GridFitSpec,

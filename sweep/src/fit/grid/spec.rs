@@ -26,13 +26,13 @@ pub struct GridFitSpec {
     pub realism: errp_bci::Realism,
     /// The fixed pairs' total Manhattan lengths, fitted jointly with the
     /// goal reward ([`PairFamily`]: each group of five runs draws its own
-    /// set of that length); empty: the shipped pairs ([`FIXED_PAIRS`]).
+    /// set of that length); empty: the shipped pairs ([`FIXED_PAIRS`](errp_sim::grid::FIXED_PAIRS)).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub pair_lengths: Vec<usize>,
     /// The ErrP's single-trial latency SDs (ms,
     /// [`Realism::trial_latency_sd_ms`](errp_bci::Realism::trial_latency_sd_ms)),
     /// fitted jointly with the rest: the whole fit is run at each
-    /// ([`TrialLatencyFit`]); empty: the users' own.
+    /// ([`TrialLatencyFit`](crate::fit::grid::TrialLatencyFit)); empty: the users' own.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub trial_latency_sds: Vec<f64>,
 }
