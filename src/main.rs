@@ -36,14 +36,17 @@ enum Command {
     /// paper's decoder (z-score, PCA 95 %, shrinkage LDA), cross-validated on a
     /// 400-action calibration session with 20 % errors, reaches the requested
     /// mean accuracy; then runs that session and reports per-class rates.
+    #[command(allow_negative_numbers = true)]
     Calibrate(CalibrateArgs),
     /// Run a scenario: the e-puck in its arena steered by the sliding-window
     /// ErrP decoder (sec. 5), or episodes of the grid task (sec. 4), printed
     /// per run and summarised next to the paper.
+    #[command(allow_negative_numbers = true)]
     Run(RunArgs),
     /// Re-run Table 1: subjects S1-S4 at their accuracies on the fixed and
     /// free goals, side by side with the paper, with the accuracy-time
     /// correlation.
+    #[command(allow_negative_numbers = true)]
     Table1(Table1Args),
     /// List the subjects of Table 1 of the paper and their accuracies.
     Subjects,
@@ -51,6 +54,7 @@ enum Command {
     /// episodes in parallel, streamed to DIR/episodes.csv (a rerun resumes),
     /// then DIR/summary.csv, a printed table, DIR/sweep.svg and .png, and
     /// DIR/sweep.json to rerun it exactly.
+    #[command(allow_negative_numbers = true)]
     Sweep(sweep::SweepArgs),
     /// Merge the directories of a sharded sweep (`errp sweep --shard K/N`)
     /// into the files one unsharded run writes.
@@ -64,15 +68,19 @@ enum Command {
     /// people: the background EEG, the ErrP at FCz, the decoders' per-class
     /// rates, calibration against the closed loop; each row with the
     /// published range, its source and whether the user falls inside it.
+    #[command(allow_negative_numbers = true)]
     Realism(commands::realism::RealismArgs),
     /// Read recordings back: what a `.rrd` holds and how to make it again,
     /// each run recomputed from it (the table `errp run` printed), tidy CSV
     /// tables, and the paper's Fig. 5 (e-puck) or Fig. 4 (grid).
+    #[command(allow_negative_numbers = true)]
     Inspect(InspectArgs),
-    /// Run a grid scenario on the wall clock over Lab Streaming Layer, with
-    /// your own online decoder in the loop: the simulated user's EEG (40
-    /// channels, 256 Hz, µV), markers and state out, p(error) per action
-    /// back from your decoder's stream; the calibration session first.
+    /// Run a grid or e-puck scenario on the wall clock over Lab Streaming
+    /// Layer, with your own online decoder in the loop: the simulated
+    /// user's EEG (40 channels, 256 Hz, µV), markers and state out, p(error)
+    /// per grid action or e-puck window back from your decoder's stream;
+    /// the calibration session first.
+    #[command(allow_negative_numbers = true)]
     Stream(commands::stream::StreamArgs),
 }
 

@@ -157,6 +157,41 @@ pub(crate) fn angle_between(a: [f64; 3], b: [f64; 3]) -> f64 {
     (dot / (na * nb)).clamp(-1.0, 1.0).acos()
 }
 
+/// A name as compared: trimmed, lower case, without an `EEG ` or `EOG `
+/// prefix (MNE drops `EOG ` when it infers channel types).
+fn bare(name: &str) -> String {
+    let n = name.trim().to_ascii_lowercase();
+    for prefix in ["eeg ", "eog ", "eeg-", "eog-"] {
+        if let Some(rest) = n.strip_prefix(prefix) {
+            return rest.trim().to_string();
+        }
+    }
+    n
+}
+
+/// The index in `labels` of montage channel `name`, compared bare; two
+/// labels that both match are an error naming both (a relabelled channel
+/// would otherwise be decoded as another).
+pub(crate) fn find_label(labels: &[&str], name: &str) -> Result<Option<usize>, String> {
+    let want = bare(name);
+    let mut hits = labels
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| bare(l) == want)
+        .map(|(i, _)| i);
+    match (hits.next(), hits.next()) {
+        (Some(i), Some(j)) => Err(format!(
+            "two channels match {name:?}: {:?} (channel {}) and {:?} (channel {}); rename or \
+             drop one (e.g. MNE's raw.rename_channels or raw.drop_channels)",
+            labels[i],
+            i + 1,
+            labels[j],
+            j + 1
+        )),
+        (first, _) => Ok(first),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

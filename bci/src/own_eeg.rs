@@ -15,7 +15,7 @@ use errp_valid::Valid;
 use nalgebra::DMatrix;
 
 use crate::calibration::CalibrationSession;
-use crate::edf::{EdfFile, EdfSignal, find};
+use crate::edf::{EdfFile, EdfSignal};
 use crate::erp::AssessmentKind;
 use crate::error::{BciError, Result};
 use crate::features::EpochWindow;
@@ -23,9 +23,19 @@ use crate::generator::{Assessment, EegBlock};
 use crate::montage::{ChannelKind, DECODING_CHANNELS, Montage};
 use crate::preprocess::{Preprocessing, Preprocessor};
 
+/// The row of `labels` that montage channel `name` matches
+/// ([`crate::montage`]'s rule), or an error naming two that both do.
+fn find(labels: &[&str], name: &str) -> Result<Option<usize>> {
+    crate::montage::find_label(labels, name).map_err(BciError::Format)
+}
+
 /// Events of each class a calibration part needs at least (the
 /// cross-validation's five folds each hold one).
 pub const MIN_CALIBRATION_PER_CLASS: usize = 5;
+
+/// The most labelled events own EEG may hold (ten times the paper's
+/// sessions of 400 and more actions; each held-out one keeps an epoch).
+pub const MAX_OWN_EEG_EVENTS: usize = 20_000;
 
 /// The EOG channels the preprocessing's regression needs.
 pub const EOG_CHANNELS: [&str; 6] = ["EOG LA", "EOG LB", "EOG RA", "EOG RB", "EOG LO", "EOG RO"];
@@ -62,6 +72,10 @@ pub struct OwnEeg {
     pub sfreq_hz: f64,
     /// The labelled events, by onset.
     pub events: Vec<Assessment>,
+    /// Events given twice (the same class at the same sample, a common
+    /// export bug), each kept once: a repeat would put one epoch into both
+    /// a training and a test fold.
+    pub merged: usize,
 }
 
 /// A short list of names, for messages.
@@ -77,8 +91,11 @@ impl OwnEeg {
     /// Matches `labels` (one per row of `data`, `(labels.len(), n)` in µV,
     /// at `sfreq_hz`) to the standard montage: the eight decoding channels
     /// and the six EOG ones must be there, every other EEG channel found
-    /// joins the common average reference. `events` are sorted by onset
-    /// and must lie inside the data.
+    /// joins the common average reference; two labels that match one
+    /// channel are refused. `events` are sorted by onset and must lie
+    /// inside the data; an event given twice is kept once
+    /// ([`OwnEeg::merged`]), one sample labelled both error and correct is
+    /// refused.
     pub fn new(
         labels: &[&str],
         data: &EegBlock,
@@ -94,11 +111,14 @@ impl OwnEeg {
         }
         let standard = Montage::standard();
         // The EOG regression's six channels, all of them or none.
-        let has_eog = EOG_CHANNELS.iter().any(|n| find(labels, n).is_some());
+        let mut has_eog = false;
+        for name in EOG_CHANNELS {
+            has_eog |= find(labels, name)?.is_some();
+        }
         let mut keep = Vec::new();
         let mut rows = Vec::new();
         for (i, c) in standard.channels().iter().enumerate() {
-            match find(labels, &c.name) {
+            match find(labels, &c.name)? {
                 Some(row) => {
                     keep.push(i);
                     rows.push(row);
@@ -129,6 +149,12 @@ impl OwnEeg {
                 montage.channels()[bad / data.n_samples.max(1)].name
             )));
         }
+        if events.len() > MAX_OWN_EEG_EVENTS {
+            return Err(BciError::Format(format!(
+                "{} labelled events; own EEG may hold at most {MAX_OWN_EEG_EVENTS}",
+                events.len()
+            )));
+        }
         events.sort_by(|a, b| a.onset_secs.total_cmp(&b.onset_secs));
         let duration = data.n_samples as f64 / sfreq_hz;
         if let Some(e) = events
@@ -140,11 +166,13 @@ impl OwnEeg {
                 e.onset_secs
             )));
         }
+        let (events, merged) = merge_repeats(events, sfreq_hz)?;
         Ok(Self {
             montage,
             raw,
             sfreq_hz,
             events,
+            merged,
         })
     }
 
@@ -155,11 +183,12 @@ impl OwnEeg {
         let labels: Vec<&str> = file.signals.iter().map(|s| s.label.as_str()).collect();
         let standard = Montage::standard();
         // Only the channels that will be used must be usable.
-        let used: Vec<&EdfSignal> = standard
-            .channels()
-            .iter()
-            .filter_map(|c| find(&labels, &c.name).map(|i| &file.signals[i]))
-            .collect();
+        let mut used: Vec<&EdfSignal> = Vec::new();
+        for c in standard.channels() {
+            if let Some(i) = find(&labels, &c.name)? {
+                used.push(&file.signals[i]);
+            }
+        }
         for s in &used {
             if s.sfreq_hz != sfreq_hz {
                 return Err(BciError::Format(format!(
@@ -193,6 +222,31 @@ impl OwnEeg {
     pub fn duration_secs(&self) -> f64 {
         self.raw.n_samples as f64 / self.sfreq_hz
     }
+}
+
+/// `events` (sorted by onset) with each repeat (the same class at the same
+/// sample) left out, and how many were; one sample of both classes is an
+/// error.
+fn merge_repeats(events: Vec<Assessment>, sfreq_hz: f64) -> Result<(Vec<Assessment>, usize)> {
+    let sample = |e: &Assessment| (e.onset_secs * sfreq_hz).round();
+    let mut kept: Vec<Assessment> = Vec::with_capacity(events.len());
+    let mut merged = 0;
+    for e in events {
+        // Events at one sample are adjacent once sorted, and only the first
+        // of them is kept.
+        match kept.last() {
+            Some(k) if sample(k) == sample(&e) && k.kind == e.kind => merged += 1,
+            Some(k) if sample(k) == sample(&e) => {
+                return Err(BciError::Format(format!(
+                    "the event at {} s is annotated both error and correct: one action has \
+                     one outcome",
+                    errp_valid::shown(e.onset_secs)
+                )));
+            }
+            _ => kept.push(e),
+        }
+    }
+    Ok((kept, merged))
 }
 
 /// The annotations of `file` that `names` marks as events, with a message

@@ -48,6 +48,7 @@ use std::ffi::CString;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+mod elf;
 mod ffi;
 
 use ffi::{Api, Info, LSL_LOST, LSL_TIMEOUT, RawInlet, RawOutlet};
@@ -219,7 +220,8 @@ impl Lsl {
             }
         }
         for name in ["liblsl.so", "liblsl.so.2", "liblsl.dylib"] {
-            if let Ok(l) = Self::open(Path::new(name)) {
+            // A bare name: the system's loader searches its own path.
+            if let Ok(l) = Self::load(Path::new(name)) {
                 return Ok(l);
             }
         }
@@ -232,22 +234,40 @@ impl Lsl {
         }
     }
 
-    /// Loads liblsl from `path`. Without a configuration of the lab's own
-    /// (`LSLAPICFG`, or an `lsl_api.cfg` where liblsl looks), liblsl logs
-    /// only errors, not its start-up notes.
+    /// Loads liblsl from the file `path` (a name without a directory is a
+    /// file in the current one, never one the system's loader finds
+    /// elsewhere). It must be a regular file (a special file is never
+    /// opened) whose headers fit in it (a truncated library, mapped, would
+    /// kill the process when a missing page is touched). Without a
+    /// configuration of the lab's own (`LSLAPICFG`, or an `lsl_api.cfg`
+    /// where liblsl looks), liblsl logs only errors, not its start-up
+    /// notes.
     pub fn open(path: &Path) -> Result<Self, LslError> {
-        // A path (not a bare name for the system's loader) must be a
-        // regular file: a special file is never opened.
-        if path.components().count() > 1 && !path.is_file() {
-            return Err(LslError::Load {
-                path: path.to_path_buf(),
-                why: if path.exists() {
-                    "not a regular file".into()
-                } else {
-                    "no such file".into()
-                },
-            });
+        let file = if path.components().count() == 1 {
+            Path::new(".").join(path)
+        } else {
+            path.to_path_buf()
+        };
+        let refuse = |why: String| LslError::Load {
+            path: path.to_path_buf(),
+            why,
+        };
+        if !file.is_file() {
+            return Err(refuse(if file.exists() {
+                "not a regular file".into()
+            } else {
+                "no such file".into()
+            }));
         }
+        elf::check_library(&file).map_err(refuse)?;
+        Self::load(&file).map_err(|e| match e {
+            LslError::Load { why, .. } => refuse(why),
+            other => other,
+        })
+    }
+
+    /// Loads liblsl from `path` as the system's loader finds it.
+    fn load(path: &Path) -> Result<Self, LslError> {
         let api = Api::load(path)?;
         if !lab_configuration() {
             api.configure("[log]\nlevel = -2\n");
@@ -444,6 +464,11 @@ impl Found {
         self.info.text(self.info.api.get_type)
     }
 
+    /// Its source id.
+    pub fn source_id(&self) -> String {
+        self.info.text(self.info.api.get_source_id)
+    }
+
     /// Its channel count.
     pub fn channels(&self) -> i32 {
         self.info.channel_count()
@@ -608,6 +633,12 @@ mod tests {
             Lsl::find(Some(&missing)),
             Err(LslError::Load { .. })
         ));
+        // A name without a directory is a file here, not one the system's
+        // loader would find elsewhere.
+        let e = Lsl::open(Path::new("errp-no-such-liblsl.so"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.ends_with("no such file"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

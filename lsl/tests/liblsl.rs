@@ -54,6 +54,7 @@ fn an_outlet_is_found_and_read_with_its_shape_values_and_stamps() {
     let f = &found[0];
     assert_eq!(f.name(), name);
     assert_eq!(f.kind(), "Test");
+    assert_eq!(f.source_id(), format!("{name}-source"));
     assert_eq!(
         (f.channels(), f.rate_hz(), f.format()),
         (2, 0.0, Some(Format::Double64))
@@ -98,4 +99,22 @@ fn a_text_stream_carries_its_strings_and_nothing_else_is_found() {
         .resolve("name", &format!("{name}-nobody-publishes-this"), 0.2)
         .unwrap();
     assert!(none.is_empty());
+}
+
+#[test]
+fn a_truncated_copy_of_liblsl_is_refused_not_mapped() {
+    let Some(lsl) = lsl() else { return };
+    // (The system's copy is loaded by name: nothing to cut.)
+    let Ok(bytes) = std::fs::read(lsl.path()) else {
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("errp-lsl-cut-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cut = dir.join("liblsl.so");
+    for keep in [bytes.len() / 2, bytes.len() * 9 / 10] {
+        std::fs::write(&cut, &bytes[..keep]).unwrap();
+        let e = Lsl::open(&cut).unwrap_err().to_string();
+        assert!(e.contains("truncated: the file has"), "{e}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -21,6 +21,11 @@ Run it beside the bridge (either first)::
     errp stream scenarios/grid_fixed_goals.toml --speed 20 &
     python python/examples/lsl_decoder.py
 
+Its outlet's source id ends with the session's id (``desc/errp/session`` of
+the EEG stream), as the bridge requires. With more than one session on the
+host, give each bridge ``--session ID`` and its decoder the same
+``--session ID``.
+
 Needs ``pip install pylsl scipy scikit-learn`` and the ``errp`` package
 (for ``errp.decoders``).
 """
@@ -44,26 +49,31 @@ DECODING = ["Fz", "FC1", "FCz", "FC2", "C1", "Cz", "C2", "CPz"]
 EPOCH_SECS = 0.8
 
 
-def find(name: str, timeout: float) -> StreamInlet:
-    """An inlet on the stream ``name``, or exit 2 naming it."""
-    found = resolve_byprop("name", name, 1, timeout)
+def find(name: str, timeout: float, session: str | None) -> StreamInlet:
+    """An inlet on the stream ``name`` (of ``session``, whose source id is
+    ``name-session``, if given), or exit 2 naming it."""
+    if session is None:
+        found = resolve_byprop("name", name, 1, timeout)
+    else:
+        found = resolve_byprop("source_id", f"{name}-{session}", 1, timeout)
     if not found:
-        print(f"error: no LSL stream {name!r} within {timeout} s: is errp stream running?",
+        which = name if session is None else f"{name}-{session}"
+        print(f"error: no LSL stream {which!r} within {timeout} s: is errp stream running?",
               file=sys.stderr)
         sys.exit(2)
     return StreamInlet(found[0], max_buflen=600, processing_flags=0)
 
 
-def channels(inlet: StreamInlet) -> tuple[list[str], list[str], float, float]:
-    """Labels, types, the true sampling rate and the speed, from the
-    stream's description."""
+def channels(inlet: StreamInlet) -> tuple[list[str], list[str], float, float, str]:
+    """Labels, types, the true sampling rate, the speed and the session,
+    from the stream's description."""
     root = ET.fromstring(inlet.info(timeout=10.0).as_xml())
     chans = root.find("desc/channels")
     labels = [c.findtext("label") for c in chans]
     types = [c.findtext("type") for c in chans]
     fs = float(root.findtext("desc/errp/sampling_rate_hz"))
     speed = float(root.findtext("desc/errp/speed"))
-    return labels, types, fs, speed
+    return labels, types, fs, speed, root.findtext("desc/errp/session")
 
 
 class Preprocess:
@@ -92,17 +102,21 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--name", default="errp-decoder", help="this decoder's stream")
     ap.add_argument("--timeout", type=float, default=60.0, help="seconds to find the streams")
+    ap.add_argument("--session", default=None,
+                    help="the bridge's session id (errp stream --session): needed only when "
+                         "more than one session runs on the host")
     ap.add_argument("--stop-after", type=int, default=None,
                     help="stop after this many decisions (to test the bridge's rules)")
     ap.add_argument("--delay", type=float, default=0.0,
                     help="wait this many seconds before each decision (to test late ones)")
     args = ap.parse_args()
 
-    eeg_in = find("errp-eeg", args.timeout)
-    markers_in = find("errp-markers", args.timeout)
-    labels, types, fs, speed = channels(eeg_in)
-    eeg_in.open_stream(timeout=10.0)
+    eeg_in = find("errp-eeg", args.timeout, args.session)
+    labels, types, fs, speed, session = channels(eeg_in)
+    markers_in = find("errp-markers", args.timeout, session)
+    # The markers first: every EEG sample received then has its markers.
     markers_in.open_stream(timeout=10.0)
+    eeg_in.open_stream(timeout=10.0)
     pre = Preprocess(labels, types, fs)
     n_keep = len(DECODING)
     span = int(round(EPOCH_SECS * fs))
@@ -154,7 +168,9 @@ def main() -> int:
         parts, times = [data], [stamps]
         if model is None and stamps.size and stamps[-1] >= t_ready:
             model, weights = train(data, stamps, calibration, t_ready, span, n_keep, windows)
-            info = StreamInfo(args.name, "Decisions", 2, 0.0, "double64", f"{args.name}-1")
+            # The source id ends with the session's id: the bridge takes
+            # no decoder of another session.
+            info = StreamInfo(args.name, "Decisions", 2, 0.0, "double64", f"{args.name}-{session}")
             outlet = StreamOutlet(info)
             print(f"trained on {len(calibration)} epochs; publishing {args.name}", file=sys.stderr)
         if model is not None and windows:

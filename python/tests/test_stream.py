@@ -13,6 +13,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from conftest import ROOT, errp_bin
@@ -56,15 +57,20 @@ def finish(p: subprocess.Popen, timeout: float = 240) -> tuple[int, str, str]:
 
 
 # A program that reads the EEG and markers and never decides; with
-# `channels`, it publishes a decoder stream of that many channels.
+# `channels`, it publishes a decoder stream of that many channels, for the
+# EEG stream's session or the one given after it.
 READER = """
-import sys, time, pylsl
+import sys, time, pylsl, xml.etree.ElementTree as ET
 eeg = pylsl.resolve_byprop("name", "errp-eeg", 1, 30)[0]
 inlet = pylsl.StreamInlet(eeg)
 inlet.open_stream(10)
+session = ET.fromstring(inlet.info(10).as_xml()).findtext("desc/errp/session")
 outlet = None
 if len(sys.argv) > 1:
-    info = pylsl.StreamInfo("errp-decoder", "Decisions", int(sys.argv[1]), 0.0, "double64", "x")
+    session = sys.argv[2] if len(sys.argv) > 2 else session
+    info = pylsl.StreamInfo(
+        "errp-decoder", "Decisions", int(sys.argv[1]), 0.0, "double64", f"x-{session}"
+    )
     outlet = pylsl.StreamOutlet(info)
 end = time.time() + 60
 while time.time() < end:
@@ -163,6 +169,21 @@ def test_the_eeg_metadata_reads_in_mne_lsl():
         assert types.count("eeg") == 34 and types.count("eog") == 6
         units = {u for u in stream.get_channel_units()}
         assert len(units) == 1 and "FIFF_UNITM_MU" in str(units), units
+        # The channels' positions: the montage's, on MNE's 95 mm head, as
+        # the channels' loc and as the montage MNE makes of the stream.
+        positions = stream.get_montage().get_positions()["ch_pos"]
+        for ch in stream.info["chs"]:
+            if ch["ch_name"] in positions:
+                assert np.allclose(ch["loc"][:3], positions[ch["ch_name"]])
+        montage = {}
+        for line in (ROOT / "assets" / "electrodes.csv").read_text().splitlines():
+            if line and not line.startswith("#") and not line.startswith("name"):
+                name, kind, x, y, z = (f.strip() for f in line.split(","))
+                if kind == "eeg":
+                    montage[name] = np.array([float(x), float(y), float(z)]) * 0.095
+        assert set(positions) == set(montage), set(positions) ^ set(montage)
+        for name, want in montage.items():
+            assert np.allclose(positions[name], want, atol=1e-6), (name, positions[name], want)
         stream.disconnect()
     finally:
         b.kill()
@@ -186,6 +207,8 @@ def test_no_decoder_within_the_timeout_is_refused():
     r.communicate()
     assert code == 2, err
     assert 'no decoder stream "errp-decoder" appeared within 2 s after the calibration' in err
+    # No stream of another session was seen, so none is named.
+    assert "other sessions" not in err
 
 
 def test_a_decoder_stream_of_the_wrong_shape_is_refused():
@@ -198,6 +221,45 @@ def test_a_decoder_stream_of_the_wrong_shape_is_refused():
     assert code == 2, err
     assert 'the decoder stream "errp-decoder" (name=errp-decoder) has 3 channels' in err
     assert "expected 2 numeric channels (action, p(error))" in err
+
+
+def test_a_decoder_of_another_session_is_refused():
+    # Published for session "theirs"; this bridge is session "mine".
+    r = python("-c", READER, "2", "theirs")
+    code, out, err = finish(
+        bridge(
+            GRID, "--timeout", "3", "--speed", "100", "--calibration-actions", "40",
+            "--session", "mine",
+        )
+    )
+    r.kill()
+    r.communicate()
+    assert code == 2, err
+    assert 'no decoder stream "errp-decoder" of this session appeared within 3 s' in err, err
+    assert 'source ids "x-theirs"' in err and 'session\'s id "mine"' in err, err
+    assert "as session mine" in err
+
+
+def test_two_sessions_on_one_host_each_close_their_own_loop():
+    # The same scenario and seed, so the same stream names: each bridge and
+    # its decoder find each other by the session's id alone.
+    bridges, clients = [], []
+    for session in ("lab_a", "lab_b"):
+        bridges.append(bridge(
+            GRID, "--speed", "40", "--runs", "1", "--timeout", "60",
+            "--calibration-actions", "200", "--session", session,
+        ))
+        clients.append(python(str(CLIENT), "--timeout", "60", "--session", session))
+    for session, b, c in zip(("lab_a", "lab_b"), bridges, clients):
+        code, out, err = finish(b)
+        client = c.communicate(timeout=60)[0]
+        assert code == 0, err + client
+        assert f"as session {session}" in err
+        summary = [line.strip() for line in out.splitlines() if "runs reached their goal" in line]
+        assert len(summary) == 1 and "0 stray" in summary[0], out
+        applied = int(summary[0].split("decisions: ")[1].split(" applied")[0])
+        assert applied >= 5, out
+        assert "trained on 200 epochs" in client, client
 
 
 def test_a_decoder_that_stops_mid_run_is_reported():

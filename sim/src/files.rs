@@ -44,7 +44,12 @@ pub fn open_regular_with(options: &mut OpenOptions, path: &Path) -> io::Result<F
     }
     let file = options.open(path).map_err(|e| match e.raw_os_error() {
         #[cfg(unix)]
-        Some(libc::ENXIO) => not_regular("a FIFO or a device"),
+        // (A socket, or a FIFO with no reader: say which, from its kind.)
+        Some(libc::ENXIO) => not_regular(
+            std::fs::metadata(path)
+                .map(|m| describe(&m.file_type()))
+                .unwrap_or("a FIFO, a socket or a device"),
+        ),
         _ => e,
     })?;
     let kind = file.metadata()?.file_type();

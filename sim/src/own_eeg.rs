@@ -305,6 +305,18 @@ impl OwnEegFields {
     }
 }
 
+/// What a report says of `merged` events annotated twice: nothing when
+/// there are none.
+pub(crate) fn twice(merged: usize) -> String {
+    match merged {
+        0 => String::new(),
+        n => format!(
+            "; {n} event{} annotated twice (the same class at the same sample), each kept once",
+            if n == 1 { "" } else { "s" }
+        ),
+    }
+}
+
 /// Reads the EEG file `eeg` names, at the decoder's `sfreq_hz`: opened as
 /// a regular file (never waiting on a FIFO or a device), at most
 /// [`MAX_OWN_EEG_BYTES`], read as EDF or BDF, every byte hashed, and

@@ -12,9 +12,12 @@ use serde::{Deserialize, Serialize};
 
 /// The fastest a live session runs: 100 times the wall clock.
 pub const MAX_SPEED: f64 = 100.0;
+/// The slowest: a tenth of the wall clock (a grid action's 3 s then last
+/// 30 s; slower, a session's timers and timeouts would mean nothing).
+pub const MIN_SPEED: f64 = 0.1;
 
-/// Simulated seconds per second of the link's clock: a number in (0,
-/// [`MAX_SPEED`]], checked where it enters.
+/// Simulated seconds per second of the link's clock: a number in
+/// [[`MIN_SPEED`], [`MAX_SPEED`]], checked where it enters.
 #[derive(Debug, Clone, Copy, PartialEq, PartialOrd, Serialize, Deserialize)]
 #[serde(try_from = "f64", into = "f64")]
 pub struct Speed(f64);
@@ -23,9 +26,9 @@ impl Speed {
     /// Real time.
     pub const REAL_TIME: Speed = Speed(1.0);
 
-    /// `k` if it is a speed: finite, above 0 and at most [`MAX_SPEED`].
+    /// `k` if it is a speed: from [`MIN_SPEED`] to [`MAX_SPEED`].
     pub fn new(k: f64) -> Option<Speed> {
-        (k.is_finite() && k > 0.0 && k <= MAX_SPEED).then_some(Speed(k))
+        (MIN_SPEED..=MAX_SPEED).contains(&k).then_some(Speed(k))
     }
 
     /// The factor.
@@ -55,7 +58,10 @@ impl TryFrom<f64> for Speed {
 
     fn try_from(k: f64) -> Result<Self, String> {
         Speed::new(k).ok_or_else(|| {
-            format!("{k} is not a speed, expected a factor > 0 and at most {MAX_SPEED}")
+            format!(
+                "{} is not a speed, expected a factor from {MIN_SPEED} to {MAX_SPEED}",
+                errp_bci::shown(k)
+            )
         })
     }
 }
@@ -131,7 +137,16 @@ mod tests {
 
     #[test]
     fn a_speed_is_checked_where_it_enters() {
-        for bad in [0.0, -1.0, 100.5, f64::NAN, f64::INFINITY] {
+        for bad in [
+            0.0,
+            1e-300,
+            1e-6,
+            0.09,
+            -1.0,
+            100.5,
+            f64::NAN,
+            f64::INFINITY,
+        ] {
             assert!(Speed::new(bad).is_none(), "{bad}");
             assert!(serde_json::from_str::<Speed>(&bad.to_string()).is_err());
         }

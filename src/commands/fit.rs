@@ -29,6 +29,7 @@ pub enum FitCommand {
     /// runs, the maximum-likelihood accuracy with its 95 % likelihood-ratio
     /// interval, each run held out in turn, and DIR/fit.json, surface.csv,
     /// fit.svg and fit.png. Rerunning into DIR resumes.
+    #[command(allow_negative_numbers = true)]
     Epuck(EpuckFitArgs),
     /// The grid task's Q-value scale (control.goal_reward at the paper's tau
     /// = 0.3), fitted to Table 1's fixed goals (the four subjects' mean
@@ -39,6 +40,7 @@ pub enum FitCommand {
     /// groups, the maximum-likelihood goal reward with its 95 %
     /// likelihood-ratio interval, each subject's own estimate, and
     /// DIR/fit.json, surface.csv, fit.svg and fit.png.
+    #[command(allow_negative_numbers = true)]
     Grid(GridFitArgs),
 }
 

@@ -11,7 +11,7 @@ use errp_lsl::Lsl;
 use errp_robot::GoalLayout;
 use errp_sim::epuck::{EpuckRunHeader, EpuckRunRow};
 use errp_sim::grid::{GridEpisodeHeader, GridEpisodeRow};
-use errp_sim::live::contract::{EEG_STREAM, MARKER_STREAM, STATE_STREAM};
+use errp_sim::live::contract::{EEG_STREAM, MARKER_STREAM, STATE_STREAM, SessionId};
 use errp_sim::live::{
     EpuckLiveRun, GridLiveRun, LiveObserver, LiveOptions, LiveRequest, LiveRunStats, LiveSession,
     LslLink,
@@ -32,7 +32,7 @@ pub(crate) struct StreamArgs {
     /// The scenario (a grid or an e-puck scenario file).
     pub(crate) scenario: PathBuf,
     /// Simulated seconds per wall second: the clock and the EEG stream's
-    /// nominal rate run this many times faster (1: real time; at most 100).
+    /// nominal rate run this many times faster (1: real time; 0.1 to 100).
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     pub(crate) speed: f64,
     /// Seconds to wait for the decoder (to open the EEG stream, to publish
@@ -53,12 +53,19 @@ pub(crate) struct StreamArgs {
     /// e-puck's (default: the scenario's).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     pub(crate) runs: Option<u64>,
+    /// This session's id, at the end of every stream's source id
+    /// (`errp-eeg-ID`): the decoder's stream is taken only if its source
+    /// id ends with `-ID` too. 1 to 16 letters, digits or _ (default: 8
+    /// fresh hexadecimal digits).
+    #[arg(long, value_name = "ID", value_parser = parse_session)]
+    pub(crate) session: Option<SessionId>,
     /// The decoder's stream, by an LSL property: name=NAME, type=TYPE or
     /// source_id=ID.
     #[arg(long, default_value = "name=errp-decoder", value_name = "PROP=VALUE")]
     pub(crate) decisions: String,
-    /// liblsl to load (default: ERRP_LIBLSL, PYLSL_LIB, the system's, then
-    /// the copy in pylsl's wheel).
+    /// liblsl to load, a file (a name without a directory is one in the
+    /// current directory); default: ERRP_LIBLSL, PYLSL_LIB, the system's,
+    /// then the copy in pylsl's wheel.
     #[arg(long, value_name = "FILE")]
     pub(crate) liblsl: Option<PathBuf>,
     /// Override the scenario's seed.
@@ -88,9 +95,23 @@ fn decisions_query(text: &str) -> Result<(&str, &str)> {
     }
 }
 
+/// `--session ID`, checked.
+fn parse_session(text: &str) -> std::result::Result<SessionId, String> {
+    SessionId::new(text).ok_or_else(|| {
+        format!(
+            "{:?} is not a session id: expected 1 to {} letters, digits or _",
+            errp_bci::shown(text),
+            SessionId::MAX_LEN
+        )
+    })
+}
+
 pub(crate) fn stream(args: &StreamArgs) -> Result<()> {
     let names = &Names::CLI;
-    let options = LiveOptions::new(args.speed, args.timeout, args.calibration_actions, names)?;
+    let mut options = LiveOptions::new(args.speed, args.timeout, args.calibration_actions, names)?;
+    if let Some(id) = args.session {
+        options.session = id;
+    }
     let query = decisions_query(&args.decisions)?;
     let input = ScenarioInput {
         accuracy: args.accuracy,
@@ -128,7 +149,8 @@ pub(crate) fn stream(args: &StreamArgs) -> Result<()> {
     if !args.quiet {
         errln!(
             "liblsl {}.{} from {}; publishing {EEG_STREAM} (EEG, {} channels at {} Hz x \
-             speed {} = {} Hz nominal), {MARKER_STREAM}, {STATE_STREAM}; decisions from {}",
+             speed {} = {} Hz nominal), {MARKER_STREAM}, {STATE_STREAM} as session {}; \
+             decisions from {} (source id ending -{})",
             lsl.version() / 100,
             lsl.version() % 100,
             lsl.path().display(),
@@ -136,7 +158,9 @@ pub(crate) fn stream(args: &StreamArgs) -> Result<()> {
             header.fs_hz,
             header.speed,
             header.speed.rate(header.fs_hz),
-            args.decisions
+            header.session,
+            args.decisions,
+            header.session
         );
     }
     let mut printer = Printer {

@@ -54,9 +54,11 @@ fn read_shards(dirs: &[PathBuf]) -> Result<Vec<(Manifest, &Path)>> {
         }
         if m.decoders != first.decoders {
             return Err(SimError::Sweep(format!(
-                "{} and {} calibrated different decoders; were they run by different versions?",
-                first_dir.display(),
-                d.display()
+                "{} and {} calibrated different decoders (the decoders in their {MANIFEST} \
+                 differ): a shard run by another version of errp, or on an own EEG file \
+                 changed between the shards; run the shards again from the same files",
+                first_dir.join(MANIFEST).display(),
+                d.join(MANIFEST).display()
             )));
         }
     }

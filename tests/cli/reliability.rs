@@ -321,6 +321,8 @@ fn bad_input_is_refused_naming_flag_field_value_and_range_leaving_nothing() {
             vec!["`user.accuracy` = 1.7", "strictly between 0.5 (chance) and 1"],
         ),
         (grid(""), vec!["--seed".into(), "-1".into()], vec!["--seed", "-1", "0 to"]),
+        // A negative number is a value of its flag, not an unknown argument.
+        (epuck("", ""), vec!["--runs".into(), "-1".into()], vec!["'--runs <", "'-1'"]),
         (
             grid(""),
             vec!["--accuracy".into(), "1".into()],

@@ -7,5 +7,3 @@ mod write;
 
 pub use read::{EdfAnnotation, EdfFile, EdfFormat, EdfSignal, MAX_EDF_SAMPLES, MAX_EDF_SIGNALS};
 pub use write::EdfWriter;
-
-pub(crate) use read::find;

@@ -7,9 +7,17 @@
 //! small (a 256-byte header, 256 bytes per signal, then data records). The
 //! reader trusts nothing it reads: every field is parsed and checked, sizes
 //! are bounded ([`MAX_EDF_SIGNALS`], [`MAX_EDF_SAMPLES`]) before anything
-//! is allocated, and a file that ends inside a record is refused.
-//! Discontinuous files (EDF+D, BDF+D) are refused: own EEG in the loop
-//! is one unbroken session.
+//! is allocated, and a file that ends inside a record, or has bytes after
+//! its last one, is refused. Discontinuous files (EDF+D, BDF+D) are
+//! refused: own EEG in the loop is one unbroken session.
+//!
+//! EDF+ keeps time in annotations: each data record's first TAL gives the
+//! record's start, and every onset counts from the header's start time.
+//! The first record may start later than that (edfio writes a sub-second
+//! start time so; a file cut from a longer one starts later still), so the
+//! onsets read here are moved to count from the first sample, as MNE and
+//! pyEDFlib place them, and a record that does not follow the previous one
+//! is refused.
 
 use std::io::Read;
 
@@ -25,6 +33,12 @@ const MAX_SAMPLES_PER_RECORD: usize = 1 << 20;
 /// The most samples one data record may hold over all its signals (12 MiB
 /// of BDF).
 const MAX_RECORD_SAMPLES: usize = 1 << 22;
+/// The largest physical minimum or maximum a signal may declare, in its own
+/// unit (a million volts in µV; real EEG is under a volt in any unit).
+const MAX_PHYSICAL: f64 = 1e12;
+/// The most annotations a file may hold (one every 0.13 s over the 3.6
+/// hours [`MAX_EDF_SAMPLES`] allows at 40 channels and 256 Hz).
+pub const MAX_EDF_ANNOTATIONS: usize = 100_000;
 
 /// Which variant of the format a file is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -88,7 +102,9 @@ impl EdfSignal {
 /// An annotation of an EDF+ or BDF+ file.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EdfAnnotation {
-    /// Its onset from the start of the file, in seconds.
+    /// Its onset from the file's first sample, in seconds (the file's own
+    /// onset, from the header's start time, less
+    /// [`EdfFile::start_secs`]).
     pub onset_secs: f64,
     /// Its duration in seconds, if given.
     pub duration_secs: Option<f64>,
@@ -110,6 +126,10 @@ pub struct EdfFile {
     pub records: usize,
     /// One data record's duration, in seconds.
     pub record_secs: f64,
+    /// When the first data record starts, in seconds after the header's
+    /// start time: its time-keeping TAL (EDF+ and BDF+), 0 without
+    /// annotations.
+    pub start_secs: f64,
 }
 
 /// One signal's header.
@@ -218,8 +238,21 @@ fn signal_headers(bytes: &[u8], n: usize, format: EdfFormat) -> Result<Vec<Signa
         let dmin = number(field(120, 8, i), &what("digital minimum"))?;
         let dmax = number(field(128, 8, i), &what("digital maximum"))?;
         let spr = whole(field(216, 8, i), &what("samples per record"))?;
-        let annotations =
-            format != EdfFormat::Edf && format != EdfFormat::Bdf && is_annotation_label(&label);
+        let plain = format == EdfFormat::Edf || format == EdfFormat::Bdf;
+        if plain && is_annotation_label(&label) {
+            return Err(bad(format!(
+                "signal {} is labelled {label:?}, but the header's reserved field does not \
+                 say {}: its annotations would be read as samples (a writer that left out \
+                 the field; write the file again, e.g. with MNE's export_raw)",
+                i + 1,
+                if format == EdfFormat::Edf {
+                    "EDF+C"
+                } else {
+                    "BDF+C"
+                }
+            )));
+        }
+        let annotations = !plain && is_annotation_label(&label);
         if !(1..=MAX_SAMPLES_PER_RECORD as i64).contains(&spr) {
             return Err(bad(format!(
                 "{} is {spr}; accepted: 1 to {MAX_SAMPLES_PER_RECORD}",
@@ -231,6 +264,14 @@ fn signal_headers(bytes: &[u8], n: usize, format: EdfFormat) -> Result<Vec<Signa
                 "signal {label:?} has digital range [{dmin}, {dmax}] and physical range \
                  [{pmin}, {pmax}]; the digital maximum must exceed the minimum and the \
                  physical range must not be empty"
+            )));
+        }
+        if !annotations && pmin.abs().max(pmax.abs()) > MAX_PHYSICAL {
+            return Err(bad(format!(
+                "signal {label:?} has physical range [{}, {}] {unit}; accepted: magnitudes \
+                 up to {MAX_PHYSICAL:e} (a header that lies about its physical range)",
+                errp_valid::shown(pmin),
+                errp_valid::shown(pmax)
             )));
         }
         let scale = (pmax - pmin) / (dmax - dmin);
@@ -317,6 +358,19 @@ impl EdfFile {
             annotations: Vec::new(),
             records,
             record_secs,
+            start_secs: 0.0,
+        };
+        // A record's start may differ from where the previous one ends by
+        // less than half a sample of the fastest signal: no sample moves.
+        let fastest = headers
+            .iter()
+            .filter(|h| !h.annotations)
+            .map(|h| h.samples_per_record)
+            .max()
+            .unwrap_or(1);
+        let clock = Clock {
+            record_secs,
+            tolerance: 0.5 * record_secs / fastest as f64,
         };
         let mut buf = vec![0u8; record_bytes];
         for k in 0..records {
@@ -325,21 +379,36 @@ impl EdfFile {
                 &mut buf,
                 &format!("data record {} of {records}", k + 1),
             )?;
-            file.take_record(&buf, &headers, k)?;
+            file.take_record(&buf, &headers, k, &clock)?;
+        }
+        let end = header_bytes as u64 + (records * record_bytes) as u64;
+        ends_after_its_records(&mut r, len, end, records, record_bytes)?;
+        let start = file.start_secs;
+        for a in &mut file.annotations {
+            a.onset_secs -= start;
         }
         Ok(file)
     }
 
     /// Decodes one data record into the signals and annotations.
-    fn take_record(&mut self, buf: &[u8], headers: &[SignalHeader], k: usize) -> Result<()> {
+    fn take_record(
+        &mut self,
+        buf: &[u8],
+        headers: &[SignalHeader],
+        k: usize,
+        clock: &Clock,
+    ) -> Result<()> {
         let bps = self.format.bytes_per_sample();
         let mut at = 0;
         let mut ordinary = 0;
+        let mut keeps_time = true;
         for h in headers {
             let bytes = &buf[at..at + h.samples_per_record * bps];
             at += bytes.len();
             if h.annotations {
-                self.take_tals(bytes, k)?;
+                // The first annotation signal keeps the time.
+                self.take_tals(bytes, k, keeps_time.then_some(clock))?;
+                keeps_time = false;
                 continue;
             }
             let out = &mut self.signals[ordinary].samples;
@@ -358,10 +427,12 @@ impl EdfFile {
     }
 
     /// Parses the TALs of one record's annotation signal: `+onset[\x15
-    /// duration]\x14text\x14...\x14\0`, padded with zeros. The first TAL of
-    /// a record keeps time and has no text.
-    fn take_tals(&mut self, bytes: &[u8], k: usize) -> Result<()> {
+    /// duration]\x14text\x14...\x14\0`, padded with zeros. In the first
+    /// annotation signal (`clock` given), the first TAL keeps time: its
+    /// onset is the record's start and its first text is empty.
+    fn take_tals(&mut self, bytes: &[u8], k: usize, clock: Option<&Clock>) -> Result<()> {
         let where_ = || format!("the annotations of data record {}", k + 1);
+        let mut keeper = clock;
         for tal in bytes.split(|&b| b == 0).filter(|t| !t.is_empty()) {
             let mut parts = tal.split(|&b| b == 0x14);
             let stamp = parts.next().unwrap_or_default();
@@ -375,9 +446,27 @@ impl EdfFile {
                         bad(format!("{}: a TAL with an invalid duration", where_()))
                     })?),
                 };
+            if let Some(clock) = keeper.take() {
+                if parts.next().is_none_or(|t| !t.is_empty()) {
+                    return Err(bad(format!(
+                        "{}: its first TAL is not a time-keeping one (an onset and an empty \
+                         text, as EDF+ asks of every record)",
+                        where_()
+                    )));
+                }
+                self.keep_time(onset, k, clock)?;
+            }
             for t in parts.filter(|t| !t.is_empty()) {
                 let text = std::str::from_utf8(t)
                     .map_err(|_| bad(format!("{}: an annotation that is not UTF-8", where_())))?;
+                if self.annotations.len() == MAX_EDF_ANNOTATIONS {
+                    return Err(bad(format!(
+                        "more than {MAX_EDF_ANNOTATIONS} annotations (at data record {} of \
+                         {}): more than a file may hold",
+                        k + 1,
+                        self.records
+                    )));
+                }
                 self.annotations.push(EdfAnnotation {
                     onset_secs: onset,
                     duration_secs: duration,
@@ -385,15 +474,46 @@ impl EdfFile {
                 });
             }
         }
+        if keeper.is_some() {
+            return Err(bad(format!(
+                "{}: no time-keeping TAL (EDF+ starts every record's first annotation \
+                 signal with one: the record's start)",
+                where_()
+            )));
+        }
+        Ok(())
+    }
+
+    /// Record `k`'s start, `onset` seconds after the header's start time:
+    /// the first sets [`EdfFile::start_secs`], each later one must follow
+    /// the one before.
+    fn keep_time(&mut self, onset: f64, k: usize, clock: &Clock) -> Result<()> {
+        if k == 0 {
+            self.start_secs = onset;
+            return Ok(());
+        }
+        let expected = self.start_secs + k as f64 * clock.record_secs;
+        if (onset - expected).abs() > clock.tolerance {
+            return Err(bad(format!(
+                "data record {} starts at {} s, where the one before ends at {} s: the \
+                 records of a continuous file (EDF+C, BDF+C) follow each other without gaps",
+                k + 1,
+                errp_valid::shown(onset),
+                errp_valid::shown(expected)
+            )));
+        }
         Ok(())
     }
 
     /// The ordinary signal labelled `label`, matched as own EEG's
-    /// channels are ([`OwnEeg`](crate::OwnEeg)): as written, else
-    /// ignoring case and an `EEG ` or `EOG ` prefix.
-    pub fn signal(&self, label: &str) -> Option<&EdfSignal> {
+    /// channels are ([`OwnEeg`](crate::OwnEeg)): ignoring case and an
+    /// `EEG ` or `EOG ` prefix; two signals that match are an error naming
+    /// both.
+    pub fn signal(&self, label: &str) -> Result<Option<&EdfSignal>> {
         let labels: Vec<&str> = self.signals.iter().map(|s| s.label.as_str()).collect();
-        find(&labels, label).map(|i| &self.signals[i])
+        Ok(crate::montage::find_label(&labels, label)
+            .map_err(bad)?
+            .map(|i| &self.signals[i]))
     }
 
     /// The file's duration, in seconds.
@@ -402,25 +522,12 @@ impl EdfFile {
     }
 }
 
-/// A name as compared: trimmed, lower case, without an `EEG ` or `EOG `
-/// prefix (MNE drops `EOG ` when it infers channel types).
-fn bare(name: &str) -> String {
-    let n = name.trim().to_ascii_lowercase();
-    for prefix in ["eeg ", "eog ", "eeg-", "eog-"] {
-        if let Some(rest) = n.strip_prefix(prefix) {
-            return rest.trim().to_string();
-        }
-    }
-    n
-}
-
-/// The index in `labels` of montage channel `name`: as written, else
-/// compared bare.
-pub(crate) fn find(labels: &[&str], name: &str) -> Option<usize> {
-    labels
-        .iter()
-        .position(|l| l.trim() == name)
-        .or_else(|| labels.iter().position(|l| bare(l) == bare(name)))
+/// The time-keeping rule of a file's records.
+struct Clock {
+    /// One record's duration, in seconds.
+    record_secs: f64,
+    /// How far a record's start may be from the previous record's end.
+    tolerance: f64,
 }
 
 /// A TAL's onset (signed) or duration (unsigned), as EDF+ writes them.
@@ -440,6 +547,29 @@ fn tal_number(bytes: &[u8], signed: bool) -> Option<f64> {
         return None;
     }
     body.parse::<f64>().ok().filter(|v| v.is_finite())
+}
+
+/// Refuses a file that goes on after its last data record (which ends at
+/// byte `end`; the file has `len` bytes if known).
+fn ends_after_its_records(
+    r: &mut impl Read,
+    len: Option<u64>,
+    end: u64,
+    records: usize,
+    record_bytes: usize,
+) -> Result<()> {
+    let mut more = [0u8; 1];
+    if read_full(r, &mut more)? == 0 {
+        return Ok(());
+    }
+    let after = len.map_or_else(
+        || "bytes".to_string(),
+        |l| format!("{} bytes", l.saturating_sub(end)),
+    );
+    Err(bad(format!(
+        "{after} after its {records} data records of {record_bytes} bytes: not a whole \
+         record (a damaged or concatenated file, or a header that declares too few records)"
+    )))
 }
 
 /// The number of data records: the header's, checked against the file's
@@ -525,8 +655,150 @@ mod tests {
             .map(|a| (a.onset_secs, a.text.as_str()))
             .collect();
         assert_eq!(texts, [(2.0, "correct"), (5.3125, "error")]);
-        assert!(f.signal("EEG fcz").is_some() && f.signal("Fcz").is_some());
-        assert!(f.signal("FCzz").is_none());
+        assert!(f.signal("EEG fcz").unwrap().is_some() && f.signal("Fcz").unwrap().is_some());
+        assert!(f.signal("FCzz").unwrap().is_none());
+        assert_eq!(f.start_secs, 0.0);
+    }
+
+    /// `bytes` (an export: 1 s records, the annotation signal last, 128
+    /// bytes) with every TAL of record k moved by `by(k)` seconds, as a
+    /// writer whose first record starts later than the header's start time
+    /// writes them.
+    fn moved(bytes: &[u8], by: impl Fn(usize) -> f64) -> Vec<u8> {
+        let ns: usize = text(&bytes[252..256]).parse().unwrap();
+        let (header, record) = (256 * (ns + 1), (ns - 1) * 512 + 128);
+        let mut out = bytes.to_vec();
+        for (k, start) in (header..out.len()).step_by(record).enumerate() {
+            let tals = &mut out[start + record - 128..start + record];
+            let mut new = Vec::new();
+            for tal in tals.split(|&b| b == 0).filter(|t| !t.is_empty()) {
+                let tal = std::str::from_utf8(tal).unwrap();
+                let end = tal.find(['\x14', '\x15']).unwrap();
+                let onset: f64 = tal[1..end].parse().unwrap();
+                new.extend_from_slice(format!("+{}{}\0", onset + by(k), &tal[end..]).as_bytes());
+            }
+            new.resize(128, 0);
+            tals.copy_from_slice(&new);
+        }
+        out
+    }
+
+    /// An EDF+ file of 1 s records: signal `Cz` (`spr` zero samples a
+    /// record) and an annotation signal of `ann_bytes` bytes a record,
+    /// `tals[k]` in record k; `reserved` the header's reserved field.
+    fn edf_plus(spr: usize, tals: &[&[u8]], ann_bytes: usize, reserved: &str) -> Vec<u8> {
+        let mut h = String::new();
+        let f = |h: &mut String, v: &str, w: usize| h.push_str(&format!("{v:<w$}"));
+        for (v, w) in [
+            ("0", 8),
+            ("", 160),
+            ("01.01.00", 8),
+            ("00.00.00", 8),
+            ("768", 8),
+        ] {
+            f(&mut h, v, w);
+        }
+        f(&mut h, reserved, 44);
+        f(&mut h, &tals.len().to_string(), 8);
+        f(&mut h, "1", 8);
+        f(&mut h, "2", 4);
+        f(&mut h, "Cz", 16);
+        f(&mut h, "EDF Annotations", 16);
+        f(&mut h, "", 160);
+        f(&mut h, "uV", 8);
+        f(&mut h, "", 8);
+        for v in [
+            "-100", "-1", "100", "1", "-32768", "-32768", "32767", "32767",
+        ] {
+            f(&mut h, v, 8);
+        }
+        f(&mut h, "", 160);
+        f(&mut h, &spr.to_string(), 8);
+        f(&mut h, &(ann_bytes / 2).to_string(), 8);
+        f(&mut h, "", 64);
+        let mut b = h.into_bytes();
+        assert_eq!(b.len(), 768);
+        for tal in tals {
+            b.extend(std::iter::repeat_n(0u8, 2 * spr));
+            let mut t = tal.to_vec();
+            t.resize(ann_bytes, 0);
+            b.extend_from_slice(&t);
+        }
+        b
+    }
+
+    fn read(b: &[u8]) -> Result<EdfFile> {
+        EdfFile::read(Cursor::new(b), Some(b.len() as u64))
+    }
+
+    #[test]
+    fn onsets_count_from_the_first_sample_as_edf_plus_keeps_time() {
+        // edfio writes a sub-second start time into the first record's
+        // TAL; a file cut from a longer session starts later still.
+        let (bytes, _) = exported(8);
+        let original = read(&bytes).unwrap();
+        for by in [0.5, 100.0] {
+            let f = read(&moved(&bytes, |_| by)).unwrap();
+            assert_eq!(f.start_secs, by);
+            assert_eq!(f.annotations, original.annotations, "started at +{by} s");
+            assert_eq!(f.signals, original.signals);
+        }
+        // A record that does not follow the one before: refused, naming it.
+        let e = read(&moved(&bytes, |k| if k >= 3 { 0.5 } else { 0.0 }))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("data record 4 starts at 3.5 s, where the one before ends at 3 s"),
+            "{e}"
+        );
+        // Less than half a sample off moves no sample.
+        let f = read(&moved(&bytes, |k| if k >= 3 { 0.001 } else { 0.0 })).unwrap();
+        assert_eq!(
+            (f.start_secs, f.signals.len()),
+            (0.0, original.signals.len())
+        );
+        // A record without its time-keeping TAL, or whose first TAL has text.
+        let tk: &[u8] = b"+0\x14\x14\0";
+        let e = read(&edf_plus(4, &[tk, b"+1\x14\x14\0", b""], 16, "EDF+C"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("data record 3: no time-keeping TAL"), "{e}");
+        let e = read(&edf_plus(4, &[b"+0\x14e\x14\0"], 16, "EDF+C"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("data record 1: its first TAL is not a time-keeping"),
+            "{e}"
+        );
+        let f = read(&edf_plus(
+            4,
+            &[tk, b"+1\x14\x14\0+1.5\x14e\x14\0"],
+            32,
+            "EDF+C",
+        ))
+        .unwrap();
+        assert_eq!((f.annotations.len(), f.annotations[0].onset_secs), (1, 1.5));
+    }
+
+    #[test]
+    fn annotations_in_a_plain_edf_and_too_many_are_refused() {
+        let tk: &[u8] = b"+0\x14\x14\0";
+        let e = read(&edf_plus(4, &[tk], 16, "")).unwrap_err().to_string();
+        assert!(
+            e.contains(
+                "signal 2 is labelled \"EDF Annotations\", but the header's reserved \
+                 field does not say EDF+C"
+            ),
+            "{e}"
+        );
+        let mut tals = tk.to_vec();
+        for _ in 0..=MAX_EDF_ANNOTATIONS {
+            tals.extend_from_slice(b"+0\x14a\x14\0");
+        }
+        let e = read(&edf_plus(1, &[&tals], (tals.len() + 2) & !1, "EDF+C"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("more than 100000 annotations"), "{e}");
     }
 
     #[test]
@@ -631,6 +903,30 @@ mod tests {
         assert!(e.to_string().contains("ends inside data record 3"), "{e}");
         let e = read(&bytes[..100]);
         assert!(e.contains("header"), "{e}");
+        // A physical range no EEG has (Fp1's minimum and maximum).
+        let mut b = bytes.clone();
+        let n = 41;
+        b[256 + 104 * n..256 + 104 * n + 8].copy_from_slice(b"-1e300  ");
+        b[256 + 112 * n..256 + 112 * n + 8].copy_from_slice(b"1e300   ");
+        let e = read(&b);
+        assert!(
+            e.contains("signal \"Fp1\" has physical range [-1e300, 1e300] uV; accepted"),
+            "{e}"
+        );
+        // Bytes after the last record, whether or not the size is known.
+        let mut b = bytes.clone();
+        b.extend_from_slice(&[7; 1000]);
+        let e = read(&b);
+        assert!(e.contains("1000 bytes after its 3 data records"), "{e}");
+        let e = EdfFile::read(Cursor::new(&b), None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("bytes after its 3 data records"), "{e}");
+        let mut b = bytes.clone();
+        b[236..244].copy_from_slice(b"-1      ");
+        b.extend_from_slice(&[7; 10]);
+        let e = read(&b);
+        assert!(e.contains("10 bytes after its 3 data records"), "{e}");
         let mut b = bytes.clone();
         b[252..256].copy_from_slice(b"9999");
         let e = read(&b);

@@ -381,6 +381,11 @@ impl Realism {
                 self.erp_latency_shift_ms,
                 MAX_SHIFT_MS,
             ),
+            (
+                "realism.task_latency_ms",
+                self.task_latency_ms,
+                MAX_SHIFT_MS,
+            ),
         ] {
             check(
                 v.is_finite() && v.abs() <= bound,

@@ -115,6 +115,22 @@ fn what_a_recording_lacks_is_named() {
     }
     f.signals.reverse();
     assert!(errp_bci::OwnEeg::from_edf(&f, &names, 256.0).is_ok());
+    // Two channels that match one name: AF3 relabelled FCz, before the
+    // real FCz, is refused naming both (never decoded as FCz).
+    let mut f = file.clone();
+    let af3 = f.signals.iter().position(|s| s.label == "AF3").unwrap();
+    let fcz = f.signals.iter().position(|s| s.label == "FCz").unwrap();
+    assert!(af3 < fcz);
+    f.signals[af3].label = "EEG FCz".into();
+    let e = err(&f, &names);
+    assert!(
+        e.contains(&format!(
+            "two channels match \"FCz\": \"EEG FCz\" (channel {}) and \"FCz\" (channel {})",
+            af3 + 1,
+            fcz + 1
+        )),
+        "{e}"
+    );
     // Another rate.
     let e = errp_bci::OwnEeg::from_edf(&file, &names, 512.0)
         .unwrap_err()
@@ -157,6 +173,60 @@ fn arrays_are_matched_and_checked_as_files_are() {
     assert!(e.contains("event at 1.5 s lies outside"), "{e}");
     let e = new(&labels[1..], vec![]).unwrap_err().to_string();
     assert!(e.contains("names for 40 rows"), "{e}");
+    let mut twice = labels.clone();
+    twice[0] = "eeg cz";
+    let e = new(&twice, vec![]).unwrap_err().to_string();
+    assert!(
+        e.contains("two channels match \"Cz\": \"eeg cz\" (channel 1)"),
+        "{e}"
+    );
+}
+
+#[test]
+fn events_annotated_twice_are_kept_once_and_two_outcomes_are_refused() {
+    // Every event written twice, as some exporters do: the same events,
+    // so no epoch lands in both a training and a test fold.
+    let (_, bytes) = exported(60, 1.0, 4);
+    let file = EdfFile::read(Cursor::new(&bytes), Some(bytes.len() as u64)).unwrap();
+    let names = EventNames::default();
+    let once = errp_bci::OwnEeg::from_edf(&file, &names, 256.0).unwrap();
+    assert_eq!(once.merged, 0);
+    let mut doubled = file.clone();
+    doubled.annotations = file
+        .annotations
+        .iter()
+        .flat_map(|a| [a.clone(), a.clone()])
+        .collect();
+    let twice = errp_bci::OwnEeg::from_edf(&doubled, &names, 256.0).unwrap();
+    assert_eq!(twice.events, once.events);
+    assert_eq!(twice.merged, once.events.len());
+    // Within half a sample is the same sample.
+    let mut near = file.clone();
+    let mut again = file.annotations[3].clone();
+    again.onset_secs += 0.3 / 256.0;
+    near.annotations.push(again);
+    let rec = errp_bci::OwnEeg::from_edf(&near, &names, 256.0).unwrap();
+    assert_eq!((rec.events.len(), rec.merged), (once.events.len(), 1));
+    // One action with both outcomes.
+    let mut both = file.clone();
+    let mut other = file.annotations[3].clone();
+    other.text = if other.text == "error" {
+        "correct"
+    } else {
+        "error"
+    }
+    .into();
+    let at = other.onset_secs;
+    both.annotations.push(other);
+    let e = errp_bci::OwnEeg::from_edf(&both, &names, 256.0)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains(&format!(
+            "the event at {at} s is annotated both error and correct"
+        )),
+        "{e}"
+    );
 }
 
 #[test]

@@ -638,6 +638,27 @@ fn bad_fields_are_named_with_their_range() {
         ),
         (
             Realism {
+                task_latency_ms: 1000.0,
+                ..Realism::default()
+            },
+            "realism.task_latency_ms",
+        ),
+        (
+            Realism {
+                task_latency_ms: f64::INFINITY,
+                ..Realism::default()
+            },
+            "realism.task_latency_ms",
+        ),
+        (
+            Realism {
+                task_latency_ms: f64::NAN,
+                ..Realism::default()
+            },
+            "realism.task_latency_ms",
+        ),
+        (
+            Realism {
                 bad_channel: "Xx".into(),
                 ..Realism::default()
             },

@@ -70,6 +70,7 @@ pub fn prepare_hybrid(
         template_counts,
         background_secs,
         eog_channels: recording.montage.n_eog(),
+        merged: recording.merged,
         false_alarms_per_min: fa,
         t_e,
         accuracy,

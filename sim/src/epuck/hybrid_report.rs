@@ -1,7 +1,7 @@
 //! What an e-puck hybrid was made of, as the output and a recording's
 //! provenance say it ([`crate::epuck::prepare_hybrid`]).
 
-use crate::own_eeg::{FITTED_FALSE_ALARMS_PER_MIN, FileDigest};
+use crate::own_eeg::{FITTED_FALSE_ALARMS_PER_MIN, FileDigest, twice};
 
 /// What the hybrid was made of, as the output and the recording's
 /// provenance say it.
@@ -17,6 +17,9 @@ pub struct HybridReport {
     pub background_secs: (f64, f64),
     /// EOG channels found (0: no EOG regression).
     pub eog_channels: usize,
+    /// Events annotated twice (the same class at the same sample), each
+    /// kept once.
+    pub merged: usize,
     /// The false alarms a minute T_e was set for.
     pub false_alarms_per_min: f64,
     /// The T_e found.
@@ -35,8 +38,11 @@ impl std::fmt::Display for HybridReport {
         let (calibration, online) = self.background_secs;
         writeln!(
             f,
-            "EEG: {HYBRID_LABEL}, from recording {} ({} bytes, SHA-256 {})",
-            self.file.name, self.file.bytes, self.file.sha256
+            "EEG: {HYBRID_LABEL}, from recording {} ({} bytes, SHA-256 {}){}",
+            self.file.name,
+            self.file.bytes,
+            self.file.sha256,
+            twice(self.merged)
         )?;
         writeln!(
             f,

@@ -18,7 +18,7 @@ use crate::error::{Result, SimError};
 use crate::grid::p_error::{PErrorChoice, PErrorMapping};
 use crate::grid::params::GridTaskParams;
 use crate::grid::scenario::GridScenario;
-use crate::own_eeg::{BankDraw, FileDigest, OwnEegSpec, load_own_eeg};
+use crate::own_eeg::{BankDraw, FileDigest, OwnEegSpec, load_own_eeg, twice};
 
 /// What the own EEG gave: the file, its split and the decoder's
 /// accuracy, cross-validated on the calibration part and measured on the
@@ -41,6 +41,9 @@ pub struct OwnEegReport {
     /// Events after the calibration part used by neither part (their
     /// epochs overlap it or run past the EEG's end).
     pub dropped: usize,
+    /// Events annotated twice (the same class at the same sample), each
+    /// kept once.
+    pub merged: usize,
     /// How held-out epochs are drawn.
     pub draw: BankDraw,
     /// The EEG's length, s.
@@ -56,7 +59,7 @@ impl std::fmt::Display for OwnEegReport {
         let h = &self.held_out;
         writeln!(
             f,
-            "EEG: recording {} ({} bytes, SHA-256 {}), {:.1} s{}",
+            "EEG: recording {} ({} bytes, SHA-256 {}), {:.1} s{}{}",
             self.file.name,
             self.file.bytes,
             self.file.sha256,
@@ -65,7 +68,8 @@ impl std::fmt::Display for OwnEegReport {
                 "; no EOG channels: no EOG regression"
             } else {
                 ""
-            }
+            },
+            twice(self.merged)
         )?;
         writeln!(
             f,
@@ -272,6 +276,7 @@ pub(crate) fn prepare_own_eeg(
             cross_validated: cv,
             held_out: Accuracy::score(&labels, &predicted),
             dropped: split.dropped,
+            merged: recording.merged,
             draw: eeg.draw,
             duration_secs: recording.duration_secs(),
             eog_channels: recording.montage.n_eog(),

@@ -11,6 +11,11 @@
 //!   ([`check_decoder_stream`]), `[action id, p(error)]` per grid action or
 //!   `[timestamp of the window's last sample, p(error)]` per e-puck window.
 //!
+//! Every stream's source id ends with the session's id ([`SessionId`],
+//! also `desc/errp/session` of the EEG stream), and the decoder's stream
+//! is accepted only if its source id ends with it too: two sessions on one
+//! host never take each other's streams.
+//!
 //! [`CONTRACT`] is the version a client can check (`desc/errp/contract`);
 //! any change of a byte below changes it.
 
@@ -22,8 +27,9 @@ use crate::pace::Speed;
 use crate::task_kind::TaskKind;
 
 /// The version of the contract the streams follow, in every stream's
-/// description.
-pub const CONTRACT: u32 = 1;
+/// description (2: every source id ends with the session's id, and so must
+/// the decoder's).
+pub const CONTRACT: u32 = 2;
 /// The EEG stream's name.
 pub const EEG_STREAM: &str = "errp-eeg";
 /// The markers' stream.
@@ -37,9 +43,128 @@ pub const DECODER_STREAM: &str = "errp-decoder";
 /// `make_standard_montage` scales the 10-20 positions).
 pub const HEAD_RADIUS_MM: f64 = 95.0;
 
-/// A stream's source id: its name and the session's seed.
-pub fn source_id(stream: &str, seed: u64) -> String {
-    format!("{stream}-{seed}")
+/// The names of MNE's 12 `loc` values of a channel, as MNE-LSL reads
+/// them from a channel's `loc` element (the XDF `location` above is not
+/// read by it).
+const MNE_LOC: [&str; 12] = [
+    "R0x", "R0y", "R0z", "Exx", "Exy", "Exz", "Eyx", "Eyy", "Eyz", "Ezx", "Ezy", "Ezz",
+];
+
+/// A channel's `loc` as MNE-LSL reads it into `info["chs"][k]["loc"]`:
+/// the position on the unit sphere `position`, in metres on MNE's default
+/// head, then the reference's position and the orientation, unknown: 0.
+fn mne_loc(position: [f64; 3]) -> Element {
+    let metres = position.map(|v| v * HEAD_RADIUS_MM / 1000.0);
+    Element::node(
+        "loc",
+        MNE_LOC
+            .iter()
+            .enumerate()
+            .map(|(i, name)| Element::leaf(name, format!("{:.6}", metres.get(i).unwrap_or(&0.0))))
+            .collect(),
+    )
+}
+
+/// A live session's id: 1 to 16 letters, digits or `_` (no `-`, which
+/// ends the rest of a source id). Given (`errp stream --session`) or
+/// drawn afresh for each session.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub struct SessionId {
+    bytes: [u8; SessionId::MAX_LEN],
+    len: u8,
+}
+
+impl SessionId {
+    /// The longest id.
+    pub const MAX_LEN: usize = 16;
+
+    /// `text` if it is an id.
+    pub fn new(text: &str) -> Option<Self> {
+        let ok = (1..=Self::MAX_LEN).contains(&text.len())
+            && text.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_');
+        ok.then(|| {
+            let mut bytes = [0; Self::MAX_LEN];
+            bytes[..text.len()].copy_from_slice(text.as_bytes());
+            Self {
+                bytes,
+                len: text.len() as u8,
+            }
+        })
+    }
+
+    /// A fresh id: 8 hexadecimal digits from the standard library's
+    /// random hasher keys (drawn from the operating system) and the
+    /// process id; nothing the results depend on.
+    pub fn fresh() -> Self {
+        use std::hash::{BuildHasher, Hasher};
+        let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+        h.write_u32(std::process::id());
+        let text = format!("{:08x}", h.finish() as u32);
+        Self::new(&text).unwrap_or(Self {
+            bytes: [b'0'; Self::MAX_LEN],
+            len: 8,
+        })
+    }
+
+    /// The id.
+    pub fn as_str(&self) -> &str {
+        std::str::from_utf8(&self.bytes[..usize::from(self.len)]).unwrap_or_default()
+    }
+}
+
+impl std::fmt::Display for SessionId {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl std::fmt::Debug for SessionId {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "SessionId({:?})", self.as_str())
+    }
+}
+
+/// The EEG channels' positions as MNE-LSL reads digitisation points
+/// (`desc/dig/point`: `kind` 3, FIFF's EEG point; `ident` from 1; `loc` X,
+/// Y, Z in metres, head coordinates): with them, MNE's `get_montage()`
+/// gives the montage (it takes the positions from the channels' `loc`,
+/// and needs some digitisation to exist).
+fn mne_dig(montage: &Montage) -> Element {
+    let points = montage
+        .channels()
+        .iter()
+        .filter(|c| c.kind == ChannelKind::Eeg)
+        .enumerate()
+        .map(|(i, c)| {
+            let metres = c.position.map(|v| v * HEAD_RADIUS_MM / 1000.0);
+            Element::node(
+                "point",
+                vec![
+                    Element::leaf("kind", 3),
+                    Element::leaf("ident", i + 1),
+                    Element::node(
+                        "loc",
+                        ["X", "Y", "Z"]
+                            .iter()
+                            .zip(metres)
+                            .map(|(name, v)| Element::leaf(name, format!("{v:.6}")))
+                            .collect(),
+                    ),
+                ],
+            )
+        })
+        .collect();
+    Element::node("dig", points)
+}
+
+/// A stream's source id: its name and the session's id.
+pub fn source_id(stream: &str, session: SessionId) -> String {
+    format!("{stream}-{session}")
+}
+
+/// The session a stream's source id names: what follows its last `-`.
+pub fn session_of(source_id: &str) -> &str {
+    source_id.rsplit('-').next().unwrap_or(source_id)
 }
 
 /// What the EEG stream says of itself beyond its channels.
@@ -53,19 +178,22 @@ pub struct EegHeader {
     pub seed: u64,
     /// The task.
     pub task: TaskKind,
+    /// The session.
+    pub session: SessionId,
 }
 
 /// The EEG stream, after LSL's meta-data conventions for EEG (channels
 /// with label, type, unit and location; the reference; the cap; the
 /// acquisition), and what the testbed adds (`errp`: the contract, the
-/// task, the speed, the true rate, the seed). Its nominal rate is the true
-/// rate times the speed.
+/// task, the speed, the true rate, the seed, the session). Its nominal
+/// rate is the true rate times the speed.
 pub fn eeg_spec(montage: &Montage, header: &EegHeader) -> StreamSpec {
     let EegHeader {
         fs_hz,
         speed,
         seed,
         task,
+        session,
     } = *header;
     let channels = montage
         .channels()
@@ -92,6 +220,7 @@ pub fn eeg_spec(montage: &Montage, header: &EegHeader) -> StreamSpec {
                             Element::leaf("Z", format!("{:.1}", z * HEAD_RADIUS_MM)),
                         ],
                     ),
+                    mne_loc([x, y, z]),
                 ],
             )
         })
@@ -102,9 +231,10 @@ pub fn eeg_spec(montage: &Montage, header: &EegHeader) -> StreamSpec {
         channels: montage.len() as u32,
         rate_hz: speed.rate(fs_hz),
         format: Format::Float32,
-        source_id: source_id(EEG_STREAM, seed),
+        source_id: source_id(EEG_STREAM, session),
         desc: vec![
             Element::node("channels", channels),
+            mne_dig(montage),
             Element::node(
                 "reference",
                 vec![
@@ -128,6 +258,7 @@ pub fn eeg_spec(montage: &Montage, header: &EegHeader) -> StreamSpec {
                     Element::leaf("speed", speed),
                     Element::leaf("sampling_rate_hz", fs_hz),
                     Element::leaf("seed", seed),
+                    Element::leaf("session", session),
                 ],
             ),
         ],
@@ -136,14 +267,14 @@ pub fn eeg_spec(montage: &Montage, header: &EegHeader) -> StreamSpec {
 
 /// A text stream of JSON strings (the markers, `"Markers"`; the state,
 /// `"State"`) at an irregular rate.
-pub fn text_spec(name: &str, kind: &str, seed: u64) -> StreamSpec {
+pub fn text_spec(name: &str, kind: &str, session: SessionId) -> StreamSpec {
     StreamSpec {
         name: name.into(),
         kind: kind.into(),
         channels: 1,
         rate_hz: 0.0,
         format: Format::String,
-        source_id: source_id(name, seed),
+        source_id: source_id(name, session),
         desc: vec![Element::leaf("contract", CONTRACT)],
     }
 }
@@ -454,10 +585,12 @@ mod tests {
             speed: Speed::new(4.0).unwrap(),
             seed: 1,
             task: TaskKind::Grid,
+            session: SessionId::new("lab_a1").unwrap(),
         };
         let spec = eeg_spec(&m, &header);
         assert_eq!(spec.rate_hz, 1024.0);
-        assert_eq!(spec.source_id, "errp-eeg-1");
+        assert_eq!(spec.source_id, "errp-eeg-lab_a1");
+        assert_eq!(session_of(&spec.source_id), "lab_a1");
         let channels = &spec.desc[0].children;
         assert_eq!(channels.len(), m.len());
         assert_eq!(
@@ -473,13 +606,27 @@ mod tests {
         assert_eq!(
             errp.children,
             vec![
-                Element::leaf("contract", "1"),
+                Element::leaf("contract", "2"),
                 Element::leaf("task", "grid"),
                 Element::leaf("speed", "4"),
                 Element::leaf("sampling_rate_hz", "256"),
                 Element::leaf("seed", "1"),
+                Element::leaf("session", "lab_a1"),
             ]
         );
+    }
+
+    #[test]
+    fn a_session_id_is_short_plain_and_fresh_each_time() {
+        for bad in ["", "a-b", "x y", "ü", "12345678901234567"] {
+            assert!(SessionId::new(bad).is_none(), "{bad:?}");
+        }
+        assert_eq!(SessionId::new("Lab_2").unwrap().to_string(), "Lab_2");
+        let (a, b) = (SessionId::fresh(), SessionId::fresh());
+        assert_eq!(a.as_str().len(), 8);
+        assert_ne!(a, b);
+        assert_eq!(session_of("errp-decoder-Lab_2"), "Lab_2");
+        assert_eq!(session_of("Lab_2"), "Lab_2");
     }
 
     #[test]

@@ -348,6 +348,13 @@ impl WindowTracker {
         self.phase_start = stamp;
     }
 
+    /// A run's warm-up began: until its first movement phase, a decision
+    /// judges no motion, so it is late (the previous run's phase no longer
+    /// counts).
+    pub fn warm_up_began(&mut self) {
+        self.phase_start = f64::INFINITY;
+    }
+
     /// The decisions to apply at the device's window (counted missed if
     /// none).
     pub fn take(&mut self) -> Vec<f64> {
@@ -421,6 +428,27 @@ mod tests {
             p_error: p,
             arrived,
         }
+    }
+
+    #[test]
+    fn a_window_before_the_runs_first_phase_is_late() {
+        let mut t = WindowTracker::new("dec", 10.0);
+        t.start(0.0);
+        // The previous run's phase began at 1 s; this run's warm-up
+        // streams from 10 s to 12 s, its first phase from 12 s.
+        t.phase_began(1.0);
+        t.take_run();
+        t.warm_up_began();
+        t.published(11.9);
+        t.receive(&[got(10.5, 1.0, 10.6), got(11.9, 1.0, 12.0)], 12.0)
+            .unwrap();
+        t.phase_began(12.0);
+        t.published(12.0625);
+        t.receive(&[got(12.0625, 0.2, 12.1)], 12.1).unwrap();
+        assert_eq!(t.take(), [0.2]);
+        let s = t.take_run();
+        let fates: Vec<Fate> = s.decisions.iter().map(|d| d.fate).collect();
+        assert_eq!(fates, [Fate::Late, Fate::Late, Fate::Applied(0)]);
     }
 
     #[test]

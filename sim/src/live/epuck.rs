@@ -143,6 +143,7 @@ fn live_run(
     let mut phase = None;
     let mut decide = |w: &LiveWindow<'_>| -> Result<Vec<f64>> {
         if let Some(warm_up) = w.warm_up {
+            s.tracker.warm_up_began();
             s.stream(warm_up)?;
             let origin = s.now_stamp();
             s.tracker.run_began(origin);

@@ -9,7 +9,8 @@ use errp_lsl::{Inlet, Lsl, LslError, Outlet};
 
 use crate::error::{Result, SimError};
 use crate::live::contract::{
-    EEG_STREAM, EegHeader, MARKER_STREAM, STATE_STREAM, check_decoder_stream, eeg_spec, text_spec,
+    EEG_STREAM, EegHeader, MARKER_STREAM, STATE_STREAM, SessionId, check_decoder_stream, eeg_spec,
+    session_of, text_spec,
 };
 use crate::live::{LiveLink, Received};
 
@@ -21,6 +22,9 @@ pub struct LslLink {
     markers: Outlet,
     state: Outlet,
     query: (String, String),
+    session: SessionId,
+    /// Decoder streams of other sessions seen (their source ids).
+    others: Vec<String>,
     decisions: Option<Inlet>,
     sample: Vec<f32>,
     /// Seconds spent publishing the EEG (LSL's clock).
@@ -34,21 +38,24 @@ fn live_error(e: LslError) -> SimError {
 impl LslLink {
     /// Opens the three streams of `montage`'s EEG as `header` describes
     /// it; the decoder's stream is the first whose LSL property `query.0`
-    /// is `query.1` (`name=errp-decoder`).
+    /// is `query.1` (`name=errp-decoder`) and whose source id ends with
+    /// the session's id.
     pub fn open(
         lsl: &Lsl,
         montage: &Montage,
         header: &EegHeader,
         query: (&str, &str),
     ) -> Result<Self> {
-        let seed = header.seed;
+        let session = header.session;
         let open = |spec| lsl.outlet(&spec).map_err(live_error);
         Ok(Self {
             lsl: lsl.clone(),
             eeg: open(eeg_spec(montage, header))?,
-            markers: open(text_spec(MARKER_STREAM, "Markers", seed))?,
-            state: open(text_spec(STATE_STREAM, "State", seed))?,
+            markers: open(text_spec(MARKER_STREAM, "Markers", session))?,
+            state: open(text_spec(STATE_STREAM, "State", session))?,
             query: (query.0.into(), query.1.into()),
+            session,
+            others: Vec::new(),
             decisions: None,
             sample: vec![0.0; montage.len()],
             busy: 0.0,
@@ -100,7 +107,20 @@ impl LiveLink for LslLink {
             .lsl
             .resolve(prop, value, timeout_secs)
             .map_err(live_error)?;
-        let Some(stream) = found.first() else {
+        // Another session's decoder (or one that names no session) is
+        // passed over, and named if none of this session's comes.
+        let mut ours = None;
+        for stream in &found {
+            let id = stream.source_id();
+            if session_of(&id) == self.session.as_str() {
+                ours = Some(stream);
+                break;
+            }
+            if !self.others.contains(&id) && self.others.len() < 8 {
+                self.others.push(id);
+            }
+        }
+        let Some(stream) = ours else {
             return Ok(false);
         };
         let shape = (stream.channels(), stream.format(), stream.rate_hz());
@@ -111,6 +131,21 @@ impl LiveLink for LslLink {
 
     fn disconnect(&mut self) {
         self.decisions = None;
+    }
+
+    fn passed_over(&self) -> Option<String> {
+        (!self.others.is_empty()).then(|| {
+            format!(
+                "found only decoder streams of other sessions (source ids {}), none whose \
+                 source id ends with this session's id {:?}",
+                self.others
+                    .iter()
+                    .map(|id| format!("{id:?}"))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                self.session.as_str()
+            )
+        })
     }
 
     fn wait(&mut self, until: f64) -> Result<Vec<Received>> {

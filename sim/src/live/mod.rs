@@ -17,6 +17,7 @@
 use errp_bci::EegBlock;
 
 use crate::error::{Result, SimError};
+use crate::live::contract::SessionId;
 use crate::names::Names;
 use crate::pace::{self, Speed};
 use crate::runner::RunObserver;
@@ -60,6 +61,9 @@ pub struct LiveOptions {
     /// Actions of the calibration session, in [`MIN_CALIBRATION_ACTIONS`,
     /// `MAX_CALIBRATION_ACTIONS`]; none for the paper's 400.
     pub calibration_actions: Option<usize>,
+    /// The session's id, in its streams' source ids (a fresh one by
+    /// default).
+    pub session: SessionId,
 }
 
 /// The shortest calibration a live session streams: 40 actions (about 8
@@ -75,6 +79,7 @@ impl Default for LiveOptions {
             timeout_secs: 30.0,
             rest_secs: 3.0,
             calibration_actions: None,
+            session: SessionId::fresh(),
         }
     }
 }
@@ -102,16 +107,17 @@ impl LiveOptions {
         }
         let speed = Speed::new(speed).ok_or_else(|| SimError::OutOfRange {
             name: names.speed.into(),
-            given: format!("{speed} is not a speed"),
+            given: format!("{} is not a speed", errp_bci::shown(speed)),
             expected: format!(
-                "a factor > 0 and at most {} (1: real time)",
+                "a factor from {} to {} (1: real time)",
+                pace::MIN_SPEED,
                 pace::MAX_SPEED
             ),
         })?;
         if !(timeout_secs.is_finite() && timeout_secs > 0.0 && timeout_secs <= MAX_TIMEOUT_SECS) {
             return Err(SimError::OutOfRange {
                 name: names.timeout.into(),
-                given: format!("{timeout_secs} is not a timeout"),
+                given: format!("{} is not a timeout", errp_bci::shown(timeout_secs)),
                 expected: format!("seconds > 0 and at most {MAX_TIMEOUT_SECS}"),
             });
         }
@@ -141,6 +147,12 @@ pub trait LiveLink: Send {
     /// Looks for the decoder's stream for up to `timeout_secs`: true once
     /// it is connected.
     fn connect(&mut self, timeout_secs: f64) -> Result<bool>;
+    /// What the link found but did not take while it looked for the
+    /// decoder (a stream of another session), for the message when none
+    /// came.
+    fn passed_over(&self) -> Option<String> {
+        None
+    }
     /// Lets the decoder's stream go (the session ends).
     fn disconnect(&mut self);
     /// Waits until the clock reads `until` and returns what the decoder
@@ -173,6 +185,14 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("--speed: 0 is not a speed"), "{e}");
+        // A speed too slow for the session's timers; its number as given.
+        let e = LiveOptions::new(1e-300, 30.0, None, names)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("--speed: 1e-300 is not a speed") && e.contains("0.1 to 100"),
+            "{e}"
+        );
         assert!(LiveOptions::new(1.0, f64::NAN, None, names).is_err());
         let e = LiveOptions::new(0.0, 30.0, Some(39), names)
             .unwrap_err()
@@ -182,6 +202,15 @@ mod tests {
             "{e}"
         );
         let ok = LiveOptions::new(1.0, 30.0, None, names).unwrap();
-        assert_eq!(ok, LiveOptions::default());
+        let default = LiveOptions::default();
+        // (Each session draws its own id.)
+        assert_ne!(ok.session, default.session);
+        assert_eq!(
+            LiveOptions {
+                session: default.session,
+                ..ok
+            },
+            default
+        );
     }
 }

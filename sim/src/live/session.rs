@@ -126,6 +126,7 @@ impl LiveSession {
             speed: self.options.speed,
             seed,
             task: self.task(),
+            session: self.options.session,
         }
     }
 

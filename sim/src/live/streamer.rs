@@ -33,11 +33,19 @@ pub(crate) fn wait_for_decoder<D: Decisions>(
             return Ok(());
         }
         if s.link().clock() - waited_from > options.timeout_secs {
-            return Err(SimError::Live(format!(
-                "no decoder stream {decoder:?} appeared within {} s after the calibration \
-                 (--timeout): is the decoder running, and does its stream have that name?",
-                options.timeout_secs
-            )));
+            return Err(SimError::Live(match s.link().passed_over() {
+                Some(others) => format!(
+                    "no decoder stream {decoder:?} of this session appeared within {} s after \
+                     the calibration (--timeout): {others} (a decoder for another session is \
+                     refused: publish yours with source id errp-decoder-{})",
+                    options.timeout_secs, options.session
+                ),
+                None => format!(
+                    "no decoder stream {decoder:?} appeared within {} s after the calibration \
+                     (--timeout): is the decoder running, and does its stream have that name?",
+                    options.timeout_secs
+                ),
+            }));
         }
     }
 }

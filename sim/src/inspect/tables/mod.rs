@@ -156,7 +156,7 @@ pub fn csv_tables(rec: &Recording) -> Vec<CsvTable> {
 
 /// A live session's decisions as received, one row each: the run and the
 /// step (grid action) or window it was applied to, from 1 (0: late or
-/// stray), and its latency in ms of the decoder's clock.
+/// stray), and its latency in ms, measured on the bridge's clock.
 fn decisions_table(rec: &Recording) -> CsvTable {
     let d = crate::record::schema::LiveDecisionsView::or_empty(&rec.tables);
     CsvTable {
