@@ -56,6 +56,15 @@ def finish(p: subprocess.Popen, timeout: float = 240) -> tuple[int, str, str]:
     return p.returncode, out, err
 
 
+def beside(helper: subprocess.Popen, *args: str) -> tuple[int, str, str]:
+    """`errp stream ARGS` run to its end beside `helper` (a decoder or a
+    reader), which is then stopped."""
+    result = finish(bridge(*args))
+    helper.kill()
+    helper.communicate()
+    return result
+
+
 # A program that reads the EEG and markers and never decides; with
 # `channels`, it publishes a decoder stream of that many channels, for the
 # EEG stream's session or the one given after it.
@@ -199,12 +208,10 @@ def test_no_reader_within_the_timeout_is_refused(tmp_path):
 
 
 def test_no_decoder_within_the_timeout_is_refused():
-    r = python("-c", READER)
-    code, out, err = finish(
-        bridge(GRID, "--timeout", "2", "--speed", "100", "--calibration-actions", "40")
+    code, out, err = beside(
+        python("-c", READER), GRID, "--timeout", "2", "--speed", "100",
+        "--calibration-actions", "40",
     )
-    r.kill()
-    r.communicate()
     assert code == 2, err
     assert 'no decoder stream "errp-decoder" appeared within 2 s after the calibration' in err
     # No stream of another session was seen, so none is named.
@@ -212,12 +219,10 @@ def test_no_decoder_within_the_timeout_is_refused():
 
 
 def test_a_decoder_stream_of_the_wrong_shape_is_refused():
-    r = python("-c", READER, "3")
-    code, out, err = finish(
-        bridge(GRID, "--timeout", "10", "--speed", "100", "--calibration-actions", "40")
+    code, out, err = beside(
+        python("-c", READER, "3"), GRID, "--timeout", "10", "--speed", "100",
+        "--calibration-actions", "40",
     )
-    r.kill()
-    r.communicate()
     assert code == 2, err
     assert 'the decoder stream "errp-decoder" (name=errp-decoder) has 3 channels' in err
     assert "expected 2 numeric channels (action, p(error))" in err
@@ -225,15 +230,10 @@ def test_a_decoder_stream_of_the_wrong_shape_is_refused():
 
 def test_a_decoder_of_another_session_is_refused():
     # Published for session "theirs"; this bridge is session "mine".
-    r = python("-c", READER, "2", "theirs")
-    code, out, err = finish(
-        bridge(
-            GRID, "--timeout", "3", "--speed", "100", "--calibration-actions", "40",
-            "--session", "mine",
-        )
+    code, out, err = beside(
+        python("-c", READER, "2", "theirs"), GRID, "--timeout", "3", "--speed", "100",
+        "--calibration-actions", "40", "--session", "mine",
     )
-    r.kill()
-    r.communicate()
     assert code == 2, err
     assert 'no decoder stream "errp-decoder" of this session appeared within 3 s' in err, err
     assert 'source ids "x-theirs"' in err and 'session\'s id "mine"' in err, err
@@ -274,15 +274,10 @@ def test_a_decoder_that_stops_mid_run_is_reported():
 
 
 def test_late_decisions_are_counted_not_applied():
-    c = python(str(CLIENT), "--delay", "0.05")
-    code, out, err = finish(
-        bridge(
-            GRID, "--timeout", "10", "--speed", "100", "--calibration-actions", "80",
-            "--runs", "1",
-        )
+    code, out, err = beside(
+        python(str(CLIENT), "--delay", "0.05"), GRID, "--timeout", "10", "--speed", "100",
+        "--calibration-actions", "80", "--runs", "1",
     )
-    c.kill()
-    c.communicate()
     assert code == 0, err
     last = out.strip().splitlines()
     summary = [line for line in last if "runs reached their goal" in line][0]
