@@ -5,7 +5,10 @@ replays to the same table, the EEG stream's metadata read by MNE-LSL, and
 the timing rules (no reader, no decoder, a decoder that stops, a wrong
 stream, late decisions).
 
-The streams have fixed names, so these tests run one after another."""
+The streams have fixed names, so these tests run one after another, each
+bridge and its decoder in this process's own session (`--session`), so that
+another run of these tests, or a lab's session, on the host is never
+found."""
 
 import os
 import subprocess
@@ -32,17 +35,29 @@ def liblsl() -> str:
     pytest.skip("pylsl without its bundled liblsl")
 
 
+#: This run's session: its streams' source ids end with it.
+SESSION = f"test{os.getpid()}"
+
+
 def bridge(*args: str) -> subprocess.Popen:
-    """`errp stream ARGS` in the background."""
+    """`errp stream ARGS` in the background, in `SESSION` unless ARGS name
+    another."""
     env = dict(os.environ, ERRP_LIBLSL=liblsl())
+    session = () if "--session" in args else ("--session", SESSION)
     return subprocess.Popen(
-        [str(errp_bin()), "stream", *args],
+        [str(errp_bin()), "stream", *args, *session],
         cwd=ROOT,
         env=env,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
     )
+
+
+def client(*args: str) -> subprocess.Popen:
+    """The reference client, in `SESSION` unless ARGS name another."""
+    session = () if "--session" in args else ("--session", SESSION)
+    return python(str(CLIENT), *args, *session)
 
 
 def python(*args: str) -> subprocess.Popen:
@@ -65,20 +80,20 @@ def beside(helper: subprocess.Popen, *args: str) -> tuple[int, str, str]:
     return result
 
 
-# A program that reads the EEG and markers and never decides; with
-# `channels`, it publishes a decoder stream of that many channels, for the
-# EEG stream's session or the one given after it.
+# A program that reads the EEG of session `argv[1]` and never decides; with
+# `channels` (`argv[2]`), it publishes a decoder stream of that many
+# channels, for that session or the one given after it.
 READER = """
-import sys, time, pylsl, xml.etree.ElementTree as ET
-eeg = pylsl.resolve_byprop("name", "errp-eeg", 1, 30)[0]
+import sys, time, pylsl
+session = sys.argv[1]
+eeg = pylsl.resolve_byprop("source_id", f"errp-eeg-{session}", 1, 30)[0]
 inlet = pylsl.StreamInlet(eeg)
 inlet.open_stream(10)
-session = ET.fromstring(inlet.info(10).as_xml()).findtext("desc/errp/session")
 outlet = None
-if len(sys.argv) > 1:
-    session = sys.argv[2] if len(sys.argv) > 2 else session
+if len(sys.argv) > 2:
+    session = sys.argv[3] if len(sys.argv) > 3 else session
     info = pylsl.StreamInfo(
-        "errp-decoder", "Decisions", int(sys.argv[1]), 0.0, "double64", f"x-{session}"
+        "errp-decoder", "Decisions", int(sys.argv[2]), 0.0, "double64", f"x-{session}"
     )
     outlet = pylsl.StreamOutlet(info)
 end = time.time() + 60
@@ -106,10 +121,10 @@ def test_the_loop_closes_and_its_recording_replays(tmp_path):
     # So the goals are checked exactly when nothing was missed, and the
     # decisions applied in any case.
     b = bridge(GRID, "--speed", "40", "--runs", "2", "--timeout", "60", "--save", str(saved))
-    c = python(str(CLIENT), "--timeout", "60")
+    c = client("--timeout", "60")
     code, out, err = finish(b)
-    client = c.communicate(timeout=60)[0]
-    assert code == 0, err + client
+    said = c.communicate(timeout=60)[0]
+    assert code == 0, err + said
     summary = [line.strip() for line in out.splitlines() if "runs reached their goal" in line]
     assert len(summary) == 1, out
     applied = int(summary[0].split("decisions: ")[1].split(" applied")[0])
@@ -117,7 +132,7 @@ def test_the_loop_closes_and_its_recording_replays(tmp_path):
     assert applied >= 20 and missed <= applied // 10, out
     if missed == 0:
         assert summary[0].startswith("2 of 2 runs reached their goal"), out
-    assert "trained on 400 epochs" in client
+    assert "trained on 400 epochs" in said
     # Latencies, median and 95th percentile, per run and over all.
     assert out.count("latency from the action's onset median") == 3, out
     assert "0 stray" in out
@@ -169,7 +184,7 @@ def test_the_eeg_metadata_reads_in_mne_lsl():
 
     b = bridge(GRID, "--timeout", "30", "--calibration-actions", "40", "--speed", "20")
     try:
-        stream = StreamLSL(bufsize=2, name="errp-eeg").connect(timeout=20)
+        stream = StreamLSL(bufsize=2, source_id=f"errp-eeg-{SESSION}").connect(timeout=20)
         info = stream.info
         assert info["sfreq"] == 256 * 20
         names = info.ch_names
@@ -209,7 +224,7 @@ def test_no_reader_within_the_timeout_is_refused(tmp_path):
 
 def test_no_decoder_within_the_timeout_is_refused():
     code, out, err = beside(
-        python("-c", READER), GRID, "--timeout", "2", "--speed", "100",
+        python("-c", READER, SESSION), GRID, "--timeout", "2", "--speed", "100",
         "--calibration-actions", "40",
     )
     assert code == 2, err
@@ -220,7 +235,7 @@ def test_no_decoder_within_the_timeout_is_refused():
 
 def test_a_decoder_stream_of_the_wrong_shape_is_refused():
     code, out, err = beside(
-        python("-c", READER, "3"), GRID, "--timeout", "10", "--speed", "100",
+        python("-c", READER, SESSION, "3"), GRID, "--timeout", "10", "--speed", "100",
         "--calibration-actions", "40",
     )
     assert code == 2, err
@@ -229,41 +244,43 @@ def test_a_decoder_stream_of_the_wrong_shape_is_refused():
 
 
 def test_a_decoder_of_another_session_is_refused():
-    # Published for session "theirs"; this bridge is session "mine".
+    # Published for another session than this bridge's.
+    theirs = f"{SESSION}x"
     code, out, err = beside(
-        python("-c", READER, "2", "theirs"), GRID, "--timeout", "3", "--speed", "100",
-        "--calibration-actions", "40", "--session", "mine",
+        python("-c", READER, SESSION, "2", theirs), GRID, "--timeout", "3", "--speed", "100",
+        "--calibration-actions", "40",
     )
     assert code == 2, err
     assert 'no decoder stream "errp-decoder" of this session appeared within 3 s' in err, err
-    assert 'source ids "x-theirs"' in err and 'session\'s id "mine"' in err, err
-    assert "as session mine" in err
+    assert f'source ids "x-{theirs}"' in err and f'session\'s id "{SESSION}"' in err, err
+    assert f"as session {SESSION}" in err
 
 
 def test_two_sessions_on_one_host_each_close_their_own_loop():
     # The same scenario and seed, so the same stream names: each bridge and
     # its decoder find each other by the session's id alone.
     bridges, clients = [], []
-    for session in ("lab_a", "lab_b"):
+    sessions = (f"{SESSION}a", f"{SESSION}b")
+    for session in sessions:
         bridges.append(bridge(
             GRID, "--speed", "40", "--runs", "1", "--timeout", "60",
             "--calibration-actions", "200", "--session", session,
         ))
-        clients.append(python(str(CLIENT), "--timeout", "60", "--session", session))
-    for session, b, c in zip(("lab_a", "lab_b"), bridges, clients):
+        clients.append(client("--timeout", "60", "--session", session))
+    for session, b, c in zip(sessions, bridges, clients):
         code, out, err = finish(b)
-        client = c.communicate(timeout=60)[0]
-        assert code == 0, err + client
+        said = c.communicate(timeout=60)[0]
+        assert code == 0, err + said
         assert f"as session {session}" in err
         summary = [line.strip() for line in out.splitlines() if "runs reached their goal" in line]
         assert len(summary) == 1 and "0 stray" in summary[0], out
         applied = int(summary[0].split("decisions: ")[1].split(" applied")[0])
         assert applied >= 5, out
-        assert "trained on 200 epochs" in client, client
+        assert "trained on 200 epochs" in said, said
 
 
 def test_a_decoder_that_stops_mid_run_is_reported():
-    c = python(str(CLIENT), "--stop-after", "3")
+    c = client("--stop-after", "3")
     code, out, err = finish(
         bridge(GRID, "--timeout", "5", "--speed", "100", "--calibration-actions", "80")
     )
@@ -275,7 +292,7 @@ def test_a_decoder_that_stops_mid_run_is_reported():
 
 def test_late_decisions_are_counted_not_applied():
     code, out, err = beside(
-        python(str(CLIENT), "--delay", "0.05"), GRID, "--timeout", "10", "--speed", "100",
+        client("--delay", "0.05"), GRID, "--timeout", "10", "--speed", "100",
         "--calibration-actions", "80", "--runs", "1",
     )
     assert code == 0, err
