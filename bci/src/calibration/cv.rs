@@ -131,6 +131,9 @@ pub fn out_of_fold_decisions<C: Classifier>(
     let fold_of = stratified_folds(labels, folds, seed);
     let mut decisions = vec![0.0; labels.len()];
     for k in 0..folds {
+        // A fold's fit is a fraction of a second: a stop request is seen
+        // between two.
+        crate::stop::check()?;
         let train: Vec<usize> = (0..labels.len()).filter(|&i| fold_of[i] != k).collect();
         let test: Vec<usize> = (0..labels.len()).filter(|&i| fold_of[i] == k).collect();
         if test.is_empty() {

@@ -292,6 +292,9 @@ fn synthesise_classes<T>(
     let mut error = Vec::with_capacity(per_class);
     let mut correct = Vec::with_capacity(per_class);
     while error.len() < per_class || correct.len() < per_class {
+        // A bank is thousands of epochs: a stop request is seen between
+        // two of them.
+        errp_bci::stop::check()?;
         let want_error = if error.len() == per_class {
             false
         } else if correct.len() == per_class {
