@@ -32,6 +32,20 @@ package's public calls, each given a bad value for one argument in a
 process of its own (`--python`, the interpreter with the package), which
 must succeed or raise TypeError, ValueError or OSError naming the argument.
 
+A family of the simulated user's `[realism]` values (`realism_cases`,
+about 2 600, in fuzz_realism.py): every field given an edge value in a
+scenario file (`errp run`, `errp realism`, `errp table1 --realism`) and
+as a sweep level, which must exit 0 or 2 naming the field or the file.
+
+A family of own-EEG files (`edf_cases`, about 260, in fuzz_edf.py): a
+session exported as EDF+ and converted to BDF+, its header fields lying,
+cut short, with bits flipped, its records keeping time oddly (a
+sub-second start, gaps, a missing time-keeping TAL), its events
+annotated twice or as both classes, two channels labelled alike; and the
+session written by MNE's export, edfio and pyEDFlib (with the `--python`
+interpreter, when it has them). Each is the recording of `errp run
+own_eeg.toml`, which must exit 0 or 2 naming the file.
+
 A second family (`hostile_cases`, about 200) changes the program's
 surroundings instead of its input: standard output or error closed early
 (`| head -1`) or on a full disk (`/dev/full`); FIFOs, sockets, devices
@@ -57,8 +71,10 @@ import time
 import tomllib
 from pathlib import Path
 
+from fuzz_edf import edf_cases, make_edf_base, run_edf, writer_cases
 from fuzz_hostile import build_base, hostile_cases, run_case, signal_cases
 from fuzz_python import python_cases, run_python_case
+from fuzz_realism import realism_cases, run_realism
 from fuzz_recordings import make_bases, recording_cases, run_damage
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -267,7 +283,8 @@ def main():
     ap.add_argument("--list", action="store_true")
     ap.add_argument("--python", default=sys.executable,
                     help="the Python with the errp package, for the python family")
-    ap.add_argument("--only", choices=["input", "hostile", "signal", "recordings", "python"],
+    ap.add_argument("--only", choices=["input", "hostile", "signal", "recordings", "python",
+                                       "realism", "edf"],
                     help="run one family of cases")
     a = ap.parse_args()
     errp = str(Path(a.errp).resolve())
@@ -282,6 +299,12 @@ def main():
         sizes = {kind: len(b) for kind, b in bases.items()}
         cases += [("recordings", c.label, None, c) for c in recording_cases(a.seed, sizes)]
     cases += [("python", c.label, None, c) for c in python_cases()]
+    cases += [("realism", c.label, None, c) for c in realism_cases(a.seed)]
+    edf_base = None
+    if a.only in (None, "edf"):
+        edf_base = make_edf_base(errp, base_dir)
+        cases += [("edf", c.label, None, c)
+                  for c in edf_cases(a.seed, len(edf_base)) + writer_cases()]
     random.Random(a.seed).shuffle(cases)
     if a.list:
         for kind, label, _, args in cases:
@@ -303,6 +326,11 @@ def main():
         elif kind == "python":
             failure, code = run_python_case(os.path.abspath(a.python), args, a.memory_gib,
                                             limit_memory)
+        elif kind == "edf":
+            failure, code = run_edf(errp, edf_base, args, os.path.abspath(a.python),
+                                    a.memory_gib, limit_memory)
+        elif kind == "realism":
+            failure, code = run_realism(errp, args, a.memory_gib, limit_memory)
         elif kind == "recordings":
             failure, code = run_damage(errp, bases, args, a.memory_gib, limit_memory)
         else:

@@ -37,6 +37,13 @@ pub(crate) fn read_recording<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bo
             match c {
                 Column::F64(v) => cols.set_item(name, v.into_pyarray(py))?,
                 Column::I64(v) => cols.set_item(name, v.into_pyarray(py))?,
+                // Values and a mask of the missing ones: a pandas `Int64`
+                // column (`read_recording`).
+                Column::OptI64(v) => {
+                    let mask: Vec<bool> = v.iter().map(Option::is_none).collect();
+                    let values: Vec<i64> = v.into_iter().map(|x| x.unwrap_or(0)).collect();
+                    cols.set_item(name, (values.into_pyarray(py), mask.into_pyarray(py)))?
+                }
                 Column::Bool(v) => cols.set_item(name, v.into_pyarray(py))?,
                 Column::Str(v) => cols.set_item(name, v)?,
                 Column::F64Rows(v, _) => cols.set_item(name, v.into_pyarray(py))?,

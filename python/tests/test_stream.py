@@ -16,6 +16,7 @@ import sys
 import time
 from pathlib import Path
 
+import errp
 import numpy as np
 import pytest
 
@@ -152,6 +153,15 @@ def test_the_loop_closes_and_its_recording_replays(tmp_path):
     # Its decisions, one line per run: as many applied as the run's actions.
     decided = [line for line in recomputed.splitlines() if " applied, latency" in line]
     assert len(decided) == 3, recomputed
+    # The decisions table: the action each applied decision decided, from
+    # 1 as the runs, in order within a run; none (pandas' NA) for one
+    # late or stray.
+    d = errp.read_recording(saved).tables["decisions"]
+    assert str(d["applied_to"].dtype) == "Int64", d.dtypes
+    assert (d["applied_to"].isna() == (d["fate"] != "applied")).all(), d
+    for _, one in d[d["fate"] == "applied"].groupby("run"):
+        steps = one["applied_to"].astype(int).tolist()
+        assert steps[0] >= 1 and steps == sorted(set(steps)), steps
     # A recording of `errp run` has no decisions to replay.
     plain = tmp_path / "plain.rrd"
     made = subprocess.run(

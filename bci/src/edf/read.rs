@@ -318,10 +318,11 @@ impl EdfFile {
                 256 * (n + 1)
             )));
         }
-        if !(record_secs > 0.0 && record_secs <= 3600.0) {
+        if !(0.001..=3600.0).contains(&record_secs) {
             return Err(bad(format!(
-                "the duration of a data record is {record_secs} s; accepted: more than 0, \
-                 at most 3600"
+                "the duration of a data record is {} s; accepted: 0.001 to 3600",
+                // As written (1e-300, not its 300 decimal digits).
+                text(&head[244..252]).trim()
             )));
         }
         let mut sig_bytes = vec![0u8; 256 * n];
@@ -927,6 +928,14 @@ mod tests {
         b.extend_from_slice(&[7; 10]);
         let e = read(&b);
         assert!(e.contains("10 bytes after its 3 data records"), "{e}");
+        // A record duration shown as written, not as its 300 decimals.
+        let mut b = bytes.clone();
+        b[244..252].copy_from_slice(b"1e-300  ");
+        let e = read(&b);
+        assert!(
+            e.contains("duration of a data record is 1e-300 s; accepted: 0.001 to 3600"),
+            "{e}"
+        );
         let mut b = bytes.clone();
         b[252..256].copy_from_slice(b"9999");
         let e = read(&b);

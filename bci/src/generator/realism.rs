@@ -128,7 +128,7 @@ pub struct Realism {
     pub task_gain: f64,
     /// Days between the calibration and the closed loop (0: the same
     /// session). Each day draws its own ERP shift from the user's seed.
-    pub day: u32,
+    pub day: u64,
     /// SD of a day's ERP latency shift (ms). ErrPs are "stable over long
     /// periods of time (from 50 to >600 days)" (Chavarriaga & Millan 2010,
     /// IEEE TNSRE 18:381, doi:10.1109/TNSRE.2010.2053387), with no SD
@@ -262,10 +262,7 @@ impl Realism {
             online.clock_offset_secs =
                 (self.clock_offset_secs + calibration_secs).min(MAX_CLOCK_SECS);
         } else {
-            let mut rng = labelled(
-                derive_seed(seed, "realism/day", u64::from(self.day)),
-                "realism/day",
-            );
+            let mut rng = labelled(derive_seed(seed, "realism/day", self.day), "realism/day");
             let z_latency: f64 = rng.sample(StandardNormal);
             let z_gain: f64 = rng.sample(StandardNormal);
             online.erp_latency_shift_ms += self.day_latency_sd_ms * z_latency;

@@ -1,9 +1,11 @@
 //! The integration tests of `errp_bci`, one binary: the synthetic EEG, the
-//! discrete and continuous decoders, and the determinism contracts.
+//! discrete and continuous decoders, the determinism contracts, and the
+//! EDF reader on files other tools wrote.
 
 mod continuous;
 mod decoder;
 mod determinism;
+mod edf_fixtures;
 mod eeg;
 mod own_eeg;
 mod realism;

@@ -512,8 +512,15 @@ def read_recording(path: PathLike) -> Recording:
     if not HAS_RERUN:
         raise RuntimeError("this errp was built without Rerun; read_recording needs it")
     d = _core.read_recording(_path(path, "path"))
+
+    def column(values):
+        # Integers with some missing come as (values, mask): pandas' Int64.
+        if isinstance(values, tuple):
+            return pd.arrays.IntegerArray(*values)
+        return values
+
     tables = {
-        name: pd.DataFrame({c: cols[c] for c in d["order"][name]})
+        name: pd.DataFrame({c: column(cols[c]) for c in d["order"][name]})
         for name, cols in d["tables"].items()
     }
     return Recording(

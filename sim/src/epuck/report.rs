@@ -98,6 +98,13 @@ impl fmt::Display for EpuckRunsTable<'_> {
     }
 }
 
+/// The fewest runs reaching the goal whose central 80 % (10th to 90th
+/// percentile) and percentiles of the paper's run the summary prints:
+/// below it the 10th and 90th percentiles are the extreme runs themselves,
+/// and a percentile of the paper's run moves by more than ten points with
+/// one run more.
+pub const MIN_RUNS_FOR_PERCENTILES: usize = 10;
+
 /// The summary of an e-puck scenario's runs, beside the paper's run of the
 /// same name if it has one.
 pub struct EpuckSummaryReport<'a> {
@@ -109,6 +116,55 @@ pub struct EpuckSummaryReport<'a> {
     pub goal: &'a str,
     /// The decision threshold in force.
     pub t_e: f64,
+}
+
+impl EpuckSummaryReport<'_> {
+    /// The central 80 % of the runs that reached the goal and the paper's
+    /// run's percentiles among them, or how many runs they need.
+    fn spread(
+        &self,
+        f: &mut fmt::Formatter<'_>,
+        paper: Option<&(&str, f64, usize)>,
+    ) -> fmt::Result {
+        let s = self.summary;
+        let q = |v: &[f64], d: usize| {
+            let (lo, hi) = (quantile(v, 0.1), quantile(v, 0.9));
+            if lo.is_finite() && hi.is_finite() {
+                format!("{lo:.d$}-{hi:.d$}")
+            } else {
+                "-".to_string()
+            }
+        };
+        let reached = s.reached_secs.len();
+        if reached < MIN_RUNS_FOR_PERCENTILES {
+            writeln!(
+                f,
+                "  central 80 %         needs at least {MIN_RUNS_FOR_PERCENTILES} runs that reach \
+                 {} ({reached} did here): run more",
+                self.goal
+            )?;
+            if paper.is_some() {
+                writeln!(f, "  the paper's run      its percentiles need as many")?;
+            }
+        } else {
+            writeln!(
+                f,
+                "  central 80 %         time {} s, detected {}",
+                q(&s.reached_secs, 1),
+                q(&s.reached_detected, 0)
+            )?;
+            if let Some(&(_, secs, det)) = paper {
+                writeln!(
+                    f,
+                    "  the paper's run      at the {} percentile of time and the {} of \
+                     detections",
+                    ordinal_percent(percentile_of(&s.reached_secs, secs)),
+                    ordinal_percent(percentile_of(&s.reached_detected, det as f64))
+                )?;
+            }
+        }
+        Ok(())
+    }
 }
 
 impl fmt::Display for EpuckSummaryReport<'_> {
@@ -142,28 +198,7 @@ impl fmt::Display for EpuckSummaryReport<'_> {
                 note(paper)
             )?;
         }
-        let q = |v: &[f64], d: usize| {
-            let (lo, hi) = (quantile(v, 0.1), quantile(v, 0.9));
-            if lo.is_finite() && hi.is_finite() {
-                format!("{lo:.d$}-{hi:.d$}")
-            } else {
-                "-".to_string()
-            }
-        };
-        writeln!(
-            f,
-            "  central 80 %         time {} s, detected {}",
-            q(&s.reached_secs, 1),
-            q(&s.reached_detected, 0)
-        )?;
-        if let Some(&(_, secs, det)) = paper {
-            writeln!(
-                f,
-                "  the paper's run      at the {} percentile of time and the {} of detections",
-                ordinal_percent(percentile_of(&s.reached_secs, secs)),
-                ordinal_percent(percentile_of(&s.reached_detected, det as f64))
-            )?;
-        }
+        self.spread(f, paper)?;
         writeln!(
             f,
             "  median time to goal  {}   (a run on a wrong city never reaches it)",

@@ -119,6 +119,10 @@ pub enum Column {
     F64(Vec<f64>),
     /// Integers.
     I64(Vec<i64>),
+    /// Integers, some missing (an empty CSV field, a Parquet null, a
+    /// pandas `Int64` NA): a decision's action or window when it was not
+    /// applied.
+    OptI64(Vec<Option<i64>>),
     /// Flags.
     Bool(Vec<bool>),
     /// Text.
@@ -133,6 +137,7 @@ impl Column {
         match self {
             Column::F64(v) => v.len(),
             Column::I64(v) => v.len(),
+            Column::OptI64(v) => v.len(),
             Column::Bool(v) => v.len(),
             Column::Str(v) => v.len(),
             Column::F64Rows(v, w) => v.len().checked_div(*w).unwrap_or(0),
@@ -175,6 +180,10 @@ impl Table {
                     Ok(())
                 }
                 (Column::I64(a), Column::I64(b)) => {
+                    a.extend(b);
+                    Ok(())
+                }
+                (Column::OptI64(a), Column::OptI64(b)) => {
                     a.extend(b);
                     Ok(())
                 }

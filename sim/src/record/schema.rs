@@ -354,6 +354,7 @@ fn send_table(
         let (array, width): (ArrayRef, usize) = match column {
             Column::F64(v) => (std::sync::Arc::new(Float64Array::from(v)), 1),
             Column::I64(v) => (std::sync::Arc::new(Int64Array::from(v)), 1),
+            Column::OptI64(v) => (std::sync::Arc::new(Int64Array::from(v)), 1),
             Column::Bool(v) => (std::sync::Arc::new(BooleanArray::from(v)), 1),
             Column::Str(v) => (std::sync::Arc::new(StringArray::from(v)), 1),
             Column::F64Rows(v, w) => (std::sync::Arc::new(Float64Array::from(v)), w),

@@ -452,6 +452,47 @@ mod saved {
         assert_eq!(replay.recorded, printed);
         assert_eq!(replay.replayed, printed);
         assert_eq!(replay.first_difference(), None);
+        check_decisions_table(&rec, runs);
+    }
+
+    /// The decisions table (`errp inspect --csv`, `read_recording`): runs
+    /// and the actions decisions were applied to both from 1, and a late
+    /// decision applied to none (an empty field, a Parquet null).
+    fn check_decisions_table(rec: &Recording, runs: &[GridLiveRun]) {
+        use errp_sim::record::data::Column;
+        let tables = errp_sim::inspect::csv_tables(rec);
+        let table = tables.iter().find(|t| t.name == "decisions").unwrap();
+        let column = |name: &str| &table.columns.iter().find(|(c, _)| *c == name).unwrap().1;
+        let (Column::I64(run), Column::Str(fate), Column::OptI64(applied_to)) =
+            (column("run"), column("fate"), column("applied_to"))
+        else {
+            panic!("run, fate or applied_to of another kind: {table:?}")
+        };
+        for (k, r) in runs.iter().enumerate() {
+            // Each run's applied decisions name its actions that had one,
+            // in order, from 1; the missed actions (every 7th) have none.
+            let want: Vec<i64> = (1..)
+                .zip(&r.decisions)
+                .filter_map(|(action, d)| d.map(|_| action))
+                .collect();
+            let rows: Vec<usize> = (0..run.len()).filter(|&i| run[i] == k as i64 + 1).collect();
+            let got: Vec<i64> = rows.iter().filter_map(|&i| applied_to[i]).collect();
+            assert_eq!(got, want, "run {}", k + 1);
+            for &i in &rows {
+                assert_eq!(fate[i] == "applied", applied_to[i].is_some(), "row {i}");
+            }
+        }
+        assert!(fate.iter().any(|f| f == "late"), "{fate:?}");
+        // As CSV: a late decision's applied_to is an empty last field.
+        let csv = table.to_csv();
+        assert!(
+            csv.starts_with("run,t_s,id,p_error,latency_ms,fate,applied_to\n"),
+            "{csv}"
+        );
+        for line in csv.lines().skip(1) {
+            assert_eq!(line.ends_with(",late,"), line.contains(",late,"), "{line}");
+            assert!(!line.ends_with(",0") && !line.ends_with(",-1"), "{line}");
+        }
     }
 
     /// The e-puck session's recording: the decisions as received, each

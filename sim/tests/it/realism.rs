@@ -28,6 +28,21 @@ fn a_bad_realism_field_is_named_with_its_value_and_range() {
         "{err}"
     );
     assert!(err.contains("[0, 1]"), "{err}");
+    // A day past the range, however far, is refused with the range (not
+    // with the limit of the integer type that holds it).
+    for day in ["5000", "99999999999"] {
+        let text = format!(
+            "{}\n[realism]\nday = {day}\n",
+            scenario_text("variants/grid_fixed_goals_ideal.toml")
+        );
+        let err = GridScenario::parse(&text, Path::new("bad.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("realism.day") && err.contains(day) && err.contains("[0, 3650]"),
+            "{err}"
+        );
+    }
     let text = format!(
         "{}\n[realism]\nbad_channel = \"Q9\"\n",
         scenario_text("variants/mexico_to_pisa_ideal.toml")

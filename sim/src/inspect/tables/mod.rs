@@ -51,6 +51,11 @@ impl CsvTable {
                     Column::I64(v) => {
                         let _ = write!(out, "{}", v[i]);
                     }
+                    Column::OptI64(v) => {
+                        if let Some(x) = v[i] {
+                            let _ = write!(out, "{x}");
+                        }
+                    }
                     Column::Bool(v) => out.push_str(if v[i] { "True" } else { "False" }),
                     Column::Str(v) => out.push_str(&quote(&v[i])),
                     Column::F64Rows(..) => {}
@@ -94,6 +99,7 @@ impl CsvTable {
                     )),
                 ),
                 Column::I64(v) => (DataType::Int64, Arc::new(Int64Array::from(v.clone()))),
+                Column::OptI64(v) => (DataType::Int64, Arc::new(Int64Array::from(v.clone()))),
                 Column::Bool(v) => (DataType::Boolean, Arc::new(BooleanArray::from(v.clone()))),
                 Column::Str(v) => (DataType::Utf8, Arc::new(StringArray::from(v.clone()))),
                 Column::F64Rows(..) => continue,
@@ -154,9 +160,10 @@ pub fn csv_tables(rec: &Recording) -> Vec<CsvTable> {
     out
 }
 
-/// A live session's decisions as received, one row each: the run and the
-/// step (grid action) or window it was applied to, from 1 (0: late or
-/// stray), and its latency in ms, measured on the bridge's clock.
+/// A live session's decisions as received, one row each: the run, the
+/// grid action or device window it was applied to (from 1, as the runs;
+/// missing when it was late or stray), and its latency in ms, measured on
+/// the bridge's clock.
 fn decisions_table(rec: &Recording) -> CsvTable {
     let d = crate::record::schema::LiveDecisionsView::or_empty(&rec.tables);
     CsvTable {
@@ -173,7 +180,12 @@ fn decisions_table(rec: &Recording) -> CsvTable {
             ("fate", Column::Str(d.fate.to_vec())),
             (
                 "applied_to",
-                Column::I64(d.applied_to.iter().map(|a| a + 1).collect()),
+                Column::OptI64(
+                    d.applied_to
+                        .iter()
+                        .map(|&a| (a >= 0).then_some(a + 1))
+                        .collect(),
+                ),
             ),
         ],
     }
