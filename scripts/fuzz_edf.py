@@ -21,6 +21,8 @@ import subprocess
 import tempfile
 from pathlib import Path
 
+from fuzz_recordings import verdict
+
 ROOT = Path(__file__).resolve().parent.parent
 
 #: One-second records kept of the exported session.
@@ -317,17 +319,7 @@ def run_edf(errp, base, case, python, gib, limit_memory):
                                timeout=120, preexec_fn=limit_memory(gib), cwd=work)
         except subprocess.TimeoutExpired:
             return f"{case.label}: no answer within 120 s", None
-        left = sorted(str(x.relative_to(out)) for x in out.rglob("*"))
-        why = None
-        if p.returncode not in (0, 2):
-            why = f"exit code {p.returncode}"
-        elif p.returncode == 2:
-            if not p.stderr.startswith("error:") or name not in p.stderr:
-                why = "exit 2 without `error:` naming the file"
-            elif left:
-                why = f"exit 2 left {left}"
-        elif any(".partial-" in x for x in left):
-            why = f"exit 0 left {left}"
+        why = verdict(p, out, (name,), "the file")
         if why:
             return f"{case.label}: {why}: {case.command()}\n{p.stderr[-600:]}", p.returncode
         return None, p.returncode

@@ -24,6 +24,8 @@ import tempfile
 import tomllib
 from pathlib import Path
 
+from fuzz_recordings import verdict
+
 ROOT = Path(__file__).resolve().parent.parent
 
 #: Every field of `[realism]` (bci/src/generator/realism.rs, `Realism`).
@@ -174,21 +176,11 @@ def run_realism(errp, case, gib, limit_memory):
                                env=dict(os.environ, ERRP_CACHE_DIR=str(work / "cache")))
         except subprocess.TimeoutExpired:
             return f"{case.label}: no answer within 120 s: {case.command()}", None
-        left = sorted(str(x.relative_to(out)) for x in out.rglob("*"))
-        why = None
-        if p.returncode not in (0, 2):
-            why = f"exit code {p.returncode}"
-        elif p.returncode == 2:
-            # A user so unlike a person that the decoder cannot reach the
-            # scenario's accuracy (no ErrP, half the actions misjudged) is
-            # refused for that accuracy, naming it.
-            names = (f"realism.{case.field}", file.name, "realism", "accuracy = ")
-            if not p.stderr.startswith("error:") or not any(n in p.stderr for n in names):
-                why = "exit 2 without `error:` naming the field or the file"
-            elif left:
-                why = f"exit 2 left {left}"
-        elif any(".partial-" in x or x.endswith(".lock") for x in left):
-            why = f"exit 0 left {left}"
+        # A user so unlike a person that the decoder cannot reach the
+        # scenario's accuracy (no ErrP, half the actions misjudged) is
+        # refused for that accuracy, naming it.
+        names = (f"realism.{case.field}", file.name, "realism", "accuracy = ")
+        why = verdict(p, out, names, "the field or the file")
         if why:
             return f"{case.label}: {why}: {case.command()}\n{p.stderr[-600:]}", p.returncode
         return None, p.returncode

@@ -83,6 +83,24 @@ def recording_cases(seed, sizes):
     return cases
 
 
+def verdict(p, out, names, named):
+    """What is wrong with a finished command `p` whose outputs go to `out`,
+    or None: an exit code other than 0 or 2; on 2, a message that does not
+    start with `error: ` or names none of `names` (`named` says what they
+    are), or anything left in `out`; on 0, a temporary or a lock left."""
+    left = sorted(str(x.relative_to(out)) for x in out.rglob("*"))
+    if p.returncode not in (0, 2):
+        return f"exit code {p.returncode}"
+    if p.returncode == 2:
+        if not p.stderr.startswith("error:") or not any(n in p.stderr for n in names):
+            return f"exit 2 without `error:` naming {named}"
+        if left:
+            return f"exit 2 left {left}"
+    elif any(".partial-" in x or x.endswith(".lock") for x in left):
+        return f"exit 0 left {left}"
+    return None
+
+
 def run_damage(errp, bases, case, gib, limit_memory):
     """Runs one case; returns (failure or None, exit code)."""
     work = Path(tempfile.mkdtemp(prefix="errp-fuzz-rrd-"))
@@ -97,17 +115,7 @@ def run_damage(errp, bases, case, gib, limit_memory):
                                preexec_fn=limit_memory(gib), cwd=work)
         except subprocess.TimeoutExpired:
             return f"{case.label}: no answer within 120 s", None
-        left = sorted(str(x.relative_to(out)) for x in out.rglob("*"))
-        why = None
-        if p.returncode not in (0, 2):
-            why = f"exit code {p.returncode}"
-        elif p.returncode == 2:
-            if not p.stderr.startswith("error:") or "x.rrd" not in p.stderr:
-                why = "exit 2 without `error:` naming the file"
-            elif left:
-                why = f"exit 2 left {left}"
-        elif any(".partial-" in x for x in left):
-            why = f"exit 0 left {left}"
+        why = verdict(p, out, ("x.rrd",), "the file")
         if why:
             return f"{case.label}: {why}\n{p.stderr[-600:]}", p.returncode
         return None, p.returncode
