@@ -71,6 +71,7 @@ import time
 import tomllib
 from pathlib import Path
 
+from fuzz_common import toml_value
 from fuzz_edf import edf_cases, make_edf_base, run_edf, writer_cases
 from fuzz_hostile import build_base, hostile_cases, run_case, signal_cases
 from fuzz_python import python_cases, run_python_case
@@ -150,26 +151,6 @@ FLAG_CASES = [
 ] + [
     ["merge", "OUT", "--out", "OUT/m"], ["merge", "OUT/none", "--out", "OUT/m"],
 ]
-
-
-def toml_value(v):
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, float):
-        if math.isnan(v):
-            return "nan"
-        if math.isinf(v):
-            return "inf" if v > 0 else "-inf"
-        return repr(v)
-    if isinstance(v, str):
-        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
-    if isinstance(v, list):
-        return "[" + ", ".join(toml_value(x) for x in v) + "]"
-    if isinstance(v, dict):
-        return "{" + ", ".join(f"{k} = {toml_value(x)}" for k, x in v.items()) + "}"
-    raise TypeError(v)
 
 
 def toml_text(table, prefix=""):

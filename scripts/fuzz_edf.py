@@ -21,7 +21,7 @@ import subprocess
 import tempfile
 from pathlib import Path
 
-from fuzz_recordings import verdict
+from fuzz_common import verdict
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -24,7 +24,7 @@ import tempfile
 import tomllib
 from pathlib import Path
 
-from fuzz_recordings import verdict
+from fuzz_common import toml_value, verdict
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -53,24 +53,6 @@ SCENARIOS = {
     "grid": ROOT / "scenarios" / "grid_fixed_goals.toml",
     "epuck": ROOT / "scenarios" / "mexico_to_pisa.toml",
 }
-
-
-def toml_value(v):
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, float):
-        if math.isnan(v):
-            return "nan"
-        if math.isinf(v):
-            return "inf" if v > 0 else "-inf"
-        return repr(v)
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, str):
-        return '"' + v + '"'
-    if isinstance(v, list):
-        return "[" + ", ".join(toml_value(x) for x in v) + "]"
-    return "{}"
 
 
 def with_field(text, field, value):

@@ -18,6 +18,8 @@ import subprocess
 import tempfile
 from pathlib import Path
 
+from fuzz_common import verdict
+
 ROOT = Path(__file__).resolve().parent.parent
 
 #: What each base recording is made with (`OUT` is the file).
@@ -81,24 +83,6 @@ def recording_cases(seed, sizes):
         cases.append(Damage(kind, "its header only", lambda b: b[:12]))
         cases.append(Damage(kind, "zeros of its length", lambda b: bytes(len(b))))
     return cases
-
-
-def verdict(p, out, names, named):
-    """What is wrong with a finished command `p` whose outputs go to `out`,
-    or None: an exit code other than 0 or 2; on 2, a message that does not
-    start with `error: ` or names none of `names` (`named` says what they
-    are), or anything left in `out`; on 0, a temporary or a lock left."""
-    left = sorted(str(x.relative_to(out)) for x in out.rglob("*"))
-    if p.returncode not in (0, 2):
-        return f"exit code {p.returncode}"
-    if p.returncode == 2:
-        if not p.stderr.startswith("error:") or not any(n in p.stderr for n in names):
-            return f"exit 2 without `error:` naming {named}"
-        if left:
-            return f"exit 2 left {left}"
-    elif any(".partial-" in x or x.endswith(".lock") for x in left):
-        return f"exit 0 left {left}"
-    return None
 
 
 def run_damage(errp, bases, case, gib, limit_memory):
