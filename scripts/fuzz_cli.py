@@ -46,6 +46,15 @@ session written by MNE's export, edfio and pyEDFlib (with the `--python`
 interpreter, when it has them). Each is the recording of `errp run
 own_eeg.toml`, which must exit 0 or 2 naming the file.
 
+A family of hostile LSL decoder clients (`lsl_cases`, 80, in
+fuzz_lsl.py): `errp stream` on a grid and an e-puck scenario beside a
+client (the `--python` interpreter, with pylsl) whose decoder stream has
+the wrong shape, sends p(error)s that are not probabilities, ids that
+name nothing, floods or falls silent, names another session or none,
+doubles; and a second session with the same seed on the host. The bridge
+must exit 0 or 2 as the contract says (2 naming the stream), never panic
+or hang, and leave nothing on 2.
+
 A second family (`hostile_cases`, about 200) changes the program's
 surroundings instead of its input: standard output or error closed early
 (`| head -1`) or on a full disk (`/dev/full`); FIFOs, sockets, devices
@@ -74,6 +83,7 @@ from pathlib import Path
 from fuzz_common import toml_value
 from fuzz_edf import edf_cases, make_edf_base, run_edf, writer_cases
 from fuzz_hostile import build_base, hostile_cases, run_case, signal_cases
+from fuzz_lsl import lsl_cases, run_lsl
 from fuzz_python import python_cases, run_python_case
 from fuzz_realism import realism_cases, run_realism
 from fuzz_recordings import make_bases, recording_cases, run_damage
@@ -265,7 +275,7 @@ def main():
     ap.add_argument("--python", default=sys.executable,
                     help="the Python with the errp package, for the python family")
     ap.add_argument("--only", choices=["input", "hostile", "signal", "recordings", "python",
-                                       "realism", "edf"],
+                                       "realism", "edf", "lsl"],
                     help="run one family of cases")
     a = ap.parse_args()
     errp = str(Path(a.errp).resolve())
@@ -286,6 +296,7 @@ def main():
         edf_base = make_edf_base(errp, base_dir)
         cases += [("edf", c.label, None, c)
                   for c in edf_cases(a.seed, len(edf_base)) + writer_cases()]
+    cases += [("lsl", c.label, None, c) for c in lsl_cases(a.seed)]
     random.Random(a.seed).shuffle(cases)
     if a.list:
         for kind, label, _, args in cases:
@@ -310,6 +321,9 @@ def main():
         elif kind == "edf":
             failure, code = run_edf(errp, edf_base, args, os.path.abspath(a.python),
                                     a.memory_gib, limit_memory)
+        elif kind == "lsl":
+            failure, code = run_lsl(errp, args, os.path.abspath(a.python), a.memory_gib,
+                                    limit_memory)
         elif kind == "realism":
             failure, code = run_realism(errp, args, a.memory_gib, limit_memory)
         elif kind == "recordings":

@@ -82,7 +82,7 @@ pub use calibration::targeting::{
 pub use calibration::{
     Accuracy, Calibrated, CalibratedModel, CalibrationParams, CalibrationSession, CalibrationSetup,
     GrandAverage, Protocol, RawSink, SessionOptions, Setup, TargetingParams, calibrate,
-    calibrate_features, calibrate_session, cross_validate, cv_seed, eog_session,
+    calibrate_features, calibrate_session, cross_validate, cv_seed, eog_session, export_session,
     out_of_fold_decisions, schedule, simulate_session, simulate_session_with,
 };
 pub use classify::{Classifier, ErrorModel, Features, sigmoid, stratified_folds};

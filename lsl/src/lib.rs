@@ -240,8 +240,10 @@ impl Lsl {
     /// opened) whose headers fit in it (a truncated library, mapped, would
     /// kill the process when a missing page is touched). Without a
     /// configuration of the lab's own (`LSLAPICFG`, or an `lsl_api.cfg`
-    /// where liblsl looks), liblsl logs only errors, not its start-up
-    /// notes.
+    /// where liblsl looks), liblsl logs only what is fatal: errp names
+    /// every failure itself (a lost stream, a peer that never came), so
+    /// liblsl's own lines (its start-up notes, "Stream transmission broke
+    /// off; re-connecting...") would only come before errp's message.
     pub fn open(path: &Path) -> Result<Self, LslError> {
         let file = if path.components().count() == 1 {
             Path::new(".").join(path)
@@ -270,7 +272,7 @@ impl Lsl {
     fn load(path: &Path) -> Result<Self, LslError> {
         let api = Api::load(path)?;
         if !lab_configuration() {
-            api.configure("[log]\nlevel = -2\n");
+            api.configure("[log]\nlevel = -3\n");
         }
         let v = api.version();
         if v < MIN_VERSION {

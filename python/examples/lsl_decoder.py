@@ -98,11 +98,21 @@ class Preprocess:
         return np.hstack([y[:, self.keep] - car, y[:, self.eog]])
 
 
+def session_id(text: str) -> str:
+    """A session id as ``errp stream --session`` takes it: 1 to 16 letters,
+    digits or ``_``."""
+    if not (1 <= len(text) <= 16 and all(c.isascii() and (c.isalnum() or c == "_")
+                                          for c in text)):
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: expected 1 to 16 letters, digits or _ (the bridge's --session)")
+    return text
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--name", default="errp-decoder", help="this decoder's stream")
     ap.add_argument("--timeout", type=float, default=60.0, help="seconds to find the streams")
-    ap.add_argument("--session", default=None,
+    ap.add_argument("--session", default=None, type=session_id,
                     help="the bridge's session id (errp stream --session): needed only when "
                          "more than one session runs on the host")
     ap.add_argument("--stop-after", type=int, default=None,

@@ -4,10 +4,7 @@
 use std::sync::LazyLock;
 
 use divan::{Bencher, black_box};
-use errp_bci::{
-    Assessment, CalibrationParams, CalibrationSetup, EdfWriter, EegBlock, SessionOptions, Valid,
-    simulate_session,
-};
+use errp_bci::{CalibrationParams, CalibrationSetup, Valid, export_session};
 use errp_robot::{Grid, GridControlParams, QTable};
 use errp_sim::grid::{
     AssessmentDecoder, CORNER_PAIRS, EpochBank, GridTaskParams, eeg_decoder, prepare_decoder,
@@ -70,14 +67,7 @@ static RECORDED: LazyLock<AssessmentDecoder> = LazyLock::new(|| {
     })
     .unwrap();
     let file = std::io::BufWriter::new(std::fs::File::create(dir.join("s.edf")).unwrap());
-    let mut writer = EdfWriter::new(file, &setup.montage, 256.0).unwrap();
-    let mut sink = |b: &EegBlock, e: &[Assessment]| writer.write(b, e);
-    let options = SessionOptions {
-        raw_sink: Some(&mut sink),
-        ..SessionOptions::default()
-    };
-    simulate_session(&setup, 1, options).unwrap();
-    writer.finish().unwrap();
+    export_session(&setup, 1, file).unwrap();
     let text = "task = \"grid\"\n[free_goals]\ncount = 1\n[eeg]\nrecording = \"s.edf\"\n";
     std::fs::write(dir.join("s.toml"), text).unwrap();
     let scenario = errp_sim::ScenarioInput::load_as_written(errp_sim::ScenarioSource::File(

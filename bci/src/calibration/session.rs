@@ -1,12 +1,15 @@
 //! Simulating a calibration session: the schedule of assessments, the EEG
 //! streamed through it, preprocessed and cut into features.
 
+use std::io::{Seek, Write};
+
 use errp_valid::Valid;
 use nalgebra::DMatrix;
 use rand::Rng;
 
 use super::{CalibrationParams, CalibrationSetup, GrandAverage, preprocessing};
 use crate::classify::Features;
+use crate::edf::EdfWriter;
 use crate::erp::AssessmentKind;
 use crate::error::{Result, check};
 use crate::features::{EpochWindow, FeatureExtractor};
@@ -104,6 +107,29 @@ pub fn simulate_session(
     let onsets: Vec<f64> = assessments.iter().map(|a| a.onset_secs).collect();
     let window = EpochWindow::paper(setup.generator.sfreq_hz);
     simulate_session_with(setup, seed, &assessments, &onsets, &window, options)
+}
+
+/// Simulates the calibration session of `setup` from `seed`, as
+/// [`simulate_session`] does, and writes its raw EEG and its events to
+/// `out` as EDF+ (one-second records, `error` and `correct` annotations),
+/// as `errp calibrate --export` does: the session, and `out` once written.
+/// A person's own EEG in the tests and benchmarks is such a file.
+pub fn export_session<W: Write + Seek>(
+    setup: &Valid<CalibrationSetup>,
+    seed: u64,
+    out: W,
+) -> Result<(CalibrationSession, W)> {
+    let mut writer = EdfWriter::new(out, &setup.montage, setup.generator.sfreq_hz)?;
+    let mut sink = |b: &EegBlock, e: &[Assessment]| writer.write(b, e);
+    let session = simulate_session(
+        setup,
+        seed,
+        SessionOptions {
+            raw_sink: Some(&mut sink),
+            ..SessionOptions::default()
+        },
+    )?;
+    Ok((session, writer.finish()?))
 }
 
 /// Checks that there is one window per assessment and that the onsets are

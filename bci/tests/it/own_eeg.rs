@@ -6,9 +6,8 @@
 use std::io::Cursor;
 
 use errp_bci::{
-    Assessment, AssessmentKind, CalibrationPart, EdfFile, EdfWriter, EegBlock, ErrorModel,
-    EventNames, LdaDecoder, Preprocessing, SessionOptions, Valid, calibrate_session,
-    simulate_session, split_own_eeg,
+    Assessment, AssessmentKind, CalibrationPart, EdfFile, EegBlock, ErrorModel, EventNames,
+    LdaDecoder, Preprocessing, Valid, calibrate_session, export_session, split_own_eeg,
 };
 
 use crate::decoder::sized;
@@ -17,20 +16,9 @@ use crate::decoder::sized;
 /// synthetic cross-validated accuracy, and its EDF+ export.
 fn exported(n_actions: usize, ratio: f64, seed: u64) -> (f64, Vec<u8>) {
     let setup = sized(n_actions, ratio);
-    let mut writer = EdfWriter::new(Cursor::new(Vec::new()), &setup.montage, 256.0).unwrap();
-    let mut sink = |b: &EegBlock, e: &[Assessment]| writer.write(b, e);
-    let session = simulate_session(
-        &setup,
-        seed,
-        SessionOptions {
-            raw_sink: Some(&mut sink),
-            ..SessionOptions::default()
-        },
-    )
-    .unwrap();
+    let (session, bytes) = export_session(&setup, seed, Cursor::new(Vec::new())).unwrap();
     let synthetic = calibrate_session(&LdaDecoder::default(), session, 5, seed).unwrap();
-    let bytes = writer.finish().unwrap().into_inner();
-    (synthetic.accuracy.mean(), bytes)
+    (synthetic.accuracy.mean(), bytes.into_inner())
 }
 
 fn preprocessing() -> Valid<Preprocessing> {

@@ -1,7 +1,7 @@
 //! The decisions a live loop takes from the decoder: what came, when, and
 //! what became of each ([`DecisionTracker`] for the grid's actions,
 //! [`WindowTracker`] for the e-puck's windows), with the rules every
-//! decoder keeps ([`Silence`]).
+//! decoder keeps: p(error) a probability, no long silence, no flood.
 
 use crate::error::{Result, SimError};
 use crate::pace::Speed;
@@ -151,32 +151,55 @@ impl LiveRunStats {
 pub trait Decisions {
     /// Takes what came by `now` (the link's clock).
     fn receive(&mut self, got: &[Received], now: f64) -> Result<()>;
-    /// Samples up to `stamp` are published.
-    fn published(&mut self, _stamp: f64) {}
+    /// Samples up to `stamp` are published, `samples` since the session
+    /// began.
+    fn published(&mut self, stamp: f64, samples: u64);
     /// The control starts at `now`: silence counts from here.
     fn start(&mut self, now: f64);
 }
 
-/// The rules every decoder keeps: p(error) is a probability, and silence
-/// lasts at most `timeout_secs` once the control has started.
+/// Decisions a decoder may send beyond one per EEG sample published (a
+/// grid decision sent twice, an e-puck window decoded again).
+pub const FLOOD_MARGIN: u64 = 1000;
+
+/// The rules every decoder keeps: p(error) is a probability, silence
+/// lasts at most `timeout_secs` once the control has started, and at most
+/// one decision comes per EEG sample published (and [`FLOOD_MARGIN`]
+/// more), so that what the loop keeps of them is bounded by the session's
+/// length.
 #[derive(Debug)]
-struct Silence {
+struct Rules {
     name: String,
     timeout_secs: f64,
     /// When the decoder was last heard from (or the control started).
     heard: Option<f64>,
+    /// Decisions received in the session.
+    received: u64,
+    /// EEG samples published in the session.
+    samples: u64,
 }
 
-impl Silence {
+impl Rules {
     fn new(name: &str, timeout_secs: f64) -> Self {
         Self {
             name: name.into(),
             timeout_secs,
             heard: None,
+            received: 0,
+            samples: 0,
         }
     }
 
     fn check(&mut self, r: &Received) -> Result<()> {
+        self.received += 1;
+        if self.received > self.samples + FLOOD_MARGIN {
+            return Err(SimError::Live(format!(
+                "the decoder stream {:?} sent {} decisions while {} EEG samples were \
+                 published: at most one decision per sample (and {FLOOD_MARGIN} more) is \
+                 read, one per grid action or e-puck window",
+                self.name, self.received, self.samples
+            )));
+        }
         if !(r.p_error.is_finite() && (0.0..=1.0).contains(&r.p_error)) {
             return Err(SimError::Live(format!(
                 "the decoder stream {:?} sent p(error) = {} for {}, expected a number from 0 \
@@ -209,7 +232,7 @@ impl Silence {
 /// action's marker.
 #[derive(Debug)]
 pub struct DecisionTracker {
-    silence: Silence,
+    rules: Rules,
     /// The action waiting (its id and onset on the link's clock).
     pending: Option<(u64, f64)>,
     /// Its decision, once come.
@@ -227,7 +250,7 @@ impl DecisionTracker {
     /// silence once [`DecisionTracker::start`]ed.
     pub fn new(name: &str, timeout_secs: f64) -> Self {
         Self {
-            silence: Silence::new(name, timeout_secs),
+            rules: Rules::new(name, timeout_secs),
             pending: None,
             decided: None,
             onsets: Vec::new(),
@@ -268,7 +291,11 @@ impl DecisionTracker {
 
 impl Decisions for DecisionTracker {
     fn start(&mut self, now: f64) {
-        self.silence.heard = Some(now);
+        self.rules.heard = Some(now);
+    }
+
+    fn published(&mut self, _stamp: f64, samples: u64) {
+        self.rules.samples = samples;
     }
 
     /// A decision for the action waiting is kept (the first one), others
@@ -276,7 +303,7 @@ impl Decisions for DecisionTracker {
     /// one, is an error.
     fn receive(&mut self, got: &[Received], now: f64) -> Result<()> {
         for r in got {
-            self.silence.check(r)?;
+            self.rules.check(r)?;
             let id =
                 (r.id.is_finite() && r.id >= 0.0 && r.id.fract() == 0.0).then_some(r.id as u64);
             let onset = id.and_then(|id| self.onsets.get(id as usize).copied());
@@ -298,7 +325,7 @@ impl Decisions for DecisionTracker {
             .pending
             .map(|(id, _)| format!(" (waiting for action {id})"))
             .unwrap_or_default();
-        self.silence.quiet(now, &waiting)
+        self.rules.quiet(now, &waiting)
     }
 }
 
@@ -309,7 +336,7 @@ impl Decisions for DecisionTracker {
 /// earlier phase is late (it judged a motion already past).
 #[derive(Debug)]
 pub struct WindowTracker {
-    silence: Silence,
+    rules: Rules,
     /// The timestamp at which the current movement phase began.
     phase_start: f64,
     /// The window of the last decision applied.
@@ -328,7 +355,7 @@ impl WindowTracker {
     /// silence once [`WindowTracker::start`]ed.
     pub fn new(name: &str, timeout_secs: f64) -> Self {
         Self {
-            silence: Silence::new(name, timeout_secs),
+            rules: Rules::new(name, timeout_secs),
             phase_start: f64::NEG_INFINITY,
             last_applied: f64::NEG_INFINITY,
             published: f64::NEG_INFINITY,
@@ -384,16 +411,17 @@ impl WindowTracker {
 
 impl Decisions for WindowTracker {
     fn start(&mut self, now: f64) {
-        self.silence.heard = Some(now);
+        self.rules.heard = Some(now);
     }
 
-    fn published(&mut self, stamp: f64) {
+    fn published(&mut self, stamp: f64, samples: u64) {
         self.published = stamp;
+        self.rules.samples = samples;
     }
 
     fn receive(&mut self, got: &[Received], now: f64) -> Result<()> {
         for r in got {
-            self.silence.check(r)?;
+            self.rules.check(r)?;
             let w = r.id;
             let fate = if !w.is_finite() || w > self.published + 1e-9 {
                 Fate::Stray
@@ -414,7 +442,7 @@ impl Decisions for WindowTracker {
                 fate,
             });
         }
-        self.silence.quiet(now, "")
+        self.rules.quiet(now, "")
     }
 }
 
@@ -439,11 +467,11 @@ mod tests {
         t.phase_began(1.0);
         t.take_run();
         t.warm_up_began();
-        t.published(11.9);
+        t.published(11.9, 10_000);
         t.receive(&[got(10.5, 1.0, 10.6), got(11.9, 1.0, 12.0)], 12.0)
             .unwrap();
         t.phase_began(12.0);
-        t.published(12.0625);
+        t.published(12.0625, 10_000);
         t.receive(&[got(12.0625, 0.2, 12.1)], 12.1).unwrap();
         assert_eq!(t.take(), [0.2]);
         let s = t.take_run();
@@ -506,12 +534,37 @@ mod tests {
     }
 
     #[test]
+    fn more_decisions_than_samples_published_stop_the_loop() {
+        // One per sample and the margin are read; one more is a flood.
+        for window in [false, true] {
+            let mut grid = DecisionTracker::new("dec", 10.0);
+            let mut epuck = WindowTracker::new("dec", 10.0);
+            let t: &mut dyn Decisions = if window { &mut epuck } else { &mut grid };
+            t.start(0.0);
+            t.published(1.0, 256);
+            let many = vec![got(7.0, 0.5, 1.0); 256 + FLOOD_MARGIN as usize];
+            t.receive(&many, 1.0).unwrap();
+            let e = t
+                .receive(&[got(7.0, 0.5, 1.0)], 1.0)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains("\"dec\" sent 1257 decisions while 256 EEG samples were published"),
+                "{e}"
+            );
+            // As more samples are published, more decisions are read.
+            t.published(2.0, 512);
+            t.receive(&[got(7.0, 0.5, 2.0)], 2.0).unwrap();
+        }
+    }
+
+    #[test]
     fn a_window_decision_applies_once_and_within_its_phase() {
         let mut t = WindowTracker::new("dec", 10.0);
         assert_eq!(t.take(), Vec::<f64>::new());
         t.take_run();
         t.start(0.0);
-        t.published(5.0);
+        t.published(5.0, 10_000);
         t.phase_began(3.0);
         t.receive(
             &[
@@ -528,7 +581,7 @@ mod tests {
         assert_eq!(t.take(), Vec::<f64>::new());
         // A decision accepted after the run's last window was never
         // applied.
-        t.published(5.5);
+        t.published(5.5, 10_000);
         t.receive(&[got(5.4, 0.3, 5.6)], 5.6).unwrap();
         let s = t.take_run();
         assert_eq!((s.late(), s.stray(), s.missed), (3, 1, 1));

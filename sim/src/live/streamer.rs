@@ -200,7 +200,7 @@ impl<'l, D: Decisions> Streamer<'l, D> {
             let last = self
                 .pace
                 .stamp(self.pace.sample_secs(self.sent + end as u64 - 1));
-            self.tracker.published(last);
+            self.tracker.published(last, self.sent + end as u64);
             errp_bci::stop::check()?;
             start = end;
         }

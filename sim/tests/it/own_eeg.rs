@@ -6,10 +6,7 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use errp_bci::{
-    Assessment, CalibrationParams, CalibrationSetup, EdfWriter, EegBlock, SessionOptions, Valid,
-    simulate_session,
-};
+use errp_bci::{CalibrationParams, CalibrationSetup, Valid, export_session};
 use errp_sim::grid::{AssessmentDecoder, GridScenario, prepare_decoder, run_grid_scenario};
 use errp_sim::{AnyScenario, ScenarioInput, ScenarioSource};
 
@@ -25,18 +22,7 @@ fn export(path: &Path, n_actions: usize, ratio: f64, seed: u64) {
     })
     .unwrap();
     let file = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
-    let mut writer = EdfWriter::new(file, &setup.montage, 256.0).unwrap();
-    let mut sink = |b: &EegBlock, e: &[Assessment]| writer.write(b, e);
-    simulate_session(
-        &setup,
-        seed,
-        SessionOptions {
-            raw_sink: Some(&mut sink),
-            ..SessionOptions::default()
-        },
-    )
-    .unwrap();
-    writer.finish().unwrap();
+    export_session(&setup, seed, file).unwrap();
 }
 
 fn dir(name: &str) -> PathBuf {

@@ -6,10 +6,7 @@
 use std::path::Path;
 
 use errp_bci::stop::WindDown;
-use errp_bci::{
-    Assessment, CalibrationParams, CalibrationSetup, EdfWriter, EegBlock, SessionOptions, Valid,
-    simulate_session,
-};
+use errp_bci::{CalibrationParams, CalibrationSetup, Valid, export_session};
 use errp_sim::Names;
 use errp_sim::TaskKind;
 use errp_sweep::{
@@ -30,18 +27,7 @@ fn export(path: &Path, ratio: f64, seed: u64) {
     })
     .unwrap();
     let file = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
-    let mut writer = EdfWriter::new(file, &setup.montage, 256.0).unwrap();
-    let mut sink = |b: &EegBlock, e: &[Assessment]| writer.write(b, e);
-    simulate_session(
-        &setup,
-        seed,
-        SessionOptions {
-            raw_sink: Some(&mut sink),
-            ..SessionOptions::default()
-        },
-    )
-    .unwrap();
-    writer.finish().unwrap();
+    export_session(&setup, seed, file).unwrap();
 }
 
 const SCENARIO: &str = "task = \"grid\"\n[free_goals]\ncount = 4\n[eeg]\nrecording = \"a.edf\"\n";
