@@ -22,6 +22,10 @@
 //!   operating point on a held-out session ([`operating_point`]);
 //! * the information one decoded action carries about the user's verdict
 //!   ([`ActionInformation`]);
+//! * the Gaussian classifier of the self-calibration papers
+//!   ([`GaussianClassifier`]: soft labels, shrunk per-class covariances,
+//!   Student-t densities) and its cross-validated confusion correction
+//!   ([`confusion_matrix`]);
 //! * the subjects of Table 1 ([`subject`]), EDF+ export ([`EdfWriter`]);
 //! * a person's own EEG in place of the synthetic EEG: EDF, EDF+,
 //!   BDF and BDF+ read and checked ([`EdfFile`]), matched to the montage
@@ -54,6 +58,7 @@ mod erp;
 mod error;
 mod features;
 mod filter;
+mod gaussian;
 mod generator;
 mod information;
 mod lda;
@@ -66,6 +71,7 @@ mod preprocess;
 mod psd;
 pub mod rng;
 mod smo;
+mod special;
 pub mod stop;
 mod subjects;
 mod svm;
@@ -95,6 +101,10 @@ pub use error::{BciError, Result};
 pub use errp_valid::{Check, Valid, shown};
 pub use features::{EpochWindow, FeatureExtractor};
 pub use filter::{Biquad, FilterBank, FilterChain};
+pub use gaussian::{
+    ClassMoments, GaussianClassifier, PAPER_FOLDS, PAPER_SHRINK, SoftLabel, column_normalised,
+    confusion_matrix, corrected, reference_folds,
+};
 pub use generator::{
     Assessment, BASELINE_SECS, Components, EegBlock, EegFeed, EegGenerator, ErrpTemplate,
     GeneratorParams, HybridEeg, HybridSource, MIN_HYBRID_PART_SECS, Realism, SFREQ_HZ,
@@ -121,5 +131,6 @@ pub use own_eeg::{
 pub use platt::PlattScaling;
 pub use preprocess::{PreprocessParams, Preprocessing, Preprocessor};
 pub use psd::ThetaPsd;
+pub use special::ln_gamma;
 pub use subjects::{GoalSet, Subject, subject, subjects};
 pub use svm::{SvmDecoder, SvmModel, SvmParts};

@@ -1,5 +1,6 @@
 //! The integration tests of `errp_bci`, one binary: the synthetic EEG, the
-//! discrete and continuous decoders, the determinism contracts, and the
+//! discrete and continuous decoders, the self-calibration papers' Gaussian
+//! classifier, the determinism contracts, and the
 //! EDF reader on files other tools wrote.
 
 mod continuous;
@@ -7,5 +8,6 @@ mod decoder;
 mod determinism;
 mod edf_fixtures;
 mod eeg;
+mod gaussian;
 mod own_eeg;
 mod realism;

@@ -1,7 +1,9 @@
 //! The grid on a person's own EEG: the decoder calibrated on the first
 //! part decodes epochs of the rest only (epochs marked by their event and
 //! their FCz trace), drawn with or without replacement, and the shared
-//! control assumes the accuracy the EEG gave.
+//! control assumes the accuracy the EEG gave; a file another tool wrote
+//! (the shared fixtures of `tests/data/edf`) without the decoding
+//! channels is refused naming them.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -131,6 +133,22 @@ fn a_recording_gives_the_accuracy_of_the_session_it_was_exported_from() {
     // The online accuracy is the held-out one, within its sampling error.
     let online = errp_sim::grid::pooled_accuracy(&episodes).mean();
     assert!((online - r.held_out.mean()).abs() < 0.06, "{online}");
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn a_file_another_tool_wrote_without_the_decoding_channels_is_refused_naming_them() {
+    // MNE's export of the shared fixture (`tests/data/edf`): Fz, Cz and an
+    // EOG channel, read as a recording; the decoder needs eight channels.
+    let d = dir("fixture");
+    let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/edf/mne_export.edf");
+    std::fs::copy(fixture, d.join("s.edf")).unwrap();
+    let s = scenario(&d, "", 1);
+    let e = prepare_decoder(&s, |_| {}).unwrap_err().to_string();
+    assert!(
+        e.contains("s.edf: no channel \"FC1\"") && e.contains("the recording has \"Fz\", \"Cz\""),
+        "{e}"
+    );
     std::fs::remove_dir_all(&d).unwrap();
 }
 
