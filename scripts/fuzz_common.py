@@ -1,7 +1,10 @@
 """What the fuzz families of fuzz_cli.py share: a value written as TOML,
-and the verdict on a finished command (see fuzz_cli.py's docstring)."""
+the verdict on a finished command, a case's command run and judged, and
+the `--help` of a family's module (see fuzz_cli.py's docstring)."""
 
 import math
+import subprocess
+import sys
 
 
 def toml_value(v):
@@ -42,9 +45,27 @@ def verdict(p, out, names, named):
     return None
 
 
-if __name__ == "__main__":
-    # A module of fuzz_cli.py: it runs nothing by itself.
-    import sys as _sys
+def judged(case, argv, out, names, named, gib, limit_memory, **run):
+    """Runs `case`'s command `argv` (its address space limited to `gib`
+    GiB, at most two minutes; `run`: `cwd`, `env`) and judges it by
+    `verdict`: (failure or None, exit code)."""
+    try:
+        p = subprocess.run(argv, capture_output=True, text=True, timeout=120,
+                           preexec_fn=limit_memory(gib), **run)
+    except subprocess.TimeoutExpired:
+        return f"{case.label}: no answer within 120 s: {case.command()}", None
+    why = verdict(p, out, names, named)
+    if why:
+        return f"{case.label}: {why}: {case.command()}\n{p.stderr[-600:]}", p.returncode
+    return None, p.returncode
 
-    print(__doc__.strip())
-    _sys.exit(0 if {"-h", "--help"} & set(_sys.argv[1:]) else 2)
+
+def module_help(doc):
+    """A family's module run by itself: it runs nothing, prints `doc`, and
+    exits 0 if asked for help (2 otherwise)."""
+    print(doc.strip())
+    sys.exit(0 if {"-h", "--help"} & set(sys.argv[1:]) else 2)
+
+
+if __name__ == "__main__":
+    module_help(__doc__)

@@ -21,7 +21,7 @@ import subprocess
 import tempfile
 from pathlib import Path
 
-from fuzz_common import verdict
+from fuzz_common import judged
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -313,23 +313,15 @@ def run_edf(errp, base, case, python, gib, limit_memory):
         (work / "own_eeg.toml").write_text(scenario)
         out = work / "out"
         out.mkdir()
-        try:
-            p = subprocess.run([errp, "run", "own_eeg.toml", "--quiet", "--save",
-                                str(out / "x.rrd")], capture_output=True, text=True,
-                               timeout=120, preexec_fn=limit_memory(gib), cwd=work)
-        except subprocess.TimeoutExpired:
-            return f"{case.label}: no answer within 120 s", None
-        why = verdict(p, out, (name,), "the file")
-        if why:
-            return f"{case.label}: {why}: {case.command()}\n{p.stderr[-600:]}", p.returncode
-        return None, p.returncode
+        return judged(case, [errp, "run", "own_eeg.toml", "--quiet", "--save",
+                             str(out / "x.rrd")], out, (name,), "the file", gib, limit_memory,
+                      cwd=work)
     finally:
         shutil.rmtree(work, ignore_errors=True)
 
 
 if __name__ == "__main__":
     # A module of fuzz_cli.py: it runs nothing by itself.
-    import sys as _sys
+    from fuzz_common import module_help
 
-    print(__doc__.strip())
-    _sys.exit(0 if {"-h", "--help"} & set(_sys.argv[1:]) else 2)
+    module_help(__doc__)

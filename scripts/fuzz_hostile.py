@@ -411,7 +411,6 @@ def signal_cases(n, seed):
 
 if __name__ == "__main__":
     # A module of fuzz_cli.py: it runs nothing by itself.
-    import sys as _sys
+    from fuzz_common import module_help
 
-    print(__doc__.strip())
-    _sys.exit(0 if {"-h", "--help"} & set(_sys.argv[1:]) else 2)
+    module_help(__doc__)

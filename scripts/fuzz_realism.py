@@ -19,12 +19,11 @@ import os
 import random
 import re
 import shutil
-import subprocess
 import tempfile
 import tomllib
 from pathlib import Path
 
-from fuzz_common import toml_value, verdict
+from fuzz_common import judged, toml_value
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -96,8 +95,8 @@ class RealismCase:
     def command(self):
         return {
             "run": f"errp run <{self.task} scenario with {self.label.split(': ', 1)[1]}>",
-            "realism": f"errp realism --grid <that scenario>",
-            "table1": f"errp table1 --realism <that scenario> --episodes 1",
+            "realism": "errp realism --grid <that scenario>",
+            "table1": "errp table1 --realism <that scenario> --episodes 1",
             "sweep": f"errp sweep --scenario <{self.task} scenario> --param "
                      f"realism.{self.field}=<shipped>,{level_text(self.value)}",
         }[self.way]
@@ -152,27 +151,19 @@ def run_realism(errp, case, gib, limit_memory):
                         with_field(text, case.field, case.value))
         out = work / "out"
         out.mkdir()
-        try:
-            p = subprocess.run([errp] + case.argv(file, out), capture_output=True, text=True,
-                               timeout=120, preexec_fn=limit_memory(gib), cwd=work,
-                               env=dict(os.environ, ERRP_CACHE_DIR=str(work / "cache")))
-        except subprocess.TimeoutExpired:
-            return f"{case.label}: no answer within 120 s: {case.command()}", None
         # A user so unlike a person that the decoder cannot reach the
         # scenario's accuracy (no ErrP, half the actions misjudged) is
         # refused for that accuracy, naming it.
         names = (f"realism.{case.field}", file.name, "realism", "accuracy = ")
-        why = verdict(p, out, names, "the field or the file")
-        if why:
-            return f"{case.label}: {why}: {case.command()}\n{p.stderr[-600:]}", p.returncode
-        return None, p.returncode
+        return judged(case, [errp] + case.argv(file, out), out, names, "the field or the file",
+                      gib, limit_memory, cwd=work,
+                      env=dict(os.environ, ERRP_CACHE_DIR=str(work / "cache")))
     finally:
         shutil.rmtree(work, ignore_errors=True)
 
 
 if __name__ == "__main__":
     # A module of fuzz_cli.py: it runs nothing by itself.
-    import sys as _sys
+    from fuzz_common import module_help
 
-    print(__doc__.strip())
-    _sys.exit(0 if {"-h", "--help"} & set(_sys.argv[1:]) else 2)
+    module_help(__doc__)
