@@ -46,14 +46,9 @@ impl ClassDensity {
     fn log_density(&self, e: &[f64]) -> f64 {
         let d = self.mean.len();
         let mut z = DVector::from_iterator(d, e.iter().zip(self.mean.iter()).map(|(x, m)| x - m));
-        // z <- L^-1 (e - mu): forward substitution.
-        for i in 0..d {
-            let mut s = z[i];
-            for j in 0..i {
-                s -= self.scale_l[(i, j)] * z[j];
-            }
-            z[i] = s / self.scale_l[(i, i)];
-        }
+        // z <- L^-1 (e - mu); L is a Cholesky factor, so its diagonal is
+        // positive and the solve cannot fail.
+        self.scale_l.solve_lower_triangular_mut(&mut z);
         let mahal = z.norm_squared();
         self.log_c - 0.5 * (self.nu + d as f64) * (mahal / self.nu).ln_1p()
     }
